@@ -1,0 +1,202 @@
+"""The design bundle: the directory every design command writes and other tools read.
+
+Layout (all geometry in metres)::
+
+    design.json     kind, units, lamellae, metrics, params, collapse curve
+    net.obj         joints as vertices, net-loops as quad faces
+    axes.obj        one dense polyline (``l`` record) per lamella axis, in design.json order
+    aligned.obj     net.obj's vertices and faces in the collapsed configuration
+    surface.obj     the designed surface (quad mesh)
+    revolution.obj  GG only: the isometric surface of revolution
+    *.png, ...      previews and extra files
+
+``design.json`` lamella records: ``{id, family, joints, joint_s, length}`` and, for NCP kinds,
+``collapse_s``: the arc length of each joint along the collapse curve.
+"""
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable
+
+import numpy as np
+
+from .atomic import atomic_dir
+from .errors import InputError
+from .net import Lamella, Net
+
+FORMAT = "gridshell.design"
+VERSION = 1
+KINDS = ("GG", "NCP", "CNC", "AA")
+
+
+@dataclass
+class CollapseCurve:
+    """The planar curve an NCP gridshell collapses into (paper 4.2.3).
+
+    Attributes
+    ----------
+    points : (k,2) float
+        Collapse polyline in its plane, metres.
+    normals : (k,2) float
+        Flattened unit surface normals at the points.
+    shape : str
+        "circle" (CNC), "line" (AA) or "curve" (general PHLW).
+    radius : float or None
+        Radius for a circle, metres.
+    """
+
+    points: np.ndarray
+    normals: np.ndarray
+    shape: str = "curve"
+    radius: float | None = None
+
+    def to_json(self) -> dict:
+        return {"shape": self.shape, "radius": self.radius,
+                "points": np.asarray(self.points).tolist(),
+                "normals": np.asarray(self.normals).tolist()}
+
+    @classmethod
+    def from_json(cls, d: dict) -> "CollapseCurve":
+        return cls(points=np.asarray(d["points"], float).reshape(-1, 2),
+                   normals=np.asarray(d["normals"], float).reshape(-1, 2),
+                   shape=str(d.get("shape", "curve")), radius=d.get("radius"))
+
+
+@dataclass
+class DesignBundle:
+    """Everything a design command produces; see the module docstring for the files."""
+
+    kind: str
+    net: Net
+    aligned: np.ndarray
+    surface_V: np.ndarray
+    surface_F: np.ndarray
+    metrics: dict[str, Any] = field(default_factory=dict)
+    params: dict[str, Any] = field(default_factory=dict)
+    collapse: CollapseCurve | None = None
+    collapse_s: dict[int, np.ndarray] | None = None
+    revolution_V: np.ndarray | None = None
+    revolution_F: np.ndarray | None = None
+    units: str = "m"
+
+    def __post_init__(self) -> None:
+        if self.kind not in KINDS:
+            raise InputError(f"design kind must be one of {', '.join(KINDS)}, got {self.kind!r}")
+        self.aligned = np.asarray(self.aligned, float).reshape(-1, 3)
+        if self.aligned.shape != self.net.joints.shape:
+            raise InputError(f"aligned joints {self.aligned.shape} do not match net joints "
+                             f"{self.net.joints.shape}")
+
+    def design_json(self) -> dict:
+        """The content of design.json."""
+        lams = []
+        for lam in self.net.lamellae:
+            rec = {"id": int(lam.id), "family": int(lam.family),
+                   "joints": lam.joints.tolist(), "joint_s": lam.joint_s.tolist(),
+                   "length": lam.length}
+            if self.collapse_s is not None and lam.id in self.collapse_s:
+                rec["collapse_s"] = np.asarray(self.collapse_s[lam.id]).tolist()
+            lams.append(rec)
+        d = {"format": FORMAT, "version": VERSION, "kind": self.kind, "units": self.units,
+             "n_joints": int(len(self.net.joints)), "n_loops": int(len(self.net.loops)),
+             "lamellae": lams, "metrics": _jsonable(self.metrics), "params": _jsonable(self.params)}
+        if self.collapse is not None:
+            d["collapse"] = self.collapse.to_json()
+        return d
+
+
+def _jsonable(obj: Any) -> Any:
+    """Turn numpy scalars/arrays nested in dicts and lists into JSON types."""
+    if isinstance(obj, dict):
+        return {str(k): _jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_jsonable(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return obj.tolist()
+    if isinstance(obj, np.generic):
+        return obj.item()
+    if isinstance(obj, Path):
+        return str(obj)
+    return obj
+
+
+def write_bundle(path: str | Path, bundle: DesignBundle,
+                 extra: dict[str, bytes | Callable[[Path], None]] | None = None) -> Path:
+    """Write ``bundle`` to directory ``path`` atomically; ``extra`` maps file names to bytes
+    or to a callable that writes that file given its full path. Returns ``path``."""
+    from .quadmesh import write_mesh, write_polylines
+
+    path = Path(path)
+    with atomic_dir(path) as tmp:
+        (tmp / "design.json").write_text(json.dumps(bundle.design_json(), indent=1),
+                                         encoding="utf-8")
+        write_mesh(tmp / "net.obj", bundle.net.joints, bundle.net.loops)
+        write_mesh(tmp / "aligned.obj", bundle.aligned, bundle.net.loops)
+        write_polylines(tmp / "axes.obj", [lam.axis for lam in bundle.net.lamellae])
+        write_mesh(tmp / "surface.obj", bundle.surface_V, bundle.surface_F)
+        if bundle.revolution_V is not None:
+            write_mesh(tmp / "revolution.obj", bundle.revolution_V, bundle.revolution_F)
+        for name, content in (extra or {}).items():
+            target = tmp / name
+            target.parent.mkdir(parents=True, exist_ok=True)
+            if callable(content):
+                content(target)
+            else:
+                target.write_bytes(content)
+    return path
+
+
+def read_design_json(path: str | Path) -> dict:
+    """Read and check ``design.json`` of bundle directory ``path``."""
+    path = Path(path)
+    f = path / "design.json"
+    if not path.is_dir():
+        raise InputError(f"{path} is not a directory; give the output directory of "
+                         "'gridshell gg' or 'gridshell ncp'")
+    if not f.is_file():
+        raise InputError(f"{path} is not a design bundle (no design.json); give the output "
+                         "directory of 'gridshell gg' or 'gridshell ncp'")
+    try:
+        d = json.loads(f.read_text(encoding="utf-8"))
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise InputError(f"{f} is not valid JSON ({exc}); re-run the design command") from exc
+    if d.get("format") != FORMAT:
+        raise InputError(f"{f} is not a gridshell design file (format {d.get('format')!r})")
+    for key in ("kind", "lamellae"):
+        if key not in d:
+            raise InputError(f"{f} lacks '{key}'; re-run the design command")
+    return d
+
+
+def read_bundle(path: str | Path) -> DesignBundle:
+    """Read a design bundle directory written by :func:`write_bundle`."""
+    from .quadmesh import read_mesh, read_polylines
+
+    path = Path(path)
+    d = read_design_json(path)
+    for name in ("net.obj", "aligned.obj", "axes.obj", "surface.obj"):
+        if not (path / name).is_file():
+            raise InputError(f"design bundle {path} lacks {name}; re-run the design command")
+    net_mesh = read_mesh(path / "net.obj", kind="quad")
+    aligned = read_mesh(path / "aligned.obj", kind="quad")
+    axes = read_polylines(path / "axes.obj")
+    if len(axes) != len(d["lamellae"]):
+        raise InputError(f"{path}: axes.obj has {len(axes)} polylines but design.json "
+                         f"{len(d['lamellae'])} lamellae")
+    lamellae = [Lamella(id=int(r["id"]), family=int(r["family"]), joints=r["joints"],
+                        joint_s=r["joint_s"], axis=ax) for r, ax in zip(d["lamellae"], axes)]
+    net = Net(joints=net_mesh.V, loops=net_mesh.F, lamellae=lamellae)
+    surf = read_mesh(path / "surface.obj", kind="any")
+    rev_V = rev_F = None
+    if (path / "revolution.obj").is_file():
+        rev = read_mesh(path / "revolution.obj", kind="any")
+        rev_V, rev_F = rev.V, rev.F
+    collapse_s = {int(r["id"]): np.asarray(r["collapse_s"], float)
+                  for r in d["lamellae"] if "collapse_s" in r} or None
+    collapse = CollapseCurve.from_json(d["collapse"]) if "collapse" in d else None
+    return DesignBundle(kind=d["kind"], net=net, aligned=aligned.V, surface_V=surf.V,
+                        surface_F=surf.F, metrics=d.get("metrics", {}),
+                        params=d.get("params", {}), collapse=collapse, collapse_s=collapse_s,
+                        revolution_V=rev_V, revolution_F=rev_F, units=d.get("units", "m"))

@@ -1,0 +1,60 @@
+"""Helpers shared by the subcommands: progress reporting and summaries."""
+from __future__ import annotations
+
+import json
+import sys
+import time
+from typing import Any, Callable
+
+
+class Progress:
+    """Progress messages on stderr, with the elapsed time; silent with ``-q``."""
+
+    def __init__(self, args: Any) -> None:
+        self.quiet = bool(getattr(args, "quiet", False))
+        self.verbose = int(getattr(args, "verbose", 0) or 0)
+        self.t0 = time.perf_counter()
+
+    def __call__(self, msg: str) -> None:
+        if not self.quiet:
+            print(f"[{time.perf_counter() - self.t0:7.1f}s] {msg}", file=sys.stderr, flush=True)
+
+    def detail(self, msg: str) -> None:
+        """A message shown only with ``-v``."""
+        if self.verbose and not self.quiet:
+            self(msg)
+
+    @property
+    def callback(self) -> Callable[[str], None]:
+        return self
+
+
+def print_summary(args: Any, title: str, summary: dict[str, Any]) -> None:
+    """One-screen summary on stdout, or JSON with ``--json``."""
+    if getattr(args, "json", False):
+        print(json.dumps({"ok": True, **summary}, indent=1, default=_default))
+        return
+    print(title)
+    width = max((len(k) for k in summary), default=0)
+    for k, v in summary.items():
+        print(f"  {k:<{width}}  {_fmt(v)}")
+
+
+def _fmt(v: Any) -> str:
+    if isinstance(v, float):
+        return f"{v:.4g}"
+    if isinstance(v, dict):
+        return ", ".join(f"{k}={_fmt(x)}" for k, x in v.items())
+    return str(v)
+
+
+def _default(o: Any) -> Any:
+    try:
+        import numpy as np
+        if isinstance(o, np.generic):
+            return o.item()
+        if isinstance(o, np.ndarray):
+            return o.tolist()
+    except ImportError:  # pragma: no cover
+        pass
+    return str(o)

@@ -1,0 +1,77 @@
+"""The ``gridshell`` command: a thin layer over the Python API, one module per subcommand."""
+from __future__ import annotations
+
+import argparse
+import importlib
+import json
+import sys
+from typing import Sequence
+
+from .. import __version__
+from ..errors import GridshellError
+
+#: subcommand name -> module in gridshell.cli with ``HELP``, ``add_args(parser)`` and ``run(args)``
+SUBCOMMANDS: dict[str, str] = {
+    "gg": "gg",
+    "phlw": "phlw",
+    "ncp": "ncp",
+    "verify": "verify",
+    "fabricate": "fabricate",
+    "render": "render",
+    "demo": "demo",
+}
+
+
+def _available() -> dict[str, object]:
+    mods = {}
+    for name, modname in SUBCOMMANDS.items():
+        try:
+            mods[name] = importlib.import_module(f"{__package__}.{modname}")
+        except ModuleNotFoundError as exc:
+            if exc.name != f"{__package__}.{modname}":
+                raise
+    return mods
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of every subcommand."""
+    parser = argparse.ArgumentParser(
+        prog="gridshell",
+        description="Design alignable lamella gridshells: from a target surface to cut files.")
+    parser.add_argument("--version", action="version", version=f"gridshell {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    for name, mod in _available().items():
+        p = sub.add_parser(name, help=getattr(mod, "HELP", None),
+                           description=getattr(mod, "HELP", None))
+        g = p.add_mutually_exclusive_group()
+        g.add_argument("-v", "--verbose", action="count", default=0, help="more progress output")
+        g.add_argument("-q", "--quiet", action="store_true", help="no progress output")
+        p.add_argument("--json", action="store_true", help="print the summary as JSON on stdout")
+        mod.add_args(p)
+        p.set_defaults(_run=mod.run)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the CLI; returns the exit code (0 success, 2 bad input, 3 no net, 4 no convergence,
+    5 output not writable, 1 other tool error)."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if not getattr(args, "command", None):
+        parser.print_help()
+        return 0
+    try:
+        result = args._run(args)
+    except GridshellError as exc:
+        if getattr(args, "json", False):
+            print(json.dumps({"ok": False, "error": type(exc).__name__, "message": str(exc)}))
+        print(f"gridshell {args.command}: error: {exc}", file=sys.stderr)
+        return exc.exit_code
+    except KeyboardInterrupt:
+        print("interrupted", file=sys.stderr)
+        return 130
+    return int(result or 0)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,114 @@
+"""A least-squares problem: a list of weighted terms over one :class:`Layout`."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..errors import InputError
+from .layout import Layout
+from .terms import TermFn, TermResult
+
+
+@dataclass
+class Entry:
+    """One weighted term of a problem: energy ``weight * |term(x)|^2``."""
+
+    name: str
+    weight: float
+    fn: TermFn
+    data: Any = None
+
+
+@dataclass
+class Assembled:
+    """Weighted residual ``r``, CSR Jacobian ``J`` and each term's rows in them."""
+
+    r: np.ndarray
+    J: sp.csr_matrix
+    slices: dict[str, slice]
+
+    def energy(self) -> float:
+        return float(self.r @ self.r)
+
+    def energies(self) -> dict[str, float]:
+        return {k: float(self.r[s] @ self.r[s]) for k, s in self.slices.items()}
+
+
+@dataclass
+class Problem:
+    """Sum of weighted squared residuals over the variables of ``layout``."""
+
+    layout: Layout
+    entries: list[Entry] = field(default_factory=list)
+
+    def add(self, name: str, weight: float, fn: TermFn, data: Any = None) -> "Problem":
+        """Add term ``fn`` with ``data`` and ``weight`` under ``name``; returns ``self``."""
+        if any(e.name == name for e in self.entries):
+            raise InputError(f"term {name!r} is added twice")
+        if not np.isfinite(weight) or weight < 0:
+            raise InputError(f"term {name!r}: weight must be finite and >= 0, got {weight}")
+        self.entries.append(Entry(name, float(weight), fn, data))
+        return self
+
+    def set_weight(self, name: str, weight: float) -> None:
+        """Change the weight of term ``name``."""
+        for e in self.entries:
+            if e.name == name:
+                e.weight = float(weight)
+                return
+        raise InputError(f"no term {name!r}; terms are {[e.name for e in self.entries]}")
+
+    def set_data(self, name: str, data: Any) -> None:
+        """Replace the data of term ``name`` (e.g. new closest points)."""
+        for e in self.entries:
+            if e.name == name:
+                e.data = data
+                return
+        raise InputError(f"no term {name!r}; terms are {[e.name for e in self.entries]}")
+
+    def evaluate(self, x: np.ndarray) -> list[tuple[Entry, TermResult]]:
+        """Every active term's unweighted result at ``x``."""
+        return [(e, e.fn(x, self.layout, e.data)) for e in self.entries if e.weight > 0]
+
+    def residuals(self, x: np.ndarray) -> np.ndarray:
+        """The weighted residual vector only (no Jacobian assembly cost saved)."""
+        return self.assemble(x, jacobian=False).r
+
+    def assemble(self, x: np.ndarray, jacobian: bool = True) -> Assembled:
+        """Weighted residual and CSR Jacobian at ``x``."""
+        rs, rows, cols, vals, slices, off = [], [], [], [], {}, 0
+        for e, res in self.evaluate(x):
+            w = np.sqrt(e.weight)
+            m = len(res.r)
+            rs.append(w * res.r)
+            if jacobian:
+                rows.append(res.rows + off)
+                cols.append(res.cols)
+                vals.append(w * res.vals)
+            slices[e.name] = slice(off, off + m)
+            off += m
+        r = np.concatenate(rs) if rs else np.zeros(0)
+        if jacobian and rows:
+            J = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                              shape=(off, self.layout.size))
+        else:
+            J = sp.csr_matrix((off, self.layout.size))
+        return Assembled(r, J, slices)
+
+    def energy(self, x: np.ndarray) -> float:
+        """Total energy ``sum_k w_k |r_k|^2``."""
+        r = self.residuals(x)
+        return float(r @ r)
+
+    def report(self, x: np.ndarray) -> dict[str, dict[str, float]]:
+        """Per term: weight, energy, unweighted RMS and max |r|."""
+        out = {}
+        for e, res in self.evaluate(x):
+            r = res.r
+            out[e.name] = {"weight": e.weight, "energy": e.weight * float(r @ r),
+                           "rms": float(np.sqrt(np.mean(r ** 2))) if r.size else 0.0,
+                           "max": float(np.max(np.abs(r))) if r.size else 0.0}
+        return out

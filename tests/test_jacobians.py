@@ -1,0 +1,47 @@
+"""One finite-difference check over every registered solver term (relative error < 1e-6)."""
+import importlib
+import pkgutil
+import zlib
+
+import numpy as np
+import pytest
+
+import gridshell
+from gridshell.solver import TERMS
+from gridshell.solver.fdcheck import jacobian_error
+
+import fd_cases
+
+
+def _import_all_gridshell_modules():
+    """Import every module of the package so that every @term is registered."""
+    for mod in pkgutil.walk_packages(gridshell.__path__, "gridshell."):
+        if ".cli" in mod.name:
+            continue
+        importlib.import_module(mod.name)
+
+
+def _all_cases():
+    cases = {}
+    for mod in pkgutil.iter_modules(fd_cases.__path__):
+        m = importlib.import_module(f"fd_cases.{mod.name}")
+        cases.update(m.CASES)
+    return cases
+
+
+_import_all_gridshell_modules()
+CASES = _all_cases()
+
+
+def test_every_registered_term_has_a_case():
+    missing = sorted(set(TERMS) - set(CASES))
+    assert not missing, f"terms without a finite-difference case: {missing}"
+
+
+@pytest.mark.parametrize("name", sorted(CASES))
+def test_jacobian_matches_finite_differences(name):
+    assert name in TERMS, f"case {name} names no registered term"
+    rng = np.random.default_rng(zlib.crc32(name.encode()))
+    layout, x, data = CASES[name](rng)
+    err = jacobian_error(TERMS[name], x, layout, data)
+    assert err < 1e-6, f"{name}: relative Jacobian error {err:.2e}"
