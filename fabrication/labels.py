@@ -1,0 +1,140 @@
+"""Engraved labels in a single-line (Hershey) font: lamella id and neighbour ids (issue item 3).
+
+Text is written as stroke polylines on the ENGRAVE layer, never as DXF TEXT. Each label
+lies along the axis tangent at its centre; a label that would leave the material (outline
+shrunk by 0.5 mm, clear of holes) is shrunk, then dropped (counted in the report).
+"""
+from __future__ import annotations
+
+from functools import lru_cache
+
+import numpy as np
+from shapely.geometry import MultiLineString, Polygon
+
+from .joints import feature_halfwidth, slot_edge
+from .params import FabParams
+from .strip import Strip
+
+MIN_HEIGHT = 1.5  # mm; smaller single-line text does not engrave legibly
+
+
+@lru_cache(maxsize=1)
+def _font():
+    from HersheyFonts import HersheyFonts
+
+    f = HersheyFonts()
+    f.load_default_font("futural")
+    f.normalize_rendering(1.0)
+    segs = np.array(list(f.lines_for_text("0123456789L")), float).reshape(-1, 2, 2)
+    y0, y1 = segs[..., 1].min(), segs[..., 1].max()
+    return f, y0, y1 - y0
+
+
+@lru_cache(maxsize=4096)
+def _unit_strokes(text: str) -> tuple[tuple[np.ndarray, ...], float]:
+    f, y0, cap = _font()
+    segs = np.array(list(f.lines_for_text(text)), float).reshape(-1, 2, 2)
+    if len(segs) == 0:
+        return (), 0.0
+    segs[..., 1] -= y0
+    segs /= cap
+    x0, x1 = segs[..., 0].min(), segs[..., 0].max()
+    segs[..., 0] -= x0
+    lines, cur = [], [segs[0, 0], segs[0, 1]]
+    for a, b in segs[1:]:
+        if np.allclose(a, cur[-1]):
+            cur.append(b)
+        else:
+            lines.append(np.array(cur))
+            cur = [a, b]
+    lines.append(np.array(cur))
+    return tuple(lines), float(x1 - x0)
+
+
+def text_strokes(text: str, height: float) -> tuple[list[np.ndarray], float]:
+    """Stroke polylines ``[(k,2)]`` of ``text`` with cap height ``height`` mm, baseline at
+    y = 0, starting at x = 0; and the text's length in mm."""
+    lines, length = _unit_strokes(text)
+    return [L * height for L in lines], length * height
+
+
+def place_text(strip: Strip, text: str, height: float, s: float, t: float) -> list[np.ndarray]:
+    """Strokes of ``text`` centred at strip coordinates ``(s, t)``, reading along +s."""
+    lines, length = text_strokes(text, height)
+    if not lines:
+        return []
+    c = strip.axis.point(s, t)
+    T = strip.axis.tangent(s)
+    R = np.array([T, [-T[1], T[0]]])
+    shift = np.array([length / 2, height / 2])
+    return [(L - shift) @ R + c for L in lines]
+
+
+def text_length(text: str, height: float) -> float:
+    return _unit_strokes(text)[1] * height
+
+
+def strip_labels(strip: Strip, params: FabParams,
+                 material: Polygon) -> tuple[list[np.ndarray], int]:
+    """Engraving strokes of the strip: its name (``L12``, ``L12-1/2``) in the widest free
+    stretch and the neighbour ids right after each joint. ``material``: the part's shapely
+    polygon (holes as interiors). Returns the strokes and the number of labels dropped."""
+    w = strip.width
+    band_t, band_h = strip.t_mid, w
+    if params.joints == "slots":   # keep to the half the notches leave whole
+        band_h = w / 2
+        band_t = strip.t_mid + (-w / 4 if slot_edge(strip.family) == "hi" else w / 4)
+    h0 = min(0.3 * w, band_h - 2.0, 8.0)
+    if h0 < MIN_HEIGHT:
+        return [], len(strip.joint_s) + 1
+    safe = material.buffer(-0.5)
+    pad = feature_halfwidth(params) + 1.0
+    strokes: list[np.ndarray] = []
+    dropped = 0
+    occupied: list[tuple[float, float]] = [(s - pad, s + pad) for s in strip.joint_s]
+
+    def fits(lines):
+        return bool(lines) and safe.contains(MultiLineString([L for L in lines]))
+
+    for s_j, nb in zip(strip.joint_s, strip.neighbours):
+        if not nb:
+            continue
+        text = ",".join(str(i) for i in nb)
+        h = h0
+        while h >= MIN_HEIGHT:
+            L = text_length(text, h)
+            s_c = s_j + pad + L / 2
+            nxt = [a for a, _ in occupied if a > s_j + 1e-9]
+            limit = min(nxt + [strip.s1 - 1.0])
+            lines = place_text(strip, text, h, s_c, band_t)
+            if s_c + L / 2 <= limit and fits(lines):
+                strokes += lines
+                occupied.append((s_j + pad, s_c + L / 2 + 1.0))
+                break
+            h *= 0.75
+        else:
+            dropped += 1
+    # the strip's name in the longest free stretch
+    text = strip.name
+    occ = sorted(occupied + [(strip.s0 - 1, strip.s0 + 1.0), (strip.s1 - 1.0, strip.s1 + 1)])
+    free, end = [], occ[0][1]
+    for a, b in occ[1:]:
+        if a > end:
+            free.append((end, a))
+        end = max(end, b)
+    free.sort(key=lambda ab: ab[0] - ab[1])
+    placed = False
+    for a, b in free:
+        h = h0
+        while h >= MIN_HEIGHT and not placed:
+            if text_length(text, h) <= b - a:
+                lines = place_text(strip, text, h, 0.5 * (a + b), band_t)
+                if fits(lines):
+                    strokes += lines
+                    placed = True
+            h *= 0.75
+        if placed:
+            break
+    dropped += 0 if placed else 1
+    return strokes, dropped
+

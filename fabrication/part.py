@@ -1,0 +1,123 @@
+"""A Part: the cut geometry of one strip in the plane, by layer, in mm.
+
+``outline`` (CUT, closed, bulges for arcs), ``holes`` (CUT circles), ``scores`` (SCORE line
+segments), ``engrave`` (ENGRAVE stroke polylines). :func:`build_part` makes it from a
+:class:`~fabrication.strip.Strip`; ``Part.moved`` places it on a sheet.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from shapely.geometry import Point, Polygon
+from shapely.ops import unary_union
+
+from gridshell.errors import InputError
+
+from .joints import hole_centres, joint_points, outline_corners, score_marks
+from .kerf import hole_radius, offset_corners
+from .labels import strip_labels
+from .params import FabParams
+from .path import Motion, Path
+from .strip import Strip
+
+
+@dataclass
+class Part:
+    """Cut geometry of one strip.
+
+    Attributes
+    ----------
+    strip : Strip
+    outline : Path
+        Closed cut path (kerf-compensated when asked).
+    holes : (k,2) float, radii : (k,) float
+        Hole centres and cut-path radii.
+    scores : (m,2,2) float
+        Score line segments.
+    engrave : list of (p,2) float
+        Label strokes.
+    joints : (j,2) float
+        The joints on the axis (not written; for checks and the cut list).
+    nominal : Path
+        The outline without kerf compensation.
+    labels_dropped : int
+    area : float
+        Material area of the nominal part (outline minus holes), mm^2.
+    motion : Motion
+        The placement applied so far (identity for a fresh part).
+    """
+
+    strip: Strip
+    outline: Path
+    holes: np.ndarray
+    radii: np.ndarray
+    scores: np.ndarray
+    engrave: list[np.ndarray]
+    joints: np.ndarray
+    nominal: Path
+    labels_dropped: int = 0
+    area: float = 0.0
+    motion: Motion = field(default_factory=Motion)
+
+    def moved(self, m: Motion) -> "Part":
+        return Part(self.strip, self.outline.moved(m), m.apply(self.holes).reshape(-1, 2),
+                    self.radii, m.apply(self.scores.reshape(-1, 2)).reshape(-1, 2, 2),
+                    [m.apply(L) for L in self.engrave], m.apply(self.joints).reshape(-1, 2),
+                    self.nominal.moved(m), self.labels_dropped, self.area,
+                    self.motion.then(m))
+
+    def polygon(self, tol: float = 0.05) -> Polygon:
+        """The outline as a shapely polygon (no holes): the sheet area the part takes."""
+        return Polygon(self.outline.flatten(tol))
+
+
+
+def _corners_to_path(axis, C: np.ndarray, tol: float) -> Path:
+    Vs, Bs = [], []
+    n = len(C)
+    for i in range(n):
+        a, b = C[i], C[(i + 1) % n]
+        if i % 2 == 0:
+            V, B = axis.edge(a[0], b[0], a[1], tol)
+        else:
+            V, B = axis.point(a[0], a[1])[None], np.zeros(1)
+        Vs.append(V)
+        Bs.append(B)
+    return Path(np.concatenate(Vs), np.concatenate(Bs), closed=True)
+
+
+def check_spacing(strip: Strip, params: FabParams) -> None:
+    """Raise InputError if neighbouring joint features would merge."""
+    if len(strip.joint_s) < 2:
+        return
+    gap = float(np.min(np.diff(strip.joint_s)))
+    need = {"hole": params.hole, "slots": params.slot_width, "marks": 0.0}[params.joints] + 0.5
+    if gap < need:
+        raise InputError(f"lamella {strip.lamella}: two joints are only {gap:.3g} mm apart at "
+                         f"this scale, too close for {params.joints} of {need - 0.5:g} mm; use a "
+                         "larger --scale or smaller --hole/--thickness")
+
+
+def build_part(strip: Strip, params: FabParams) -> Part:
+    """Outline (with slots), holes, score marks and labels of ``strip``."""
+    check_spacing(strip, params)
+    tol = params.tolerance
+    C = outline_corners(strip, params)
+    nominal = _corners_to_path(strip.axis, C, tol)
+    d = params.kerf / 2
+    outline = _corners_to_path(strip.axis, offset_corners(strip.axis, C, d), tol) if d else nominal
+    k = len(strip.joint_s)
+    if params.joints == "hole":
+        holes, radii = hole_centres(strip), np.full(k, hole_radius(params.hole, params.kerf))
+    else:
+        holes, radii = np.zeros((0, 2)), np.zeros(0)
+    scores = score_marks(strip) if params.joints == "marks" else np.zeros((0, 2, 2))
+    part = Part(strip, outline, holes, radii, scores, [], joint_points(strip), nominal)
+    mat = Polygon(nominal.flatten(tol))
+    if len(holes):
+        mat = mat.difference(unary_union([Point(c).buffer(params.hole / 2, 32) for c in holes]))
+    part.area = float(mat.area)
+    if params.labels:
+        part.engrave, part.labels_dropped = strip_labels(strip, params, mat)
+    return part

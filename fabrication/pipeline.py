@@ -1,0 +1,170 @@
+"""``fabricate``: from a design bundle to laser-ready sheets, a cut list and an assembly plan.
+
+Everything that can go wrong with the parameters or the design is checked before the first
+file is written; the output directory then appears at once (``gridshell.atomic.atomic_dir``)::
+
+    sheet_01.dxf, sheet_01.svg, ...   one DXF and one SVG per sheet
+    cutlist.csv                        one row per piece
+    plan.png, plan.svg                 the net with every lamella's id at its place
+    fabrication.json                   this report
+"""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any, Callable
+
+import numpy as np
+
+from gridshell.atomic import atomic_dir
+from gridshell.bundle import DesignBundle, read_bundle
+from gridshell.errors import InputError
+
+from .cutlist import cutlist_rows, write_cutlist
+from .dxf import write_sheet_dxf
+from .nesting import Layout, check_layout, nest
+from .params import FabParams
+from .part import Part, build_part
+from .plan import write_plan
+from .splice import split_strip
+from .strips import strips_from_bundle
+from .svg import write_sheet_svg
+
+REPORT = "fabrication.json"
+
+
+def _check_out(out: Path, bundle_dir: Path | None) -> None:
+    out_r = out.resolve()
+    if bundle_dir is not None:
+        b = bundle_dir.resolve()
+        if out_r == b or out_r in b.parents:
+            raise InputError(f"output directory {out} would replace the design bundle {bundle_dir};"
+                             " choose another -o (default: DIR/fabrication)")
+    if out.exists():
+        if not out.is_dir():
+            raise InputError(f"{out} exists and is not a directory; choose another -o")
+        if any(out.iterdir()) and not (out / REPORT).is_file():
+            raise InputError(f"{out} exists and is not the output of 'gridshell fabricate' (no "
+                             f"{REPORT}); choose another -o or remove it")
+
+
+def plan_parts(bundle: DesignBundle, params: FabParams,
+               progress: Callable[[str], None] | None = None) -> tuple[list[Part], Layout, dict]:
+    """Strips, pieces, parts and their layout, without writing anything."""
+    say = progress or (lambda msg: None)
+    strips = strips_from_bundle(bundle, params)
+    say(f"{len(strips)} {strips[0].axis.kind} strips")
+    pieces = [p for s in strips for p in split_strip(s, params)]
+    by_lamella: dict[int, list] = {}
+    for p in pieces:
+        by_lamella.setdefault(p.lamella, []).append(p)
+    split = []
+    for lam, ps in by_lamella.items():
+        if len(ps) > 1:
+            notes = [n for p in ps for n in p.splices if n["with"] > p.piece]
+            split.append({"lamella": lam, "pieces": len(ps),
+                          "overlaps_mm": [round(n["overlap"], 3) for n in notes],
+                          "splice_joints": [n["splice_joint"] for n in notes]})
+    if split:
+        say(f"{len(split)} lamellae longer than the sheet split at joints")
+    parts = [build_part(p, params) for p in pieces]
+    layout = nest(parts, params)
+    check_layout(layout, params.gap)
+    say(f"nested {len(parts)} pieces on {layout.n_sheets} sheet(s)")
+    return parts, layout, {"strips": strips, "split": split}
+
+
+def fabricate(bundle: str | Path | DesignBundle, out_dir: str | Path,
+              params: FabParams | dict[str, Any] | None = None,
+              progress: Callable[[str], None] | None = None,
+              plan: bool = True) -> dict[str, Any]:
+    """Write cut files, cut list and plan of a design bundle to ``out_dir``.
+
+    Parameters
+    ----------
+    bundle : path or DesignBundle
+        A design bundle directory (read with :func:`gridshell.bundle.read_bundle`) or the
+        bundle itself.
+    out_dir : path
+        Output directory; replaced atomically. It must not be (or contain) the bundle, and an
+        existing non-empty directory must be an earlier fabrication output.
+    params : FabParams or dict of its fields
+    progress : callable, optional
+    plan : bool
+        Draw plan.png / plan.svg (the slowest step; off for quick checks).
+
+    Returns
+    -------
+    dict
+        The report also written to ``fabrication.json``: parameters, counts, utilisation,
+        split lamellae, files, and each piece's sheet and placement (the rigid motion from
+        strip coordinates, see :mod:`fabrication.axis`, to the sheet).
+    """
+    say = progress or (lambda msg: None)
+    if params is None:
+        params = FabParams()
+    elif isinstance(params, dict):
+        params = FabParams(**params)
+    bundle_dir = None
+    if not isinstance(bundle, DesignBundle):
+        bundle_dir = Path(bundle)
+        say(f"reading {bundle_dir}")
+        bundle = read_bundle(bundle_dir)
+    out = Path(out_dir)
+    _check_out(out, bundle_dir)
+    parts, layout, info = plan_parts(bundle, params, say)
+    W, H = params.sheet
+    area = sum(p.area for p in parts)
+    util = area / (layout.n_sheets * W * H)
+    per_sheet = [sum(p.area for p in layout.on_sheet(k)) / (W * H) for k in range(layout.n_sheets)]
+    names = [f"sheet_{k + 1:02d}" for k in range(layout.n_sheets)]
+    files = [f"{n}{ext}" for n in names for ext in (".dxf", ".svg")]
+    files += ["cutlist.csv"] + (["plan.png", "plan.svg"] if plan else []) + [REPORT]
+    mm = params.mm_per_m
+    axis_lengths = {int(lam.id): lam.length * mm for lam in bundle.net.lamellae}
+    report = {
+        "kind": bundle.kind,
+        "shape": info["strips"][0].axis.kind,
+        "params": params.to_json(),
+        "n_strips": len(info["strips"]),
+        "n_pieces": len(parts),
+        "n_sheets": layout.n_sheets,
+        "n_joint_marks": int(sum(len(p.strip.joint_s) for p in parts)),
+        "n_design_joints": int(sum(len(lam.joints) for lam in bundle.net.lamellae)),
+        "utilisation": util,
+        "utilisation_per_sheet": per_sheet,
+        "pieces_split": info["split"],
+        "labels_dropped": int(sum(p.labels_dropped for p in parts)),
+        "radius_mm": info["strips"][0].axis.radius,
+        "sheet_files": "one DXF and one SVG per sheet",
+        "files": files,
+        "pieces": [{"lamella": p.strip.lamella, "piece": p.strip.piece,
+                    "n_pieces": p.strip.n_pieces, "sheet": s + 1,
+                    "flat_length_mm": p.strip.length, "s0": p.strip.s0,
+                    "motion": p.motion.to_json()}
+                   for p, s in zip(layout.parts, layout.sheet_of)],
+    }
+    say(f"writing {out}")
+    with atomic_dir(out) as tmp:
+        for k, name in enumerate(names):
+            sp = layout.on_sheet(k)
+            write_sheet_dxf(tmp / f"{name}.dxf", sp, (W, H), params)
+            write_sheet_svg(tmp / f"{name}.svg", sp, (W, H), params,
+                            title=f"{name}: {len(sp)} parts")
+        write_cutlist(tmp / "cutlist.csv", cutlist_rows(layout, axis_lengths))
+        if plan:
+            say("drawing the assembly plan")
+            write_plan(tmp / "plan.png", tmp / "plan.svg", bundle.net,
+                       title=f"{bundle.kind} gridshell: lamella ids (blue family 1, red family 3)")
+        (tmp / REPORT).write_text(json.dumps(report, indent=1, default=_json_default),
+                                  encoding="utf-8")
+    report["out"] = str(out)
+    return report
+
+
+def _json_default(o: Any) -> Any:
+    if isinstance(o, np.generic):
+        return o.item()
+    if isinstance(o, np.ndarray):
+        return o.tolist()
+    return str(o)

@@ -1,0 +1,80 @@
+"""``gridshell fabricate``: laser-ready DXF/SVG sheets, cut list and plan of a design bundle."""
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Any
+
+HELP = ("cut files of a design bundle: flat lamellae with joint holes, slots or marks and "
+        "engraved ids, nested on sheets as DXF and SVG, with a cut list and an assembly plan")
+
+
+def add_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("bundle", metavar="DIR",
+                   help="design bundle (output of 'gridshell gg' or 'ncp')")
+    p.add_argument("-o", "--out", metavar="OUT",
+                   help="output directory, replaced atomically (default DIR/fabrication)")
+    g = p.add_argument_group("strips (mm of the model)")
+    g.add_argument("--width", type=float, default=20.0, help="strip width (default 20)")
+    g.add_argument("--thickness", type=float, default=1.0, help="sheet thickness (default 1)")
+    g.add_argument("--margin", type=float, default=15.0,
+                   help="strip length beyond the end joints (default 15)")
+    g.add_argument("--axis", choices=("centre", "edge"), default="centre",
+                   help="lamella axis on the strip's centre line or on one edge (orthogonal "
+                        "lamellae standing on the surface); default centre")
+    g.add_argument("--scale", default="1:10",
+                   help="model scale, e.g. 1:10 (default), 1:1 or 0.1")
+    g = p.add_argument_group("joints")
+    g.add_argument("--joints", choices=("hole", "slots", "marks"), default="hole",
+                   help="hole on the axis (default); slots: cross-halving notches (orthogonal "
+                        "lamellae); marks: score lines across the strip")
+    g.add_argument("--hole", type=float, default=3.0, help="hole diameter, mm (default 3)")
+    g.add_argument("--clearance", type=float, default=0.2,
+                   help="slot width = thickness + clearance, mm (default 0.2)")
+    g = p.add_argument_group("sheets and cutting")
+    g.add_argument("--sheet", default="600x400",
+                   help="sheet size WIDTHxHEIGHT mm (default 600x400)")
+    g.add_argument("--gap", type=float, default=5.0,
+                   help="gap between parts and to the sheet edges, mm (default 5)")
+    g.add_argument("--overlap", type=float, default=None,
+                   help="splice overlap of lamellae split to fit a sheet, mm (default: one joint "
+                        "spacing plus two margins, so the pieces share two joints)")
+    g.add_argument("--kerf", type=float, default=0.0,
+                   help="laser kerf, mm: outlines move out and holes in by kerf/2 (default 0: off)")
+    g.add_argument("--dxf-version", choices=("R2010", "R12"), default="R2010",
+                   help="DXF version (default R2010; R12 through ezdxf's R12 export)")
+    g.add_argument("--segments", action="store_true",
+                   help="write arcs as short segments instead of bulges")
+    g.add_argument("--no-labels", action="store_true", help="do not engrave ids")
+    p.add_argument("--no-plan", action="store_true", help="do not draw plan.png / plan.svg")
+
+
+def run(args: Any) -> int:
+    from fabrication import FabParams, fabricate
+
+    from .common import Progress, print_summary
+
+    progress = Progress(args)
+    params = FabParams(width=args.width, thickness=args.thickness, hole=args.hole,
+                       joints=args.joints, clearance=args.clearance, margin=args.margin,
+                       axis=args.axis, scale=args.scale, sheet=args.sheet, gap=args.gap,
+                       overlap=args.overlap, kerf=args.kerf, dxf_version=args.dxf_version,
+                       segments=args.segments, labels=not args.no_labels)
+    out = Path(args.out) if args.out else Path(args.bundle) / "fabrication"
+    rep = fabricate(args.bundle, out, params, progress=progress.callback, plan=not args.no_plan)
+    summary = {
+        "output": str(out),
+        "design": f"{rep['kind']} ({rep['shape']} strips)",
+        "strips / pieces": f"{rep['n_strips']} / {rep['n_pieces']}",
+        "joint marks": rep["n_joint_marks"],
+        "sheets": f"{rep['n_sheets']} x {params.sheet[0]:g} x {params.sheet[1]:g} mm "
+                  "(one DXF and one SVG per sheet)",
+        "utilisation [%]": 100.0 * rep["utilisation"],
+        "pieces split": ", ".join(f"L{d['lamella']} in {d['pieces']}"
+                                  for d in rep["pieces_split"]) or "none",
+        "files": ", ".join(rep["files"]),
+    }
+    if rep["labels_dropped"]:
+        summary["labels dropped (no room)"] = rep["labels_dropped"]
+    print_summary(args, "Fabrication", summary)
+    return 0

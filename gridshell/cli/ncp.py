@@ -1,0 +1,91 @@
+"""``gridshell ncp``: design a normal-curvature-preserving alignable gridshell (paper 4.2)."""
+from __future__ import annotations
+
+import argparse
+from typing import Any
+
+HELP = ("trace a normal-curvature-preserving alignable net on a PHLW / CNC / PK surface, "
+        "post-optimize it, simulate its alignment and write a design bundle (NCP, CNC or AA)")
+
+
+def add_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("reference", help="a surface.json written by 'gridshell phlw', or a reference "
+                                     "mesh (OBJ, PLY, OFF): the PHLW step runs first")
+    p.add_argument("-o", "--output", required=True, metavar="DIR",
+                   help="output design bundle directory (replaced atomically)")
+    p.add_argument("--mode", choices=("phlw", "cnc", "aa"), default="phlw",
+                   help="phlw: normal curvature per principal line (kind NCP); cnc: one normal "
+                        "curvature, collapses into a circle (kind CNC); aa: asymptotic net on "
+                        "a PK surface, collapses into a line (kind AA); default phlw")
+    g = p.add_mutually_exclusive_group()
+    g.add_argument("--curves", type=int, metavar="N",
+                   help="curves per family, uniformly subdivided level values (default 10)")
+    g.add_argument("--spacing", type=float, metavar="M",
+                   help="spacing of the curves, metres")
+    p.add_argument("--n", type=float, metavar="1/M",
+                   help="cnc: the normal curvature of the net (default: fitted)")
+    p.add_argument("--samples", nargs=2, type=int, default=(48, 48), metavar=("RU", "RV"),
+                   help="direction samples of the level-set fit (default 48 48)")
+    p.add_argument("--levelset-ctrl", nargs=2, type=int, default=(12, 12), metavar=("NU", "NV"),
+                   help="control points of the level functions (default 12 12)")
+    p.add_argument("--omega-f", type=float, default=0.01, metavar="W",
+                   help="fairness weight of the level functions (default 0.01; the paper uses 0.1)")
+    p.add_argument("--collapse-samples", nargs=2, type=int, default=(1200, 1200),
+                   metavar=("RU", "RV"), help="collapse-curve sampling (default 1200 1200)")
+    p.add_argument("--rounds", type=int, default=3,
+                   help="post-optimization rounds (default 3)")
+    p.add_argument("--frames", type=int, default=12,
+                   help="steps of the alignment sequence (default 12)")
+    p.add_argument("--no-render", action="store_true",
+                   help="skip the PNG pictures, PNG frames and alignment.gif")
+    p.add_argument("--phlw-ctrl", nargs=2, type=int, default=(9, 9), metavar=("NU", "NV"),
+                   help="mesh input: control points of the PHLW B-spline (default 9 9)")
+    p.add_argument("--phlw-samples", nargs=2, type=int, default=(18, 18), metavar=("RU", "RV"),
+                   help="mesh input: PHLW optimization samples (default 18 18)")
+    p.add_argument("--phlw-outer", type=int, default=4,
+                   help="mesh input: PHLW outer rounds (default 4)")
+    p.add_argument("--phlw-max-iter", type=int, default=40,
+                   help="mesh input: PHLW iterations per round (default 40)")
+
+
+def run(args: Any) -> int:
+    from ..ncp.pipeline import design_ncp, write_ncp
+    from .common import Progress, print_summary
+
+    progress = Progress(args)
+    progress(f"reading {args.reference}")
+    phlw = {"ctrl": tuple(args.phlw_ctrl), "samples": tuple(args.phlw_samples),
+            "outer": args.phlw_outer, "max_iter": args.phlw_max_iter}
+    curves = args.curves if args.curves is not None or args.spacing is not None else 10
+    bundle, report = design_ncp(args.reference, mode=args.mode, curves=curves,
+                                spacing=args.spacing, n=args.n, samples=tuple(args.samples),
+                                levelset_ctrl=tuple(args.levelset_ctrl), omega_f=args.omega_f,
+                                collapse_samples=tuple(args.collapse_samples),
+                                postopt_rounds=args.rounds, frames=args.frames,
+                                phlw_options=phlw, progress=progress.callback)
+    progress(f"writing {args.output}")
+    out = write_ncp(args.output, bundle, report, render=not args.no_render,
+                    progress=progress.callback)
+    m = bundle.metrics
+    summary = {
+        "bundle": str(out),
+        "kind": bundle.kind,
+        "joints / loops / lamellae": f"{m['n_joints']} / {m['n_loops']} / "
+                                     f"{m['n_lamellae']['C1']} + {m['n_lamellae']['C3']}",
+        "Delta_a before [%]": m["delta_a_before"],
+        "Delta_a after [%]": m["delta_a_after"],
+        "Delta_l [%]": m["delta_l"],
+        "Delta_n [%]": m["delta_n"],
+        "deviation [% diag]": m["deviation"],
+        "crossing kn difference [%]": {"mean": m["crossing_kn"]["mean"],
+                                       "max": m["crossing_kn"]["max"]},
+    }
+    if "n" in m:
+        summary["n [1/m]"] = m["n"]
+        summary["collapse radius [m]"] = m["collapse_radius"]
+        summary["aligned radius error [%]"] = m["aligned_radius_error"]
+    if "aligned_line_error" in m:
+        summary["aligned line error [% span]"] = m["aligned_line_error"]
+    summary["time [s]"] = {k: v for k, v in m["timings"].items() if k != "metrics"}
+    print_summary(args, f"{bundle.kind} design", summary)
+    return 0

@@ -1,0 +1,97 @@
+"""``gridshell render``: pictures, the self-contained report and a Rhino model of a bundle."""
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Any
+
+HELP = ("render a design bundle: render.png (lamellae as ribbons), alignment.gif when the bundle "
+        "has an alignment sequence, and optionally report.html and a Rhino .3dm")
+
+
+def add_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("bundle", metavar="DIR",
+                   help="design bundle (output of 'gridshell gg' or 'ncp'); files go into it")
+    p.add_argument("--report", action="store_true",
+                   help="also write DIR/report.html: one self-contained page of the design")
+    p.add_argument("--3dm", dest="rhino", metavar="PATH",
+                   help="also export net, surface and lamellae to this Rhino .3dm file")
+    p.add_argument("--width", type=float, metavar="MM",
+                   help="ribbon width in mm of the model (default a quarter of the joint "
+                        "spacing)")
+    p.add_argument("--size", nargs=2, type=int, default=(1200, 900), metavar=("W", "H"),
+                   help="render.png size in pixels (default 1200 900)")
+    p.add_argument("--no-sequence", action="store_true",
+                   help="do not render the alignment sequence")
+    p.add_argument("--force", action="store_true",
+                   help="re-render alignment.gif even when it is newer than the sequence")
+
+
+def _sequence_is_current(bundle: Path, gif: Path) -> bool:
+    from ..render.sequence import sequence_files
+
+    files = sequence_files(bundle)
+    return gif.is_file() and all(gif.stat().st_mtime >= f.stat().st_mtime for f in files)
+
+
+def run(args: Any) -> int:
+    from ..bundle import read_design_json
+    from ..errors import InputError
+    from ..render.ribbons import render_bundle
+    from ..render.sequence import render_bundle_sequence, sequence_files
+    from .common import Progress, print_summary
+
+    progress = Progress(args)
+    bundle = Path(args.bundle)
+    design = read_design_json(bundle)
+    if args.width is not None and not args.width > 0:
+        raise InputError(f"--width must be positive (mm), got {args.width}")
+    if min(args.size) < 64:
+        raise InputError(f"--size must be at least 64 x 64 pixels, got {args.size}")
+    written: list[str] = []
+
+    progress("rendering render.png")
+    width_m = None if args.width is None else args.width / 1000.0
+    out = render_bundle(bundle, width=width_m, size=tuple(args.size))
+    written.append(out.name)
+
+    frames = sequence_files(bundle)
+    gif = bundle / "alignment.gif"
+    sequence = "none in the bundle"
+    if frames and args.no_sequence:
+        sequence = f"{len(frames)} frames, not rendered (--no-sequence)"
+    elif frames and _sequence_is_current(bundle, gif) and not args.force:
+        sequence = f"{len(frames)} frames, alignment.gif up to date (--force re-renders)"
+    elif frames:
+        res = render_bundle_sequence(bundle, progress=progress.callback)
+        sequence = f"{len(frames)} frames -> alignment.gif"
+        written += [f"sequence/frame_*.png ({len(res['frames'])})", gif.name]
+
+    report = None
+    if args.report:
+        from ..render.report import write_report
+
+        progress("writing report.html")
+        report = write_report(bundle)
+        written.append(report.name)
+
+    rhino = None
+    if args.rhino:
+        from ..export.rhino import export_3dm
+
+        progress(f"exporting {args.rhino}")
+        rhino = export_3dm(bundle, args.rhino)
+        written.append(str(rhino))
+
+    summary = {
+        "bundle": str(bundle),
+        "kind": design["kind"],
+        "lamellae": len(design["lamellae"]),
+        "render": str(out),
+        "alignment sequence": sequence,
+        "report": str(report) if report else "not written (--report)",
+        "rhino": str(rhino) if rhino else "not written (--3dm PATH)",
+        "files": ", ".join(written),
+    }
+    print_summary(args, "Render", summary)
+    return 0

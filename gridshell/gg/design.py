@@ -1,0 +1,537 @@
+"""GG surface design (paper 4.1.1, after Wang et al. 2019): a quad mesh isometric to a surface of
+revolution that approximates a target surface.
+
+The designed mesh is ``P (R, C, 3)``, metres: ``P[i, j]`` with ``i`` the parallel and ``j`` the
+meridian, so meridians are ``P[:, j]`` and parallels ``P[i, :]``. A *rotationally isometric
+geodesic-parallel mesh* (Fig. 12a) satisfies
+
+1. **geodesic meridians** - at every interior vertex the edge angles on both sides of the
+   meridian have equal sums, ``ang(a,l) + ang(l,b) = ang(a,r) + ang(r,b)``
+   (``a, b`` the meridian edges, ``l, r`` the parallel edges, ``ang(u,w) = atan2(|u x w|, u.w)``);
+2. **isometric parallels** - every edge of parallel ``i`` has one length ``l_i``;
+3. **geodesic parallels** - every meridian edge between parallels ``i`` and ``i+1`` has one
+   length ``h_i`` (the parallels are at constant geodesic distance).
+
+Such a mesh maps isometrically to a discrete surface of revolution (parallel ``i`` a circle with
+chord ``l_i``, profile chords ``h_i``), see :mod:`gridshell.gg.revolution`.
+
+Optimization (Tang et al. 2014 style, one :class:`~gridshell.solver.Layout` with blocks
+``P (R*C, 3)``, ``l (R,)``, ``h (R-1,)``):
+
+- ``outer`` rounds; round ``k`` refreshes the closest points on the target and runs a few
+  Levenberg-Marquardt iterations on
+  ``E = w_g E_geo + w_l (E_par + E_mer) + s^k (w_c E_glide + w_b E_bnd + w_p E_prox)
+  + w_f d^k E_fair`` (``s = soften``, ``d = fairness_decay``: a penalty continuation in which
+  the constraints dominate more every round);
+- a final *polish* (guided projection, fixed small damping, in chunks of 4 iterations until
+  the tolerances are met) drops closeness, boundary and fairness and keeps only the
+  constraints 1-3 plus a tiny proximity to the chunk start: a projection onto the constraint
+  set that moves the (already nearly feasible) mesh little and drives the residuals down.
+  The boundary gliding conflicts with the constraints when the target's outline is not a
+  possible GG outline (e.g. a small-circle edge that must become a geodesic), which is why it
+  is softened and dropped at the end rather than enforced.
+
+Boundary handling (keeps the patch from shrinking or sliding): every vertex of the grid's four
+boundary polylines glides on the *initial* boundary polyline of its side - residual = distance
+to the tangent line at its closest point on that polyline, refreshed every round - so the
+outline stays where ``P0`` put it (for a structured-grid target that is the target's own
+boundary; for a grid sampled inside a triangle mesh it is the sampled rectangle's outline).
+Corners lie on two sides and are thus pinned. On top, a proximity term to the start of each
+round (``w_p``) keeps the tangential motion, which nothing else resists, from drifting.
+
+All length-like residuals are divided by the mean edge length ``L`` of ``P0`` (their weights are
+``w / L^2``), so the weights of :class:`GGWeights` are dimensionless and mean the same on any
+model; the geodesic residual is in radians.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import asdict, dataclass, field, fields
+from typing import Any, Callable, Mapping, NamedTuple
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..errors import InputError
+from ..solver import Layout, Problem, TermResult, result, solve, term
+from ..solver import terms as T
+
+__all__ = ["GGDesign", "GGWeights", "design_gg_surface", "edge_groups", "equal_lengths",
+           "fairness_matrix", "geodesic_meridians", "geodesic_residual", "GridShape",
+           "EdgeGroups", "init_group_lengths", "length_residual_rel"]
+
+Progress = Callable[[str], None] | None
+
+
+# ============================================================================ terms
+
+class GridShape(NamedTuple):
+    """Data of :func:`geodesic_meridians`: block ``block`` holds an ``R x C`` grid row-major."""
+
+    shape: tuple[int, int]
+    block: str = "P"
+
+
+def _angle_grads(u: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``theta = atan2(|u x w|, u.w)`` ``(m,)`` and its gradients w.r.t. ``u`` and ``w`` ``(m,3)``.
+
+    ``d theta / du = (u x n) / (|u|^2 |n|)``, ``d theta / dw = (n x w) / (|w|^2 |n|)`` with
+    ``n = u x w`` (minus the unit part of ``w`` normal to ``u``, over ``|u|``).
+    """
+    n = np.cross(u, w)
+    s = np.linalg.norm(n, axis=1)
+    c = np.einsum("ij,ij->i", u, w)
+    theta = np.arctan2(s, c)
+    s_ = np.maximum(s, 1e-300)
+    gu = np.cross(u, n) / (np.einsum("ij,ij->i", u, u) * s_)[:, None]
+    gw = np.cross(n, w) / (np.einsum("ij,ij->i", w, w) * s_)[:, None]
+    return theta, gu, gw
+
+
+def _stencil(shape: tuple[int, int]) -> tuple[np.ndarray, ...]:
+    """Flat indices of interior vertices and their neighbours ``a`` (i-1), ``b`` (i+1),
+    ``l`` (j-1), ``r`` (j+1)."""
+    R, C = shape
+    idx = np.arange(R * C).reshape(R, C)
+    return (idx[1:-1, 1:-1].ravel(), idx[:-2, 1:-1].ravel(), idx[2:, 1:-1].ravel(),
+            idx[1:-1, :-2].ravel(), idx[1:-1, 2:].ravel())
+
+
+@term
+def geodesic_meridians(x: np.ndarray, layout: Layout, data: GridShape) -> TermResult:
+    """Paper Fig. 12a: ``r = ang(a,l) + ang(l,b) - ang(a,r) - ang(r,b)`` (radians) at every
+    interior vertex: the meridians ``P[:, j]`` are discrete geodesics."""
+    X = layout.view(x, data.block).reshape(-1, 3)
+    cols_blk = layout.indices(data.block).reshape(-1, 3)
+    c0, ia, ib, il, ir = _stencil(data.shape)
+    m = len(c0)
+    r = np.zeros(m)
+    rows, cols, vals = [], [], []
+    rr = np.repeat(np.arange(m), 3)
+    for sign, p, q in ((1.0, ia, il), (1.0, il, ib), (-1.0, ia, ir), (-1.0, ir, ib)):
+        th, gu, gw = _angle_grads(X[p] - X[c0], X[q] - X[c0])
+        r += sign * th
+        for vert, g in ((p, gu), (q, gw), (c0, -(gu + gw))):
+            rows.append(rr)
+            cols.append(cols_blk[vert].ravel())
+            vals.append(sign * g.ravel())
+    if m == 0:
+        z = np.zeros(0)
+        return result(z, z, z, z)
+    return result(r, np.concatenate(rows), np.concatenate(cols), np.concatenate(vals))
+
+
+def geodesic_residual(P: np.ndarray) -> np.ndarray:
+    """Residual of :func:`geodesic_meridians` on ``P (R, C, 3)``, radians, ``(R-2, C-2)``."""
+    P = np.asarray(P, float)
+    R, C = P.shape[:2]
+    lay = Layout({"P": (R * C, 3)})
+    return geodesic_meridians(P.reshape(-1), lay, GridShape((R, C))).r.reshape(R - 2, C - 2)
+
+
+class EdgeGroups(NamedTuple):
+    """Data of :func:`equal_lengths`: edges ``p[k] -> q[k]`` of block ``block`` whose lengths
+    all equal the auxiliary ``aux[group[k]]``."""
+
+    block: str
+    aux: str
+    p: np.ndarray
+    q: np.ndarray
+    group: np.ndarray
+
+
+def edge_groups(shape: tuple[int, int], family: str, block: str = "P",
+                aux: str | None = None) -> EdgeGroups:
+    """Edge groups of an ``R x C`` grid: ``"parallel"`` (edges ``(i,j)-(i,j+1)``, group ``i``,
+    aux ``"l"``) or ``"meridian"`` (edges ``(i,j)-(i+1,j)``, group ``i``, aux ``"h"``)."""
+    R, C = shape
+    idx = np.arange(R * C).reshape(R, C)
+    if family == "parallel":
+        p, q = idx[:, :-1], idx[:, 1:]
+        g = np.broadcast_to(np.arange(R)[:, None], p.shape)
+        aux = aux or "l"
+    elif family == "meridian":
+        p, q = idx[:-1, :], idx[1:, :]
+        g = np.broadcast_to(np.arange(R - 1)[:, None], p.shape)
+        aux = aux or "h"
+    else:
+        raise InputError(f"family must be 'parallel' or 'meridian', got {family!r}")
+    return EdgeGroups(block, aux, p.ravel(), q.ravel(), np.ascontiguousarray(g).ravel())
+
+
+@term
+def equal_lengths(x: np.ndarray, layout: Layout, data: EdgeGroups) -> TermResult:
+    """``r = |X[q] - X[p]| - a[group]`` (metres): the edges of a group have one length ``a``
+    (parallels: isometry with a surface of revolution; meridians: geodesic parallels)."""
+    X = layout.view(x, data.block).reshape(-1, 3)
+    A = layout.view(x, data.aux).reshape(-1)
+    cols_blk = layout.indices(data.block).reshape(-1, 3)
+    cols_aux = layout.indices(data.aux).reshape(-1)
+    e = X[data.q] - X[data.p]
+    n = np.linalg.norm(e, axis=1)
+    r = n - A[data.group]
+    t = e / np.maximum(n, 1e-300)[:, None]
+    m = len(r)
+    rows = np.concatenate([np.repeat(np.arange(m), 3), np.repeat(np.arange(m), 3), np.arange(m)])
+    cols = np.concatenate([cols_blk[data.q].ravel(), cols_blk[data.p].ravel(),
+                           cols_aux[data.group]])
+    vals = np.concatenate([t.ravel(), -t.ravel(), -np.ones(m)])
+    return result(r, rows, cols, vals)
+
+
+def init_group_lengths(X: np.ndarray, data: EdgeGroups) -> np.ndarray:
+    """Initial auxiliary of :func:`equal_lengths`: the mean edge length of each group, metres."""
+    X = np.asarray(X, float).reshape(-1, 3)
+    n = np.linalg.norm(X[data.q] - X[data.p], axis=1)
+    k = int(data.group.max()) + 1 if len(data.group) else 0
+    return np.bincount(data.group, n, k) / np.maximum(np.bincount(data.group, None, k), 1)
+
+
+def length_residual_rel(P: np.ndarray) -> dict[str, float]:
+    """Largest relative spread of edge lengths within a parallel (``parallel``) and within a
+    meridian strip (``meridian``): ``max |e - mean| / mean`` over each group."""
+    P = np.asarray(P, float)
+    shape = P.shape[:2]
+    out = {}
+    for fam in ("parallel", "meridian"):
+        g = edge_groups(shape, fam)
+        mean = init_group_lengths(P, g)
+        n = np.linalg.norm(P.reshape(-1, 3)[g.q] - P.reshape(-1, 3)[g.p], axis=1)
+        out[fam] = float(np.max(np.abs(n - mean[g.group]) / np.maximum(mean[g.group], 1e-300)))
+    return out
+
+
+def fairness_matrix(shape: tuple[int, int]) -> sp.csr_matrix:
+    """Second differences ``X[k-1] - 2 X[k] + X[k+1]`` along meridians and along parallels of
+    an ``R x C`` grid (row-major), ``((R-2) C + R (C-2), R C)``."""
+    R, C = shape
+    idx = np.arange(R * C).reshape(R, C)
+    trip = []
+    for a, b, c in ((idx[:-2, :], idx[1:-1, :], idx[2:, :]), (idx[:, :-2], idx[:, 1:-1], idx[:, 2:])):
+        trip.append((a.ravel(), b.ravel(), c.ravel()))
+    a = np.concatenate([t[0] for t in trip])
+    b = np.concatenate([t[1] for t in trip])
+    c = np.concatenate([t[2] for t in trip])
+    m = len(a)
+    rows = np.tile(np.arange(m), 3)
+    return sp.csr_matrix((np.concatenate([np.ones(m), -2 * np.ones(m), np.ones(m)]),
+                          (rows, np.concatenate([a, b, c]))), shape=(m, R * C))
+
+
+# ============================================================================ weights, result
+
+@dataclass
+class GGWeights:
+    """Weights of the GG surface design; dimensionless (length residuals are divided by the
+    mean edge length of the initial grid, the geodesic residual is in radians).
+
+    Attributes
+    ----------
+    geodesic : float
+        Geodesic meridians (angle sums), 1.
+    lengths : float
+        Equal edge lengths along parallels and across meridian strips, 1.
+    closeness : float
+        Gliding on the target (distance to the tangent plane at the closest point), 0.1:
+        below the constraints so that they dominate.
+    boundary : float
+        Boundary vertices glide on the initial boundary polylines, 0.1.
+    fairness : float
+        Second differences along meridians and parallels in the first round, 1e-4;
+        multiplied by ``fairness_decay`` every round.
+    fairness_decay : float
+        Factor of the fairness weight per round, 0.3.
+    proximity : float
+        Closeness to the positions at the start of each round, 1e-2: resists the tangential
+        drift nothing else resists (and the fairness' pull along the surface).
+    soften : float
+        Factor per round on ``closeness``, ``boundary`` and ``proximity``, 0.5: a penalty
+        continuation, so the constraints dominate more every round and the final polish only
+        has round-off-sized work left.
+    polish_proximity : float
+        Proximity weight of the final projection onto the constraints, 1e-8.
+    """
+
+    geodesic: float = 1.0
+    lengths: float = 1.0
+    closeness: float = 0.1
+    boundary: float = 0.1
+    fairness: float = 1e-4
+    fairness_decay: float = 0.3
+    proximity: float = 1e-2
+    soften: float = 0.5
+    polish_proximity: float = 1e-8
+
+    @classmethod
+    def coerce(cls, weights: "GGWeights | Mapping[str, float] | None") -> "GGWeights":
+        """``GGWeights`` from ``None`` (defaults), an instance, or a mapping of some fields."""
+        if weights is None:
+            return cls()
+        if isinstance(weights, cls):
+            w = weights
+        elif isinstance(weights, Mapping):
+            names = {f.name for f in fields(cls)}
+            bad = sorted(set(weights) - names)
+            if bad:
+                raise InputError(f"unknown GG design weight(s) {bad}; valid names are "
+                                 f"{sorted(names)}")
+            w = cls(**{k: float(v) for k, v in weights.items()})
+        else:
+            raise InputError(f"weights must be a GGWeights, a dict or None, got {type(weights)}")
+        for k, v in asdict(w).items():
+            if not np.isfinite(v) or v < 0:
+                raise InputError(f"GG design weight {k!r} must be finite and >= 0, got {v}")
+        return w
+
+
+@dataclass
+class GGDesign:
+    """Outcome of :func:`design_gg_surface`.
+
+    Attributes
+    ----------
+    P : (R, C, 3) float
+        The designed mesh, metres; meridians ``P[:, j]``, parallels ``P[i, :]``.
+    l : (R,) float
+        Parallel edge length of each parallel, metres.
+    h : (R-1,) float
+        Meridian edge length between consecutive parallels, metres.
+    history : list of dict
+        Per round (and the polish): weights used, energies, solver iterations and message,
+        geodesic and length residuals, deviation, time.
+    report : dict
+        ``{"before": ..., "after": ...}``: per term (base weights) weight, energy, RMS, max of
+        the unweighted residual at ``P0`` and at ``P``.
+    converged : bool
+        Geodesic residual <= ``tol_geodesic`` and relative length spread <= ``tol_length``.
+    deviation : dict
+        ``max``, ``mean`` distance of the vertices of ``P`` to the target, % of the target's
+        bounding-box diagonal; ``diagonal`` in metres.
+    geodesic_residual_max : float
+        Largest |angle-sum difference|, radians.
+    length_residual_rel_max : float
+        Largest relative spread of edge lengths within a parallel or a meridian strip.
+    """
+
+    P: np.ndarray
+    l: np.ndarray
+    h: np.ndarray
+    history: list[dict] = field(default_factory=list)
+    report: dict = field(default_factory=dict)
+    converged: bool = False
+    deviation: dict = field(default_factory=dict)
+    geodesic_residual_max: float = float("nan")
+    length_residual_rel_max: float = float("nan")
+
+
+# ============================================================================ the optimization
+
+def _say(progress: Progress, msg: str) -> None:
+    if progress is not None:
+        progress(msg)
+
+
+def _check_P0(P0: Any) -> np.ndarray:
+    P0 = np.asarray(P0, dtype=float)
+    if P0.ndim != 3 or P0.shape[2] != 3:
+        raise InputError(f"the initial grid must have shape (R, C, 3), got {P0.shape}")
+    R, C = P0.shape[:2]
+    if R < 4 or C < 4:
+        raise InputError(f"the initial grid is too coarse ({R} x {C}); a GG mesh needs at least "
+                         "4 x 4 vertices - ask for a finer grid")
+    if not np.all(np.isfinite(P0)):
+        raise InputError("the initial grid has NaN or infinite coordinates")
+    e1 = np.linalg.norm(np.diff(P0, axis=0), axis=2)
+    e2 = np.linalg.norm(np.diff(P0, axis=1), axis=2)
+    L = float(np.mean(np.concatenate([e1.ravel(), e2.ravel()])))
+    if not L > 0 or min(e1.min(), e2.min()) <= 1e-9 * L:
+        raise InputError("the initial grid has zero-length edges (coincident vertices); "
+                         "build it from a non-degenerate target")
+    return P0
+
+
+def _closest_on_polyline(X: np.ndarray, Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Closest points ``(k,3)`` of ``X (k,3)`` on polyline ``Q (n,3)`` and the unit tangent of
+    the segment holding each."""
+    A, B = Q[:-1], Q[1:]
+    d = B - A
+    dd = np.maximum(np.einsum("ij,ij->i", d, d), 1e-300)
+    t = np.clip(np.einsum("kij,ij->ki", X[:, None, :] - A[None], d) / dd[None], 0.0, 1.0)
+    F = A[None] + t[..., None] * d[None]
+    s = np.argmin(np.einsum("kij,kij->ki", X[:, None] - F, X[:, None] - F), axis=1)
+    k = np.arange(len(X))
+    return F[k, s], d[s] / np.sqrt(dd[s])[:, None]
+
+
+def _boundary_sides(R: int, C: int) -> list[np.ndarray]:
+    idx = np.arange(R * C).reshape(R, C)
+    return [idx[0, :], idx[-1, :], idx[:, 0], idx[:, -1]]
+
+
+def _boundary_gliding(X: np.ndarray, P0flat: np.ndarray, sides: list[np.ndarray]) -> T.Gliding:
+    """Gliding data keeping each boundary vertex on the tangent line of its side of ``P0``."""
+    index, foot, normal = [], [], []
+    for side in sides:
+        F, t = _closest_on_polyline(X[side], P0flat[side])
+        # two unit normals of the tangent line
+        helper = np.where(np.abs(t[:, [0]]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]])
+        n1 = np.cross(t, helper)
+        n1 /= np.linalg.norm(n1, axis=1)[:, None]
+        n2 = np.cross(t, n1)
+        index += [side, side]
+        foot += [F, F]
+        normal += [n1, n2]
+    return T.Gliding("P", np.concatenate(foot), np.concatenate(normal), np.concatenate(index))
+
+
+def _surface_gliding(X: np.ndarray, V: np.ndarray, F: np.ndarray) -> T.Gliding:
+    from ..igl_adapter import closest_points_with_normals
+
+    C, N = closest_points_with_normals(X, V, F)
+    bad = ~np.all(np.isfinite(N), axis=1)
+    N[bad] = 0.0
+    return T.Gliding("P", C, N)
+
+
+def _figures(P: np.ndarray) -> tuple[float, float]:
+    g = geodesic_residual(P)
+    lr = length_residual_rel(P)
+    return float(np.max(np.abs(g))) if g.size else 0.0, max(lr.values())
+
+
+def design_gg_surface(target_V: Any, target_F: Any, P0: Any, *,
+                      weights: GGWeights | Mapping[str, float] | None = None, outer: int = 6,
+                      max_iter: int = 4, polish_iter: int = 20, tol_geodesic: float = 1e-6,
+                      tol_length: float = 1e-6, progress: Progress = None) -> GGDesign:
+    """Optimize ``P0`` into a rotationally isometric geodesic-parallel mesh near a target
+    (paper 4.1.1, Fig. 12a; Wang et al. 2019).
+
+    Parameters
+    ----------
+    target_V : (n, 3) float
+        Target surface vertices, metres (or a ``QuadMesh`` / ``TriMesh``, then ``target_F``
+        is ``None``).
+    target_F : (m, 3) or (m, 4) int or None
+        Target faces (quads are triangulated for the closest-point queries).
+    P0 : (R, C, 3) float
+        Initial grid, metres (see :func:`gridshell.gg.initial.initial_grid`): meridians
+        ``P0[:, j]``, parallels ``P0[i, :]``; ``R, C >= 4``.
+    weights : GGWeights or dict, optional
+        Term weights (defaults: :class:`GGWeights`).
+    outer : int
+        Rounds of (closest points -> ``max_iter`` Levenberg-Marquardt iterations).
+    max_iter : int
+        Solver iterations per round.
+    polish_iter : int
+        Iterations of the final projection onto the constraints (0: no polish).
+    tol_geodesic : float
+        Convergence tolerance on the geodesic residual, radians.
+    tol_length : float
+        Convergence tolerance on the relative spread of edge lengths.
+    progress : callable, optional
+        Receives one line per round.
+
+    Returns
+    -------
+    GGDesign
+        ``converged=False`` (never an exception) when the tolerances are not met: the caller
+        decides.
+    """
+    from ..igl_adapter import triangulate
+    from ..metrics import deviation
+
+    if target_F is None:
+        if not (hasattr(target_V, "V") and hasattr(target_V, "F")):
+            raise InputError("pass the target as (V, F) arrays or as a mesh object; F is missing")
+        target_V, target_F = target_V.V, target_V.F
+    V, Ft, _ = triangulate(target_V, target_F)  # validates the target
+    P0 = _check_P0(P0)
+    w = GGWeights.coerce(weights)
+    if int(outer) < 1 or int(max_iter) < 1 or int(polish_iter) < 0:
+        raise InputError(f"outer and max_iter must be >= 1 and polish_iter >= 0, got "
+                         f"{outer}, {max_iter}, {polish_iter}")
+    t0 = time.perf_counter()
+    R, C = P0.shape[:2]
+    P0flat = P0.reshape(-1, 3)
+    L = float(np.mean(np.concatenate([np.linalg.norm(np.diff(P0, axis=a), axis=2).ravel()
+                                      for a in (0, 1)])))
+    s2 = 1.0 / L ** 2
+
+    lay = Layout({"P": (R * C, 3), "l": R, "h": R - 1})
+    par, mer = edge_groups((R, C), "parallel"), edge_groups((R, C), "meridian")
+    x = lay.pack({"P": P0flat, "l": init_group_lengths(P0flat, par),
+                  "h": init_group_lengths(P0flat, mer)})
+    sides = _boundary_sides(R, C)
+    D = fairness_matrix((R, C))
+
+    def build(X: np.ndarray) -> Problem:
+        """The problem with base weights and data refreshed at vertices ``X``."""
+        return (Problem(lay)
+                .add("geodesic", w.geodesic, geodesic_meridians, GridShape((R, C)))
+                .add("parallel_lengths", w.lengths * s2, equal_lengths, par)
+                .add("meridian_lengths", w.lengths * s2, equal_lengths, mer)
+                .add("closeness", w.closeness * s2, T.gliding, _surface_gliding(X, V, Ft))
+                .add("boundary", w.boundary * s2, T.gliding, _boundary_gliding(X, P0flat, sides))
+                .add("fairness", w.fairness * s2, T.linear, T.Linear("P", D))
+                .add("proximity", w.proximity * s2, T.closeness, T.Closeness("P", X.copy())))
+
+    prob = build(P0flat)
+    before = prob.report(x)
+    history: list[dict] = []
+    g0, l0 = _figures(P0)
+    _say(progress, f"GG design {R} x {C}: geodesic residual {g0:.2e} rad, length spread "
+                   f"{l0:.2e} at the start")
+    for k in range(int(outer)):
+        X = lay.view(x, "P")
+        if k > 0:
+            prob = build(X)
+        wf = w.fairness * w.fairness_decay ** k
+        soft = w.soften ** k
+        prob.set_weight("fairness", wf * s2)
+        for name, wk in (("closeness", w.closeness), ("boundary", w.boundary),
+                         ("proximity", w.proximity)):
+            prob.set_weight(name, wk * soft * s2)
+        res = solve(prob, x, method="lm", max_iter=int(max_iter), tol_rel=1e-8)
+        x = res.x
+        g, lr = _figures(lay.view(x, "P").reshape(R, C, 3))
+        history.append({"round": k, "fairness": wf, "soften": soft, "energy0": res.energy0, "energy": res.energy,
+                        "iterations": res.iterations, "message": res.message,
+                        "terms": {n: v["energy"] for n, v in res.report.items()},
+                        "geodesic_max": g, "length_rel_max": lr,
+                        "time": time.perf_counter() - t0})
+        _say(progress, f"round {k + 1}/{outer}: energy {res.energy0:.3e} -> {res.energy:.3e}, "
+                       f"geodesic {g:.2e} rad, length spread {lr:.2e}")
+    done = 0
+    while done < polish_iter:  # in short chunks, so that a converged mesh stops early
+        g, lr = _figures(lay.view(x, "P").reshape(R, C, 3))
+        if g <= 0.5 * tol_geodesic and lr <= 0.5 * tol_length:
+            break
+        n_it = min(4, int(polish_iter) - done)
+        pol = (Problem(lay)
+               .add("geodesic", w.geodesic, geodesic_meridians, GridShape((R, C)))
+               .add("parallel_lengths", w.lengths * s2, equal_lengths, par)
+               .add("meridian_lengths", w.lengths * s2, equal_lengths, mer)
+               .add("proximity", w.polish_proximity * s2, T.closeness,
+                    T.Closeness("P", lay.view(x, "P").copy())))
+        res = solve(pol, x, method="guided", max_iter=n_it, damping=1e-6, tol_energy=1e-28,
+                    tol_rel=1e-12)
+        x = res.x
+        done += max(res.iterations, 1)
+        g, lr = _figures(lay.view(x, "P").reshape(R, C, 3))
+        history.append({"round": "polish", "energy0": res.energy0, "energy": res.energy,
+                        "iterations": res.iterations, "message": res.message,
+                        "terms": {n: v["energy"] for n, v in res.report.items()},
+                        "geodesic_max": g, "length_rel_max": lr,
+                        "time": time.perf_counter() - t0})
+        _say(progress, f"polish: geodesic {g:.2e} rad, length spread {lr:.2e}")
+    P = lay.view(x, "P").reshape(R, C, 3).copy()
+    after = build(P.reshape(-1, 3)).report(x)
+    g, lr = _figures(P)
+    dev = deviation(P.reshape(-1, 3), V, Ft)
+    converged = bool(g <= tol_geodesic and lr <= tol_length)
+    _say(progress, f"GG design {'converged' if converged else 'did NOT converge'}: geodesic "
+                   f"{g:.2e} rad, length spread {lr:.2e}, deviation max {dev['max']:.3f} % "
+                   f"mean {dev['mean']:.3f} % of the diagonal, {time.perf_counter() - t0:.2f} s")
+    return GGDesign(P=P, l=lay.view(x, "l").copy(), h=lay.view(x, "h").copy(), history=history,
+                    report={"before": before, "after": after}, converged=converged,
+                    deviation=dev, geodesic_residual_max=g, length_residual_rel_max=lr)

@@ -1,0 +1,289 @@
+"""The GG pipeline (paper 4.1): target surface -> GG mesh -> surface of revolution -> geodesic
+alignable net -> net on the designed surface -> metrics -> design bundle.
+
+Stages (each usable alone):
+
+1. :func:`gridshell.gg.initial.initial_grid` and :func:`gridshell.gg.design.design_gg_surface`:
+   a mesh ``P (R, C, 3)`` isometric to a surface of revolution approximating the target (4.1.1);
+2. :func:`gg_net_from_mesh`: :func:`~gridshell.gg.revolution.rebuild_revolution`,
+   :func:`~gridshell.gg.clairaut.geodesic_net`, :func:`~gridshell.gg.mapback.map_back` (4.1.2);
+3. :func:`collapse_gg`: the aligned (collapsed) configuration;
+4. :func:`gg_metrics`: paper 5.1 on the result.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, Callable, Sequence
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
+from scipy.sparse.linalg import lsqr
+
+from ..bundle import DesignBundle, write_bundle
+from ..errors import InputError
+from ..grid import grid_quads
+from ..metrics import (alignability_error, alignability_error_arc, deviation, geodesic_turning,
+                       summary)
+from ..net import Net
+from .clairaut import IntrinsicNet, geodesic_net
+from .mapback import map_back, map_to_revolution
+from .revolution import rebuild_revolution
+
+__all__ = ["collapse_gg", "design_gg", "gg_metrics", "gg_net_from_mesh", "write_gg"]
+
+Progress = Callable[[str], None] | None
+
+
+def _say(progress: Progress, msg: str) -> None:
+    if progress is not None:
+        progress(msg)
+
+
+# ----------------------------------------------------------------------------- stages
+
+
+def gg_net_from_mesh(P: np.ndarray, *, n_lamellae: int | None = 10, spacing: float | None = None,
+                     crossing_angle: float = 90.0, at_parallel: float = 0.5,
+                     offsets: tuple[Sequence[float], Sequence[float]] | None = None,
+                     angle: float | None = None, step: float | None = None,
+                     progress: Progress = None) -> dict[str, Any]:
+    """The geodesic alignable net of a GG mesh (paper 4.1.2).
+
+    Parameters
+    ----------
+    P : (R, C, 3) float
+        GG mesh, metres (``P[:, j]`` meridians, ``P[i, :]`` parallels).
+    n_lamellae, spacing, crossing_angle, at_parallel
+        As in :func:`gridshell.gg.clairaut.geodesic_net` (``crossing_angle`` in degrees,
+        ``spacing`` in metres along the reference parallel).
+    offsets : (seq, seq), optional
+        Non-uniform positions of the C1 and C3 curves on the reference parallel, metres of
+        arc length from the first meridian; override ``n_lamellae`` / ``spacing``.
+    angle : float, optional
+        Total angle of the surface of revolution, radians (default: chosen automatically).
+    step : float, optional
+        Sampling step of the traced curves, metres.
+
+    Returns
+    -------
+    dict
+        ``rev`` (Revolution), ``inet`` (IntrinsicNet), ``net`` (Net on ``P``), ``extra``
+        (joint parameters etc., see :func:`gridshell.gg.mapback.map_net`) and ``net_rev``
+        (the same net on the surface of revolution).
+    """
+    P = np.asarray(P, float)
+    _say(progress, f"rebuilding the surface of revolution of the {P.shape[0]} x {P.shape[1]} mesh")
+    rev = rebuild_revolution(P, angle=angle)
+    o1 = o3 = None
+    if offsets is not None:
+        if len(offsets) != 2:
+            raise InputError("offsets must be a pair (offsets of C1, offsets of C3) in metres")
+        s_star = rev.s[0] + at_parallel * (rev.s[-1] - rev.s[0])
+        r_star = float(rev.r_of_s(s_star))
+        o1 = np.asarray(offsets[0], float) / r_star + rev.phi[0]
+        o3 = np.asarray(offsets[1], float) / r_star + rev.phi[0]
+        n_lamellae = spacing = None
+    _say(progress, f"tracing geodesics (crossing angle {crossing_angle:g} deg)")
+    inet = geodesic_net(rev, n_lamellae=n_lamellae, spacing=spacing,
+                        crossing_angle=crossing_angle, at_parallel=at_parallel,
+                        offsets1=o1, offsets3=o3, step=step)
+    _say(progress, f"mapping {len(inet.curves1)} + {len(inet.curves3)} curves onto the surface")
+    net, extra = map_back(inet, P, rev)
+    net_rev, _ = map_to_revolution(inet, rev)
+    return {"rev": rev, "inet": inet, "net": net, "extra": extra, "net_rev": net_rev}
+
+
+def collapse_gg(net: Net) -> tuple[np.ndarray, dict[str, float]]:
+    """The collapsed (aligned) configuration of a GG net: all lamellae on one straight line.
+
+    Every lamella keeps its length and runs in ``+x``; joint ``J`` on lamellae ``L1`` (C1) and
+    ``L3`` (C3) sits at ``x_J = s_J^{L1} + a_{L1} = s_J^{L3} + a_{L3}`` with ``s`` its arc
+    length along the lamella. The shifts ``a`` are the least-squares solution over all joints
+    (one gauge per connected component); for an alignable net (Definition 4:
+    ``l_AB + l_BC = l_AD + l_DC`` on every loop) they agree exactly, otherwise up to
+    ``Delta_a`` - the disagreement is reported.
+
+    Returns
+    -------
+    aligned : (n, 3) float
+        ``(x_J - min x, 0, 0)``, metres. Joints of a net-loop are collinear, so the loops are
+        degenerate quads, as a collapsed gridshell is.
+    info : dict
+        ``mismatch_max``, ``mismatch_mean``: disagreement of the lamellae about joint
+        positions, metres; ``length``: length of the collapsed bundle, metres.
+    """
+    n = len(net.joints)
+    lam_of, s_of, joint_of = [], [], []
+    for li, lam in enumerate(net.lamellae):
+        lam_of.append(np.full(len(lam.joints), li))
+        s_of.append(lam.joint_s)
+        joint_of.append(lam.joints)
+    if not lam_of:
+        raise InputError("the net has no lamellae; nothing to collapse")
+    L, S, J = (np.concatenate(a) for a in (lam_of, s_of, joint_of))
+    order = np.lexsort((L, J))
+    L, S, J = L[order], S[order], J[order]
+    pair = np.flatnonzero(J[1:] == J[:-1])  # consecutive memberships of one joint
+    nl = len(net.lamellae)
+    rows = np.arange(len(pair))
+    A = sp.coo_matrix((np.concatenate([np.ones(len(pair)), -np.ones(len(pair))]),
+                       (np.concatenate([rows, rows]), np.concatenate([L[pair], L[pair + 1]]))),
+                      shape=(len(pair), nl))
+    rhs = S[pair + 1] - S[pair]
+    adj = sp.coo_matrix((np.ones(len(pair)), (L[pair], L[pair + 1])), shape=(nl, nl))
+    n_comp, label = connected_components(adj, directed=False)
+    first = np.array([np.flatnonzero(label == c)[0] for c in range(n_comp)])
+    gauge = sp.coo_matrix((np.ones(n_comp), (np.arange(n_comp), first)), shape=(n_comp, nl))
+    M = sp.vstack([A, gauge]).tocsr()
+    b = np.concatenate([rhs, np.zeros(n_comp)])
+    a = lsqr(M, b, atol=1e-14, btol=1e-14, iter_lim=20 * nl + 100)[0]
+    xs = S + a[L]
+    x = np.bincount(J, weights=xs, minlength=n) / np.maximum(np.bincount(J, minlength=n), 1)
+    mism = np.abs(xs - x[J])
+    x = x - x.min()
+    aligned = np.zeros((n, 3))
+    aligned[:, 0] = x
+    return aligned, {"mismatch_max": float(mism.max()), "mismatch_mean": float(mism.mean()),
+                     "length": float(x.max()), "components": int(n_comp)}
+
+
+def _pct(d: dict[str, float]) -> dict[str, float]:
+    return {k: 100.0 * v for k, v in d.items()}
+
+
+def gg_metrics(net: Net, V: np.ndarray, F: np.ndarray, *, net_rev: Net | None = None,
+               target: tuple[np.ndarray, np.ndarray] | None = None) -> dict[str, Any]:
+    """Paper 5.1 metrics of a GG net on its surface ``(V, F)``; percentages.
+
+    Returns
+    -------
+    dict
+        ``alignability`` and ``alignability_arc`` (``{"mean", "max"}`` of ``Delta_a`` in %),
+        ``alignability_revolution`` (the same net on the surface of revolution, if given),
+        ``geodesic_turning`` (ratio, %), and with a target ``deviation`` (the surface's
+        vertices) and ``deviation_joints`` (``{"mean", "max"}`` in % of the target's
+        bounding-box diagonal).
+    """
+    out: dict[str, Any] = {
+        "alignability": _pct(summary(alignability_error(net.joints, net.loops))),
+        "alignability_arc": _pct(summary(alignability_error_arc(net))),
+    }
+    if net_rev is not None:
+        out["alignability_revolution"] = _pct(summary(alignability_error(net_rev.joints,
+                                                                         net_rev.loops)))
+    out["geodesic_turning"] = 100.0 * geodesic_turning(net, V, F)["ratio"]
+    if target is not None:
+        tV, tF = target
+        dv = deviation(V, tV, tF)
+        dj = deviation(net.joints, tV, tF)
+        out["deviation"] = {"mean": dv["mean"], "max": dv["max"]}
+        out["deviation_joints"] = {"mean": dj["mean"], "max": dj["max"]}
+    out["n_joints"] = int(len(net.joints))
+    out["n_loops"] = int(len(net.loops))
+    out["n_lamellae"] = {"C1": len(net.family(1)), "C3": len(net.family(3))}
+    return out
+
+
+# ----------------------------------------------------------------------------- the pipeline
+
+
+def _load_target(target: Any) -> tuple[np.ndarray, np.ndarray, str | None]:
+    from ..quadmesh import read_mesh
+
+    if isinstance(target, (str, Path)):
+        m = read_mesh(target, kind="any")
+        return m.V, m.F, str(Path(target).resolve())
+    if hasattr(target, "V") and hasattr(target, "F"):
+        return np.asarray(target.V, float), np.asarray(target.F, np.int64), None
+    if isinstance(target, tuple) and len(target) == 2:
+        return np.asarray(target[0], float), np.asarray(target[1], np.int64), None
+    raise InputError("the target must be a mesh file path, a QuadMesh/TriMesh or a (V, F) pair")
+
+
+def design_gg(target: Any, *, meridians: str = "rows", grid: tuple[int, int] | None = None,
+              direction: float | None = None, n_lamellae: int | None = 10,
+              spacing: float | None = None, crossing_angle: float = 90.0,
+              at_parallel: float = 0.5,
+              offsets: tuple[Sequence[float], Sequence[float]] | None = None,
+              weights: dict[str, float] | None = None, angle: float | None = None,
+              progress: Progress = None) -> tuple[DesignBundle, dict[str, Any]]:
+    """Design a geodesic alignable gridshell on (an approximation of) a target surface.
+
+    Parameters
+    ----------
+    target : path, QuadMesh/TriMesh or (V, F)
+        The target surface, metres; one disk.
+    meridians : {"rows", "cols"}
+        For a structured quad-grid target: which grid lines become the meridians (geodesics
+        of the designed surface); passed to :func:`gridshell.gg.initial.initial_grid`.
+    grid : (R, C), optional
+        Resolution of the GG mesh (default from the target).
+    direction : float, optional
+        Meridian direction in degrees for unstructured targets (see ``initial_grid``).
+    n_lamellae, spacing, crossing_angle, at_parallel, offsets, angle
+        The net (see :func:`gg_net_from_mesh`).
+    weights : dict, optional
+        Weights of the surface optimization (see ``design_gg_surface``).
+    progress : callable, optional
+        Receives one-line progress messages.
+
+    Returns
+    -------
+    bundle : DesignBundle
+        ``kind="GG"``; aligned = :func:`collapse_gg`; surface = the GG mesh; revolution = the
+        isometric surface of revolution; metrics = :func:`gg_metrics`.
+    report : dict
+        The surface optimization's report, the revolution's info and the collapse info.
+    """
+    V, F, target_path = _load_target(target)
+    from .design import design_gg_surface
+    from .initial import initial_grid
+
+    _say(progress, f"target: {len(V)} vertices, {len(F)} faces")
+    P0 = initial_grid(V, F, meridians=meridians, grid=grid, direction=direction)
+    _say(progress, f"initial grid {P0.shape[0]} x {P0.shape[1]}; designing the GG surface")
+    P, design_report = design_gg_surface(P0, (V, F), weights=weights, progress=progress)
+    stage = gg_net_from_mesh(P, n_lamellae=n_lamellae, spacing=spacing,
+                             crossing_angle=crossing_angle, at_parallel=at_parallel,
+                             offsets=offsets, angle=angle, progress=progress)
+    net, rev = stage["net"], stage["rev"]
+    _say(progress, f"net: {len(net.joints)} joints, {len(net.loops)} loops, "
+         f"{len(net.lamellae)} lamellae; collapsing and measuring")
+    aligned, collapse_info = collapse_gg(net)
+    R, C = P.shape[:2]
+    sV, sF = P.reshape(-1, 3), grid_quads(R, C)
+    metrics = gg_metrics(net, sV, sF, net_rev=stage["net_rev"], target=(V, F))
+    metrics["collapse_mismatch_max"] = collapse_info["mismatch_max"]
+    rV, rF = rev.mesh()
+    inet: IntrinsicNet = stage["inet"]
+    params = {"target": target_path, "meridians": meridians, "grid": [int(R), int(C)],
+              "direction": direction, "n_lamellae": n_lamellae, "spacing": spacing,
+              "crossing_angle": crossing_angle, "at_parallel": at_parallel,
+              "offsets": [list(map(float, o)) for o in offsets] if offsets else None,
+              "weights": weights, "dphi": rev.dphi, "total_angle": rev.total_angle,
+              "clairaut_c": inet.c, "s_star": inet.s_star}
+    bundle = DesignBundle(kind="GG", net=net, aligned=aligned, surface_V=sV, surface_F=sF,
+                          metrics=metrics, params=params, revolution_V=rV, revolution_F=rF)
+    report = {"design": design_report, "revolution": rev.info, "collapse": collapse_info,
+              "net": inet.info}
+    return bundle, report
+
+
+def write_gg(path: str | Path, bundle: DesignBundle, *, preview: bool = True) -> Path:
+    """Write a GG design bundle (atomically), with ``preview.png``: the net on the designed
+    surface, loops coloured by the straight-edge ``Delta_a`` in %."""
+    extra: dict[str, Any] = {}
+    if preview:
+        from ..render.net_preview import net_preview
+
+        values = 100.0 * alignability_error(bundle.net.joints, bundle.net.loops)
+
+        def _png(p: Path) -> None:
+            net_preview(p, bundle.surface_V, bundle.surface_F, bundle.net.joints,
+                        bundle.net.loops, [lam.axis for lam in bundle.net.lamellae], values,
+                        title=f"GG net: mean Delta_a {np.nanmean(values):.3g} %")
+
+        extra["preview.png"] = _png
+    return write_bundle(path, bundle, extra=extra)
+

@@ -1,0 +1,278 @@
+"""Verification metrics of a gridshell net (paper 5.1), shared by the GG and NCP pipelines.
+
+Every function is pure: arrays (or a :class:`~gridshell.net.Net`) in, arrays or a small dict
+out. Lengths in metres; errors are dimensionless fractions (multiply by 100 for %), except
+:func:`deviation`, which reports percent of a bounding-box diagonal as the paper does.
+"""
+from __future__ import annotations
+
+from typing import Any, Sequence
+
+import numpy as np
+
+from .errors import InputError
+from .net import Net
+
+__all__ = ["alignability_error", "alignability_error_arc", "delta_l", "delta_n", "deviation",
+           "geodesic_turning", "loop_side_lengths", "summary"]
+
+
+def _V(name: str, V: Any) -> np.ndarray:
+    V = np.asarray(V, dtype=float)
+    if V.ndim != 2 or V.shape[1] != 3:
+        raise InputError(f"{name} must have shape (n, 3), got {V.shape}")
+    return V
+
+
+def _loops(loops: Any, n: int) -> np.ndarray:
+    L = np.asarray(loops)
+    if L.ndim != 2 or L.shape[1] != 4:
+        raise InputError(f"loops must have shape (m, 4), got {L.shape}")
+    L = L.astype(np.int64)
+    if L.size and (L.min() < 0 or L.max() >= n):
+        raise InputError(f"loop indices must lie in [0, {n}), got [{L.min()}, {L.max()}]")
+    return L
+
+
+def _delta_a(l1: np.ndarray, l2: np.ndarray, l3: np.ndarray, l4: np.ndarray) -> np.ndarray:
+    tot = l1 + l2 + l3 + l4
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(tot > 0, 4.0 * np.abs(l1 + l2 - l3 - l4) / tot, np.nan)
+
+
+def loop_side_lengths(V: np.ndarray, loops: np.ndarray) -> np.ndarray:
+    """Chord lengths ``(m, 4)`` of the sides ``AB, BC, AD, DC`` of net-loops ``A, B, C, D``."""
+    V = _V("V", V)
+    L = _loops(loops, len(V))
+    A, B, C, D = (V[L[:, i]] for i in range(4))
+    return np.stack([np.linalg.norm(B - A, axis=1), np.linalg.norm(C - B, axis=1),
+                     np.linalg.norm(D - A, axis=1), np.linalg.norm(C - D, axis=1)], axis=1)
+
+
+def alignability_error(V: np.ndarray, loops: np.ndarray) -> np.ndarray:
+    """Alignability error per net-loop with straight edges (paper 5.1).
+
+    ``Delta_a = 4 |l1 + l2 - l3 - l4| / (l1 + l2 + l3 + l4)`` with ``(l1, l2) = (|AB|, |BC|)``
+    the way from corner ``A`` to ``C`` through ``B`` and ``(l3, l4) = (|AD|, |DC|)`` the way
+    through ``D``: a loop is alignable iff ``l_AB + l_BC = l_AD + l_DC`` (Definition 4), and
+    ``Delta_a`` is that difference over the mean edge length.
+
+    Parameters
+    ----------
+    V : (n, 3) float
+        Joint positions, metres.
+    loops : (m, 4) int
+        Net-loops ``A, B, C, D`` (either orientation: the value is symmetric).
+
+    Returns
+    -------
+    delta_a : (m,) float
+        Dimensionless (0.01 = 1 %); NaN for a loop of zero perimeter.
+    """
+    ell = loop_side_lengths(V, loops)
+    return _delta_a(*ell.T)
+
+
+def _edge_arcs(net: Net) -> dict[tuple[int, int], float]:
+    arcs: dict[tuple[int, int], float] = {}
+    for lam in net.lamellae:
+        d = np.diff(lam.joint_s)
+        for a, b, x in zip(lam.joints[:-1].tolist(), lam.joints[1:].tolist(), d.tolist()):
+            arcs[(a, b)] = arcs[(b, a)] = float(x)
+    return arcs
+
+
+def alignability_error_arc(net: Net) -> np.ndarray:
+    """Alignability error per net-loop with the lamella arc lengths between joints (paper 5.1).
+
+    As :func:`alignability_error` with ``l_XY = |joint_s(Y) - joint_s(X)|`` along the lamella
+    joining consecutive joints ``X`` and ``Y`` (the exact quantity of Definition 4).
+
+    Returns
+    -------
+    delta_a : (m,) float
+
+    Raises
+    ------
+    InputError
+        If a loop side joins joints that are not consecutive on any lamella.
+    """
+    arcs = _edge_arcs(net)
+    L = net.loops
+    out = np.empty((len(L), 4))
+    for k, (a, b) in enumerate(((0, 1), (1, 2), (0, 3), (3, 2))):
+        for m, (x, y) in enumerate(zip(L[:, a].tolist(), L[:, b].tolist())):
+            v = arcs.get((x, y))
+            if v is None:
+                raise InputError(f"net-loop {m}: joints {x} and {y} are not consecutive on a "
+                                 "lamella; the loops do not match the lamellae")
+            out[m, k] = v
+    return _delta_a(*out.T)
+
+
+def delta_l(V_star: np.ndarray, V_aligned: np.ndarray, edges: np.ndarray) -> np.ndarray:
+    """Relative edge-length change between a mesh and its aligned configuration (paper 5.1).
+
+    ``Delta_l = | |V^a_k - V^a_j| - |V*_k - V*_j| | / |V*_k - V*_j|`` per edge ``(j, k)``.
+
+    Parameters
+    ----------
+    V_star : (n, 3) float
+        Optimized (deployed) vertices, metres.
+    V_aligned : (n, 3) float
+        The same vertices in the aligned configuration.
+    edges : (E, 2) int
+
+    Returns
+    -------
+    (E,) float
+        Dimensionless; NaN for zero-length edges of ``V_star``.
+    """
+    Vs, Va = _V("V_star", V_star), _V("V_aligned", V_aligned)
+    if Vs.shape != Va.shape:
+        raise InputError(f"V_star {Vs.shape} and V_aligned {Va.shape} must have the same shape")
+    E = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+    ls = np.linalg.norm(Vs[E[:, 1]] - Vs[E[:, 0]], axis=1)
+    la = np.linalg.norm(Va[E[:, 1]] - Va[E[:, 0]], axis=1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(ls > 0, np.abs(la - ls) / ls, np.nan)
+
+
+def delta_n(V_star: np.ndarray, r_star: np.ndarray, V_a: np.ndarray, r_a: np.ndarray,
+            edges: np.ndarray) -> np.ndarray:
+    """Relative change of discrete normal curvature at each vertex upon alignment (paper 5.1).
+
+    ``Delta_n_j = (1/m) sum_k | <V^a_j - V^a_k, r^a_j> - <V*_j - V*_k, r*_j> |
+    / |<V*_j - Vbar*_k, r*_j>|`` over the ``m`` neighbours ``k`` of ``j`` along ``edges``,
+    with ``Vbar*_k`` the mean of those neighbours and ``r_j`` the rotation axis at ``j``.
+
+    Parameters
+    ----------
+    V_star, r_star : (n, 3) float
+        Optimized vertices (metres) and their unit rotation axes.
+    V_a, r_a : (n, 3) float
+        Aligned vertices and axes.
+    edges : (E, 2) int
+
+    Returns
+    -------
+    (n,) float
+        Dimensionless; NaN at vertices without neighbours or with a zero denominator
+        (locally flat along the axis).
+    """
+    Vs, rs, Va, ra = (_V(n_, a) for n_, a in (("V_star", V_star), ("r_star", r_star),
+                                                 ("V_a", V_a), ("r_a", r_a)))
+    if not (Vs.shape == rs.shape == Va.shape == ra.shape):
+        raise InputError("V_star, r_star, V_a and r_a must all have the same shape (n, 3)")
+    n = len(Vs)
+    E = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+    j = np.concatenate([E[:, 0], E[:, 1]])
+    k = np.concatenate([E[:, 1], E[:, 0]])
+    m = np.bincount(j, minlength=n).astype(float)
+    num = np.abs(np.einsum("ij,ij->i", Va[j] - Va[k], ra[j])
+                 - np.einsum("ij,ij->i", Vs[j] - Vs[k], rs[j]))
+    Vbar = np.zeros_like(Vs)
+    np.add.at(Vbar, j, Vs[k])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        Vbar /= m[:, None]
+        den = np.abs(np.einsum("ij,ij->i", Vs - Vbar, rs))
+        tot = np.bincount(j, weights=num, minlength=n)
+        out = tot / m / den
+    return np.where((m > 0) & (den > 0), out, np.nan)
+
+
+def deviation(P: np.ndarray, V: np.ndarray, F: np.ndarray) -> dict[str, float]:
+    """Distance of points from a surface mesh in percent of its bounding-box diagonal (Fig. 17).
+
+    Parameters
+    ----------
+    P : (k, 3) float
+        Points, metres.
+    V, F
+        The reference surface (triangles or quads; see :mod:`gridshell.igl_adapter`).
+
+    Returns
+    -------
+    dict
+        ``max``, ``mean``: distances in % of the bounding-box diagonal of the referenced
+        vertices of ``(V, F)``; ``diagonal`` in metres.
+    """
+    from .igl_adapter import closest_points
+
+    V = _V("V", V)
+    used = V[np.unique(np.asarray(F, dtype=np.int64))]
+    diag = float(np.linalg.norm(used.max(axis=0) - used.min(axis=0)))
+    if not diag > 0:
+        raise InputError("the reference surface has a zero bounding box; give a real surface")
+    sq, _, _ = closest_points(_V("P", P), V, F)
+    d = np.sqrt(np.maximum(sq, 0.0)) / diag * 100.0
+    return {"max": float(d.max()) if len(d) else 0.0, "mean": float(d.mean()) if len(d) else 0.0,
+            "diagonal": diag}
+
+
+def geodesic_turning(net_or_axes: Net | Sequence[np.ndarray], V: np.ndarray,
+                     F: np.ndarray) -> dict[str, float]:
+    """How far lamella axes are from geodesics of a surface: ``int |kg| ds / int |kappa| ds``.
+
+    ``kappa_vec = kn n + kg (n x t)`` (:func:`gridshell.diffgeo.normal_geodesic_curvature`)
+    with ``n`` the interpolated surface normal at the closest point of the mesh; each interior
+    vertex carries half of its two adjacent segments. Zero for geodesics (then the lamella
+    bends about its weak axis only), one for a curve in a plane tangent to the surface.
+
+    Parameters
+    ----------
+    net_or_axes : Net or list of (k_i, 3) float
+        The axes (dense polylines, metres).
+    V, F
+        The surface mesh.
+
+    Returns
+    -------
+    dict
+        ``ratio`` (the quotient above), ``kg_integral``, ``kappa_integral`` (radians),
+        ``kg_max`` (1/m).
+    """
+    from .diffgeo import normal_geodesic_curvature
+    from .igl_adapter import closest_points_with_normals
+
+    axes = [lam.axis for lam in net_or_axes.lamellae] if isinstance(net_or_axes, Net) \
+        else [np.asarray(a, float) for a in net_or_axes]
+    axes = [a for a in axes if len(a) >= 3]
+    if not axes:
+        raise InputError("no lamella axis with at least 3 points; nothing to measure")
+    # drop repeated points (zero-length segments) that the curvature formula cannot handle
+    clean = []
+    for a in axes:
+        keep = np.concatenate([[True], np.linalg.norm(np.diff(a, axis=0), axis=1) > 0])
+        if keep.sum() >= 3:
+            clean.append(a[keep])
+    allP = np.concatenate(clean)
+    _, N = closest_points_with_normals(allP, V, F)
+    kg_int = kappa_int = 0.0
+    kg_max = 0.0
+    start = 0
+    for a in clean:
+        n = N[start:start + len(a)]
+        start += len(a)
+        kn, kg = normal_geodesic_curvature(a, n)
+        seg = np.linalg.norm(np.diff(a, axis=0), axis=1)
+        w = np.zeros(len(a))
+        w[1:-1] = 0.5 * (seg[:-1] + seg[1:])
+        inner = slice(1, -1)
+        kg_i, kn_i, w_i = kg[inner], kn[inner], w[inner]
+        ok = np.isfinite(kg_i) & np.isfinite(kn_i)
+        kg_int += float(np.sum(np.abs(kg_i[ok]) * w_i[ok]))
+        kappa_int += float(np.sum(np.hypot(kg_i[ok], kn_i[ok]) * w_i[ok]))
+        if ok.any():
+            kg_max = max(kg_max, float(np.abs(kg_i[ok]).max()))
+    ratio = kg_int / kappa_int if kappa_int > 0 else 0.0
+    return {"ratio": ratio, "kg_integral": kg_int, "kappa_integral": kappa_int, "kg_max": kg_max}
+
+
+def summary(values: np.ndarray) -> dict[str, float]:
+    """``{"mean", "max"}`` of finite values (NaN when there are none)."""
+    v = np.asarray(values, float)
+    v = v[np.isfinite(v)]
+    if not len(v):
+        return {"mean": float("nan"), "max": float("nan")}
+    return {"mean": float(v.mean()), "max": float(v.max())}

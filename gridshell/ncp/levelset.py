@@ -1,0 +1,452 @@
+"""Tracing the NCP net as level sets of scalar B-splines (paper 4.2.2, eqs. 4.12-4.13).
+
+For each family ``f`` (1 or 3) a scalar function ``xi_f(u, v)`` is a B-spline on the domain of
+the surface, stored as the paper's ``F(u, v) = (u, v, xi)`` (a :class:`BSplineSurface` whose
+first two coordinates reproduce ``u`` and ``v`` through Greville abscissae). It minimizes
+
+    E_a + omega_f E_f = sum dxi(e_f)^2 + omega_f sum (dxi(e_f+1) - 1)^2
+
+at the samples (eqs. 4.12, 4.13), so that its level sets follow ``e_f`` and are spaced by about
+one metre of ``xi`` per metre across. Curves are level sets at uniformly subdivided values,
+traced in ``(u, v)`` (marching squares on a dense grid, each vertex then projected onto the
+exact level) and mapped to 3D; joints are the points where ``xi_1`` and ``xi_3`` both take
+their levels (found on the traced curves, refined by Newton's method in ``(u, v)``).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable, NamedTuple
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..bspline import BSplineSurface, open_uniform_knots
+from ..errors import InputError, NoNetError
+from ..net import Lamella, Net
+from ..solver import Layout, Problem, TermResult, result, solve, term
+from .directions import NetDirections
+
+__all__ = ["LEVELSET_DEFAULTS", "DirectionalDerivative", "directional_derivative", "LevelFit",
+           "level_function", "fit_level_function", "level_values", "project_to_level",
+           "trace_levels", "TracedNet", "trace_net", "trace", "evaluate_xi"]
+
+#: paper 4.2.2: bi-degree 3, 12 x 12 control points, 48 x 48 samples. omega_f: the paper sets
+#: 0.1; measured on the pseudosphere patch (10 curves) 0.1 leaves the level sets 0.44 degrees
+#: (RMS) off the asymptotic directions, which shows as up to 4.6 % difference of the normal
+#: curvatures of the two axes at a joint and Delta_a up to 1.7 %; 0.01 gives 0.06 degrees,
+#: 0.6 % and 0.3 % with the same curve spacing (density within 1 %). Pass 0.1 for the paper.
+LEVELSET_DEFAULTS = {"n_ctrl": (12, 12), "degree": (3, 3), "samples": (48, 48), "omega_f": 0.01,
+                     "grid": (240, 240)}
+
+
+# ============================================================================ the scalar B-spline
+
+def _greville(knots: np.ndarray, degree: int, n: int) -> np.ndarray:
+    return np.array([knots[i + 1:i + degree + 1].mean() for i in range(n)])
+
+
+def level_function(surf: BSplineSurface, xi_ctrl: np.ndarray, n_ctrl: tuple[int, int],
+                   degree: tuple[int, int]) -> BSplineSurface:
+    """``F(u, v) = (u, v, xi)`` over the domain of ``surf`` with ``xi`` control values
+    ``xi_ctrl (nu * nv,)``."""
+    (u0, u1), (v0, v1) = surf.domain
+    nu, nv = n_ctrl
+    du, dv = degree
+    ku = u0 + (u1 - u0) * open_uniform_knots(nu, du)
+    kv = v0 + (v1 - v0) * open_uniform_knots(nv, dv)
+    gu, gv = np.meshgrid(_greville(ku, du, nu), _greville(kv, dv, nv), indexing="ij")
+    ctrl = np.stack([gu, gv, np.asarray(xi_ctrl, float).reshape(nu, nv)], axis=-1)
+    return BSplineSurface(du, dv, ku, kv, ctrl)
+
+
+def evaluate_xi(F: BSplineSurface, u: np.ndarray, v: np.ndarray, du: int = 0,
+                dv: int = 0) -> np.ndarray:
+    """``xi`` (or a derivative) at paired parameters ``(k,)``."""
+    A = F.operator(u, v, du, dv)
+    return np.asarray(A @ F.ctrl[..., 2].reshape(-1))
+
+
+# ============================================================================ terms (4.12, 4.13)
+
+class DirectionalDerivative(NamedTuple):
+    """Data of :func:`directional_derivative`: ``r = a xi_u + b xi_v - target`` at ``k``
+    samples; ``Du, Dv (k, nc)`` map the control values of block ``block`` to ``xi_u, xi_v``."""
+
+    Du: sp.csr_matrix
+    Dv: sp.csr_matrix
+    a: np.ndarray
+    b: np.ndarray
+    target: np.ndarray
+    block: str = "xi"
+
+
+@term
+def directional_derivative(x: np.ndarray, layout: Layout,
+                           data: DirectionalDerivative) -> TermResult:
+    """``r = dxi(e) - target = a xi_u + b xi_v - target``: eq. 4.12 (``e = e1``, target 0,
+    ``a = cos b / |S_u|``, ``b = -sin b / |S_v|``) and eq. 4.13 (``e = e2``, target 1)."""
+    xi = layout.view(x, data.block).reshape(-1)
+    A = (sp.diags(data.a) @ data.Du + sp.diags(data.b) @ data.Dv).tocoo()
+    r = A @ xi - data.target
+    cols = layout.indices(data.block).reshape(-1)[A.col]
+    return result(r, A.row, cols, A.data)
+
+
+# ============================================================================ optimization
+
+@dataclass
+class LevelFit:
+    """A fitted level function: ``F`` (``(u, v, xi)`` B-spline), the solver result and the
+    alignment figures at the samples: ``align_rms`` = RMS of ``dxi(e_f) / |dxi|`` (the sine
+    of the angle between level set and net direction), ``density`` = mean ``dxi(e_f+1)``."""
+
+    family: int
+    F: BSplineSurface
+    converged: bool
+    iterations: int
+    report: dict
+    align_rms: float
+    density: float
+
+
+def fit_level_function(surf: BSplineSurface, dirs: NetDirections, family: int, *,
+                       n_ctrl: tuple[int, int] = (12, 12), degree: tuple[int, int] = (3, 3),
+                       omega_f: float = 0.01, max_iter: int = 20) -> LevelFit:
+    """Fit ``xi_f`` minimizing ``E_a + omega_f E_f`` at the samples of ``dirs`` (paper 4.2.2).
+
+    The problem is linear in the control values; one control value (the centre one) is fixed
+    to remove the free constant. Levenberg-Marquardt of :mod:`gridshell.solver`.
+    """
+    if family not in (1, 3):
+        raise InputError(f"family must be 1 or 3, got {family}")
+    nu, nv = (int(k) for k in n_ctrl)
+    F0 = level_function(surf, np.zeros(nu * nv), (nu, nv), tuple(int(d) for d in degree))
+    uu, vv = np.meshgrid(dirs.u, dirs.v, indexing="ij")
+    ok = dirs.valid.reshape(-1)
+    uu, vv = uu.reshape(-1)[ok], vv.reshape(-1)[ok]
+    Du = F0.operator(uu, vv, 1, 0)
+    Dv = F0.operator(uu, vv, 0, 1)
+    a1, b1, a2, b2 = (c.reshape(-1)[ok] for c in dirs.coefficients(family))
+    k = len(uu)
+    lay = Layout({"xi": nu * nv})
+    prob = Problem(lay)
+    prob.add("alignment (4.12)", 1.0, directional_derivative,
+             DirectionalDerivative(Du, Dv, a1, b1, np.zeros(k)))
+    prob.add("density (4.13)", omega_f, directional_derivative,
+             DirectionalDerivative(Du, Dv, a2, b2, np.ones(k)))
+    fixed = np.zeros(lay.size, bool)
+    fixed[(nu // 2) * nv + nv // 2] = True
+    sol = solve(prob, np.zeros(lay.size), fixed=fixed, method="lm", max_iter=max_iter,
+                damping=1e-9, tol_rel=1e-12)
+    xi = sol.x
+    F = level_function(surf, xi, (nu, nv), tuple(int(d) for d in degree))
+    gu, gv = np.asarray(Du @ xi), np.asarray(Dv @ xi)
+    d1 = a1 * gu + b1 * gv
+    d2 = a2 * gu + b2 * gv
+    with np.errstate(divide="ignore", invalid="ignore"):
+        sin_err = d1 / np.hypot(d1, d2)
+    return LevelFit(family, F, bool(sol.converged), sol.iterations, sol.report,
+                    float(np.sqrt(np.nanmean(sin_err ** 2))), float(np.mean(d2)))
+
+
+# ============================================================================ tracing
+
+def level_values(zmin: float, zmax: float, count: int | None = None,
+                 spacing: float | None = None) -> np.ndarray:
+    """Uniformly subdivided levels strictly inside ``(zmin, zmax)``: ``count`` values at
+    ``zmin + k (zmax - zmin) / (count + 1)``, or values ``spacing`` apart centred on the
+    middle of the range (``xi`` is in metres across the curves, eq. 4.13)."""
+    if (count is None) == (spacing is None):
+        raise InputError("give either the number of curves or their spacing, not both")
+    if count is not None:
+        if int(count) < 1:
+            raise InputError(f"the number of curves must be >= 1, got {count}")
+        return np.linspace(zmin, zmax, int(count) + 2)[1:-1]
+    if not (spacing > 0 and np.isfinite(spacing)):
+        raise InputError(f"the curve spacing must be a positive number of metres, got {spacing}")
+    mid = 0.5 * (zmin + zmax)
+    k = int(np.floor((zmax - mid) / spacing))
+    vals = mid + spacing * np.arange(-k, k + 1)
+    vals = vals[(vals > zmin) & (vals < zmax)]
+    if len(vals) == 0:
+        raise InputError(f"spacing {spacing} m is larger than the surface; choose a smaller one")
+    return vals
+
+
+def _grad_xi(F: BSplineSurface, uv: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    z = evaluate_xi(F, uv[:, 0], uv[:, 1])
+    g = np.stack([evaluate_xi(F, uv[:, 0], uv[:, 1], 1, 0),
+                  evaluate_xi(F, uv[:, 0], uv[:, 1], 0, 1)], axis=1)
+    return z, g
+
+
+def _clip_uv(uv: np.ndarray, dom: tuple[tuple[float, float], tuple[float, float]]) -> np.ndarray:
+    (u0, u1), (v0, v1) = dom
+    return np.stack([np.clip(uv[:, 0], u0, u1), np.clip(uv[:, 1], v0, v1)], axis=1)
+
+
+def project_to_level(F: BSplineSurface, uv: np.ndarray, level: np.ndarray,
+                     steps: int = 3) -> np.ndarray:
+    """Move ``uv (k, 2)`` onto ``xi = level`` along the gradient (Newton, ``steps`` times)."""
+    uv = np.array(uv, float)
+    lev = np.broadcast_to(np.asarray(level, float), (len(uv),))
+    for _ in range(steps):
+        z, g = _grad_xi(F, uv)
+        gg = np.einsum("ij,ij->i", g, g)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            step = np.where(gg > 0, (lev - z) / gg, 0.0)
+        uv = _clip_uv(uv + step[:, None] * g, F.domain)
+    return uv
+
+
+def trace_levels(F: BSplineSurface, levels: np.ndarray, grid: tuple[int, int] = (240, 240)
+                 ) -> list[np.ndarray | None]:
+    """Level sets of ``xi`` in ``(u, v)``: for each level the longest connected polyline
+    ``(k, 2)`` (marching squares on a ``grid``, vertices projected onto the exact level),
+    oriented with increasing ``u``; ``None`` where the level does not cross the domain."""
+    import contourpy
+
+    (u0, u1), (v0, v1) = F.domain
+    u = np.linspace(u0, u1, int(grid[0]))
+    v = np.linspace(v0, v1, int(grid[1]))
+    Z = F.evaluate_grid(u, v)[..., 2]
+    gen = contourpy.contour_generator(x=v, y=u, z=Z, line_type="Separate")
+    out: list[np.ndarray | None] = []
+    for lev in levels:
+        pieces = [p for p in gen.lines(float(lev)) if len(p) >= 2]
+        if not pieces:
+            out.append(None)
+            continue
+        P = max(pieces, key=lambda p: np.linalg.norm(np.diff(p, axis=0), axis=1).sum())
+        uv = project_to_level(F, P[:, ::-1], lev)
+        keep = np.concatenate([[True], np.linalg.norm(np.diff(uv, axis=0), axis=1) > 1e-12])
+        uv = uv[keep]
+        if len(uv) < 2:
+            out.append(None)
+            continue
+        if uv[-1, 0] < uv[0, 0]:
+            uv = uv[::-1]
+        out.append(uv)
+    return out
+
+
+def _crossings(values: np.ndarray, levels: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Segments of a polyline where ``values (k,)`` crosses ``levels (m,)``:
+    ``(level index, segment index, fraction)`` (first crossing of each level)."""
+    d = values[:, None] - levels[None, :]
+    s = np.sign(d)
+    change = (s[:-1] * s[1:] <= 0) & (d[:-1] != d[1:])
+    seg, lev = np.nonzero(change)
+    if len(seg) == 0:
+        z = np.zeros(0, np.int64)
+        return z, z, np.zeros(0)
+    order = np.lexsort((seg, lev))
+    seg, lev = seg[order], lev[order]
+    first = np.concatenate([[True], lev[1:] != lev[:-1]])
+    seg, lev = seg[first], lev[first]
+    a, b = d[seg, lev], d[seg + 1, lev]
+    t = np.clip(a / (a - b), 0.0, 1.0)
+    return lev, seg, t
+
+
+def _newton_joints(F1: BSplineSurface, F3: BSplineSurface, uv: np.ndarray, a: np.ndarray,
+                   b: np.ndarray, steps: int = 8) -> tuple[np.ndarray, np.ndarray]:
+    """Solve ``xi_1 = a, xi_3 = b`` from ``uv (k, 2)``; returns ``uv`` and the max residual."""
+    uv = np.array(uv, float)
+    for _ in range(steps):
+        z1, g1 = _grad_xi(F1, uv)
+        z3, g3 = _grad_xi(F3, uv)
+        det = g1[:, 0] * g3[:, 1] - g1[:, 1] * g3[:, 0]
+        r1, r3 = a - z1, b - z3
+        with np.errstate(divide="ignore", invalid="ignore"):
+            du = np.where(det != 0, (r1 * g3[:, 1] - r3 * g1[:, 1]) / det, 0.0)
+            dv = np.where(det != 0, (g1[:, 0] * r3 - g3[:, 0] * r1) / det, 0.0)
+        uv = _clip_uv(uv + np.stack([du, dv], axis=1), F1.domain)
+    z1, _ = _grad_xi(F1, uv)
+    z3, _ = _grad_xi(F3, uv)
+    return uv, np.maximum(np.abs(z1 - a), np.abs(z3 - b))
+
+
+@dataclass
+class TracedNet:
+    """The traced NCP net.
+
+    net : :class:`~gridshell.net.Net` (joints on the surface, loops ``A, B, C, D`` with ``A``
+        the corner of least ``u`` and ``C`` the opposite one, lamellae with dense axes)
+    joint_uv : (n, 2) surface parameters of the joints
+    joint_ij : (n, 2) level indices (family 1, family 3) of each joint
+    axis_uv : per lamella (same order as ``net.lamellae``) the ``(k, 2)`` parameters of its axis
+    axis_joint_index : per lamella the indices of its joints among the axis vertices
+    levels : {1: (m1,), 3: (m3,)} level values
+    fits : {1: LevelFit, 3: LevelFit}
+    dropped : notes on curves without enough joints
+    """
+
+    net: Net
+    joint_uv: np.ndarray
+    joint_ij: np.ndarray
+    axis_uv: list[np.ndarray]
+    axis_joint_index: list[np.ndarray]
+    levels: dict[int, np.ndarray]
+    fits: dict[int, LevelFit]
+    dropped: list[str] = field(default_factory=list)
+
+
+def _resample_axis(surf: BSplineSurface, F: BSplineSurface, level: float, uv: np.ndarray,
+                   joints_uv: np.ndarray, seg: np.ndarray, frac: np.ndarray,
+                   spacing: float) -> tuple[np.ndarray, np.ndarray]:
+    """Axis ``uv`` with the joints inserted as vertices and every piece between consecutive
+    joints (and the two end pieces) resampled uniformly in 3D arc length ~``spacing``."""
+    order = np.lexsort((frac, seg))
+    seg, frac, joints_uv = seg[order], frac[order], joints_uv[order]
+    P = surf.evaluate(uv[:, 0], uv[:, 1])
+    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(P, axis=0), axis=1))])
+    sj = s[seg] + frac * (s[seg + 1] - s[seg])
+    # knots: start, joints, end; each piece resampled with uv interpolated in arc length
+    ends = np.concatenate([[0.0], sj, [s[-1]]])
+    pieces, jidx = [], []
+    count = 0
+    for k in range(len(ends) - 1):
+        a, b = ends[k], ends[k + 1]
+        m = max(int(np.ceil((b - a) / spacing)), 1 if k in (0, len(ends) - 2) else 2)
+        t = np.linspace(a, b, m + 1)[:-1] if k < len(ends) - 2 else np.linspace(a, b, m + 1)
+        q = np.stack([np.interp(t, s, uv[:, 0]), np.interp(t, s, uv[:, 1])], axis=1)
+        if k > 0:
+            q[0] = joints_uv[k - 1]
+            jidx.append(count)
+        pieces.append(q)
+        count += len(q)
+    Q = np.concatenate(pieces)
+    jidx = np.asarray(jidx, np.int64)
+    free = np.ones(len(Q), bool)
+    free[jidx] = False
+    Q[free] = project_to_level(F, Q[free], level)
+    keep = np.concatenate([[True], np.linalg.norm(np.diff(Q, axis=0), axis=1) > 1e-13])
+    keep[jidx] = True
+    new_index = np.cumsum(keep) - 1
+    return Q[keep], new_index[jidx]
+
+
+def trace_net(surf: BSplineSurface, fits: dict[int, LevelFit], *, curves: int | tuple[int, int]
+              | None = None, spacing: float | None = None, grid: tuple[int, int] = (240, 240),
+              axis_points: int = 300, tol: float = 1e-9) -> TracedNet:
+    """Trace both families and build the net (joints, loops, lamellae).
+
+    Parameters
+    ----------
+    surf : the surface
+    fits : level functions of families 1 and 3 (:func:`fit_level_function`)
+    curves : number of curves per family (or a pair), or
+    spacing : spacing of the curves, metres (``xi`` units)
+    grid : marching-squares grid in ``(u, v)``
+    axis_points : about this many vertices along the longest lamella axis
+    tol : joint residual ``|xi - level|`` relative to the ``xi`` range accepted as converged
+
+    Returns
+    -------
+    TracedNet
+    """
+    if curves is not None and spacing is not None:
+        raise InputError("give either curves or spacing, not both")
+    if curves is None and spacing is None:
+        curves = 10
+    counts = (curves, curves) if curves is None or np.isscalar(curves) else tuple(curves)
+    (u0, u1), (v0, v1) = surf.domain
+    ug, vg = np.linspace(u0, u1, 120), np.linspace(v0, v1, 120)
+    levels, polys = {}, {}
+    for f, cnt in zip((1, 3), counts):
+        Z = fits[f].F.evaluate_grid(ug, vg)[..., 2]
+        levels[f] = level_values(float(Z.min()), float(Z.max()), cnt, spacing)
+        polys[f] = trace_levels(fits[f].F, levels[f], grid)
+    F1, F3 = fits[1].F, fits[3].F
+    rng = max(float(np.ptp(levels[1])), float(np.ptp(levels[3])), 1.0)
+    # joints: crossings of xi_3 levels along the traced curves of family 1
+    found: dict[tuple[int, int], np.ndarray] = {}
+    for i, uv in enumerate(polys[1]):
+        if uv is None:
+            continue
+        lev, seg, t = _crossings(evaluate_xi(F3, uv[:, 0], uv[:, 1]), levels[3])
+        if len(lev) == 0:
+            continue
+        guess = uv[seg] + t[:, None] * (uv[seg + 1] - uv[seg])
+        sol, res = _newton_joints(F1, F3, guess, np.full(len(lev), levels[1][i]), levels[3][lev])
+        for j, p, r in zip(lev.tolist(), sol, res.tolist()):
+            if r <= tol * rng:
+                found[(i, j)] = p
+    # positions along the traced curves of both families (segment, fraction) per joint
+    where: dict[int, dict[tuple[int, int], tuple[int, float]]] = {1: {}, 3: {}}
+    for f, other, Fo in ((1, 3, F3), (3, 1, F1)):
+        for a, uv in enumerate(polys[f]):
+            if uv is None:
+                continue
+            lev, seg, t = _crossings(evaluate_xi(Fo, uv[:, 0], uv[:, 1]), levels[other])
+            for b, sg, tt in zip(lev.tolist(), seg.tolist(), t.tolist()):
+                key = (a, b) if f == 1 else (b, a)
+                if key in found:
+                    where[f][key] = (sg, tt)
+    keys = sorted(k for k in found if k in where[1] and k in where[3])
+    if len(keys) < 4:
+        raise NoNetError(f"the traced curves cross at only {len(keys)} joints; ask for more "
+                         "curves (--curves) or a smaller spacing")
+    index = {k: n for n, k in enumerate(keys)}
+    joint_uv = np.array([found[k] for k in keys])
+    joint_ij = np.array(keys, np.int64)
+    P3 = surf.evaluate(joint_uv[:, 0], joint_uv[:, 1])
+    # lamellae
+    longest = 0.0
+    for f in (1, 3):
+        for uv in polys[f]:
+            if uv is not None:
+                Q = surf.evaluate(uv[:, 0], uv[:, 1])
+                longest = max(longest, float(np.linalg.norm(np.diff(Q, axis=0), axis=1).sum()))
+    h = longest / max(int(axis_points), 10)
+    lamellae, axis_uv, axis_jidx, dropped = [], [], [], []
+    Ffam = {1: F1, 3: F3}
+    for f in (1, 3):
+        for a, uv in enumerate(polys[f]):
+            if uv is None:
+                continue
+            mine = [k for k in keys if (k[0] if f == 1 else k[1]) == a]
+            if len(mine) < 2:
+                dropped.append(f"family {f} curve {a} (xi = {levels[f][a]:.4g}) has "
+                               f"{len(mine)} joint(s); left out")
+                continue
+            seg = np.array([where[f][k][0] for k in mine])
+            frac = np.array([where[f][k][1] for k in mine])
+            juv = np.array([found[k] for k in mine])
+            order = np.lexsort((frac, seg))
+            mine = [mine[o] for o in order]
+            Q, jidx = _resample_axis(surf, Ffam[f], levels[f][a], uv, juv, seg, frac, h)
+            X = surf.evaluate(Q[:, 0], Q[:, 1])
+            s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(X, axis=0), axis=1))])
+            lamellae.append(Lamella(id=len(lamellae), family=f,
+                                    joints=[index[k] for k in mine], joint_s=s[jidx], axis=X))
+            axis_uv.append(Q)
+            axis_jidx.append(jidx)
+    # net-loops (i, j), (i+1, j), (i+1, j+1), (i, j+1), A = corner of least u
+    loops = []
+    for (i, j) in keys:
+        quad = [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)]
+        if all(q in index for q in quad):
+            ids = np.array([index[q] for q in quad])
+            start = int(np.argmin(joint_uv[ids, 0]))
+            loops.append(np.roll(ids, -start))
+    net = Net(joints=P3, loops=np.array(loops, np.int64).reshape(-1, 4), lamellae=lamellae)
+    return TracedNet(net=net, joint_uv=joint_uv, joint_ij=joint_ij, axis_uv=axis_uv,
+                     axis_joint_index=axis_jidx, levels=levels, fits=fits, dropped=dropped)
+
+
+def trace(surf: BSplineSurface, dirs: NetDirections, *, curves: int | tuple[int, int] | None = None,
+          spacing: float | None = None, n_ctrl: tuple[int, int] = (12, 12),
+          degree: tuple[int, int] = (3, 3), omega_f: float = 0.01,
+          grid: tuple[int, int] = (240, 240), axis_points: int = 300,
+          progress: Callable[[str], None] | None = None) -> TracedNet:
+    """Fit both level functions on the samples of ``dirs`` and trace the net (paper 4.2.2)."""
+    fits = {}
+    for f in (1, 3):
+        fits[f] = fit_level_function(surf, dirs, f, n_ctrl=n_ctrl, degree=degree, omega_f=omega_f)
+        if progress is not None:
+            progress(f"level function xi_{f}: alignment RMS sin {fits[f].align_rms:.2e}, "
+                     f"density {fits[f].density:.3f}")
+    return trace_net(surf, fits, curves=curves, spacing=spacing, grid=grid,
+                     axis_points=axis_points)

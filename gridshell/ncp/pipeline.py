@@ -1,0 +1,373 @@
+"""The NCP pipeline (paper 4.2, 5.1): from a PHLW / CNC / PK surface to a design bundle.
+
+Stages, each timed in the report: PHLW surface (only for a mesh input, :mod:`.phlw`), net
+directions (:mod:`.directions`), level-set tracing (:mod:`.levelset`), collapse curve
+(:mod:`.collapse`), post-optimization (:mod:`.postopt`), alignment simulation
+(:mod:`.simulate`), metrics (:mod:`gridshell.metrics`). The bundle kind follows the mode:
+``phlw -> "NCP"``, ``cnc -> "CNC"``, ``aa -> "AA"``.
+"""
+from __future__ import annotations
+
+import json
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Callable
+
+import numpy as np
+
+from ..bspline import BSplineSurface
+from ..bundle import CollapseCurve, DesignBundle, write_bundle
+from ..errors import InputError
+from ..metrics import alignability_error, delta_l, delta_n, deviation, summary
+from .collapse import (CollapseResult, closest_on_polyline, collapse_curve, fit_circle,
+                       line_deviation)
+from .directions import net_directions, uniform_params
+from .levelset import TracedNet, trace
+from .postopt import PostOptResult, interior_vertices, post_optimize
+from .simulate import AlignmentSequence, collapse_direction, plane_frame, simulate_alignment
+
+__all__ = ["KIND", "NCPState", "crossing_normal_curvature", "design_ncp", "write_ncp",
+           "load_surface"]
+
+KIND = {"phlw": "NCP", "cnc": "CNC", "aa": "AA"}
+
+
+@dataclass
+class NCPState:
+    """Intermediate results of :func:`design_ncp` (arrays, for writing and inspection)."""
+
+    surface: BSplineSurface
+    traced: TracedNet
+    collapse: CollapseResult
+    post: PostOptResult
+    sequence: AlignmentSequence
+    aligned_2d: np.ndarray
+
+
+def load_surface(source: Any, *, mode: str, phlw_options: dict | None = None,
+                 progress: Callable[[str], None] | None = None
+                 ) -> tuple[BSplineSurface, float | None, dict]:
+    """``(surface, n, info)`` from a B-spline JSON path, a :class:`BSplineSurface`, a
+    ``PHLWResult`` or a reference mesh path / ``(V, F)`` (optimized with
+    :func:`gridshell.ncp.phlw.optimize_phlw` first). ``n`` is the CNC normal curvature when the
+    source provides it."""
+    from .phlw import PHLWResult, optimize_phlw
+
+    if isinstance(source, BSplineSurface):
+        return source, None, {"source": "bspline"}
+    if isinstance(source, PHLWResult):
+        n = float(source.n_rows[0]) if source.mode == "cnc" else None
+        return source.surface, n, {"source": "phlw-result", "phlw_mode": source.mode}
+    if isinstance(source, (str, Path)) and str(source).lower().endswith(".json"):
+        return BSplineSurface.load(source), None, {"source": str(source)}
+    from ..quadmesh import read_mesh
+    from .reference import initial_surface
+
+    opts = dict(phlw_options or {})
+    if isinstance(source, (str, Path)):
+        mesh = read_mesh(source, kind="any")
+        V, F = mesh.V, mesh.F
+        name = str(source)
+    else:
+        try:
+            V, F = source
+        except (TypeError, ValueError):
+            raise InputError("the NCP source must be a B-spline .json, a mesh file, (V, F), a "
+                             "BSplineSurface or a PHLWResult") from None
+        name = "(V, F)"
+    init = initial_surface(V, F, n_ctrl=tuple(opts.pop("ctrl", (9, 9))),
+                           degree=tuple(opts.pop("degree", (4, 4))),
+                           transpose=bool(opts.pop("transpose", False)))
+    if progress is not None:
+        progress(f"PHLW step: initial B-spline ({init.method} fit, rms {init.rms:.3g} m)")
+    res = optimize_phlw(init.surface, (V, F), mode=mode, progress=progress, **opts)
+    n = float(res.n_rows[0]) if mode == "cnc" else None
+    return res.surface, n, {"source": name, "phlw_deviation": res.deviation,
+                            "phlw_converged": res.converged, "phlw_diagnostics": res.diagnostics}
+
+
+def crossing_normal_curvature(surf: BSplineSurface, traced: TracedNet) -> dict[str, Any]:
+    """Normal curvature of the two lamella axes crossing at each interior joint.
+
+    ``kn`` from :func:`gridshell.diffgeo.normal_geodesic_curvature` on the dense axes with the
+    B-spline normals at their traced parameters; the relative difference at a joint is
+    ``|kn_1 - kn_3| / max(|kn_1|, |kn_3|, |kappa_II - kappa_I| / 2)`` (the last term, the radius
+    of Euler's circle, keeps it meaningful where ``n = 0``, AA).
+
+    Returns
+    -------
+    dict : ``rel (m,)``, ``joints (m,)``, ``kn1, kn3 (m,)`` 1/m, ``mean``, ``max``
+    """
+    from ..diffgeo import normal_geodesic_curvature, surface_curvature
+
+    kn_at: dict[int, dict[int, float]] = {}
+    for lam, uv, jidx in zip(traced.net.lamellae, traced.axis_uv, traced.axis_joint_index):
+        if len(lam.axis) < 3:
+            continue
+        N = np.cross(surf.evaluate(uv[:, 0], uv[:, 1], 1, 0),
+                     surf.evaluate(uv[:, 0], uv[:, 1], 0, 1))
+        kn, _ = normal_geodesic_curvature(lam.axis, N)
+        for jj, vi in zip(lam.joints.tolist(), jidx.tolist()):
+            if 0 < vi < len(lam.axis) - 1:
+                kn_at.setdefault(jj, {})[lam.family] = float(kn[vi])
+    joints = np.array(sorted(j for j, d in kn_at.items() if len(d) == 2), np.int64)
+    if len(joints) == 0:
+        return {"rel": np.zeros(0), "joints": joints, "kn1": np.zeros(0), "kn3": np.zeros(0),
+                "mean": float("nan"), "max": float("nan")}
+    k1 = np.array([kn_at[j][1] for j in joints])
+    k3 = np.array([kn_at[j][3] for j in joints])
+    uv = traced.joint_uv[joints]
+    g = surface_curvature(surf, uv[:, 0], uv[:, 1])
+    scale = np.abs(g["kII"] - g["kI"]) / 2
+    rel = np.abs(k1 - k3) / np.maximum.reduce([np.abs(k1), np.abs(k3), scale])
+    return {"rel": rel, "joints": joints, "kn1": k1, "kn3": k3, "mean": float(rel.mean()),
+            "max": float(rel.max())}
+
+
+def _collapse_s(traced: TracedNet, collapse: CollapseResult,
+                A2: np.ndarray) -> dict[int, np.ndarray]:
+    """Arc length along the collapse curve of every joint of every lamella, from the aligned
+    joints ``A2 (n, 2)`` registered onto the collapse curve's frame."""
+    _, _, t = closest_on_polyline(A2, collapse.points)
+    s = np.interp(t, np.arange(len(collapse.s)), collapse.s)
+    return {lam.id: s[lam.joints] for lam in traced.net.lamellae}
+
+
+def _register_2d(P: np.ndarray, Q: np.ndarray) -> np.ndarray:
+    """``P (n, 2)`` moved by the orthogonal map + translation that best matches ``Q``."""
+    pc, qc = P.mean(axis=0), Q.mean(axis=0)
+    U, _, Wt = np.linalg.svd((P - pc).T @ (Q - qc))
+    return (P - pc) @ (U @ Wt) + qc
+
+
+def _pct(d: dict[str, float]) -> dict[str, float]:
+    return {k: 100.0 * v for k, v in d.items()}
+
+
+def design_ncp(source: Any, *, mode: str = "phlw", curves: int | tuple[int, int] | None = None,
+               spacing: float | None = None, n: float | None = None,
+               samples: tuple[int, int] = (48, 48), levelset_ctrl: tuple[int, int] = (12, 12),
+               levelset_degree: tuple[int, int] = (3, 3), omega_f: float = 0.01,
+               trace_grid: tuple[int, int] = (240, 240),
+               collapse_samples: tuple[int, int] = (1200, 1200),
+               postopt_weights: dict[str, float] | None = None, postopt_rounds: int = 3,
+               frames: int = 12, sim_weights: dict[str, float] | None = None,
+               surface_samples: tuple[int, int] = (100, 100), phlw_options: dict | None = None,
+               progress: Callable[[str], None] | None = None) -> tuple[DesignBundle, dict]:
+    """Design a normal-curvature-preserving alignable gridshell (paper 4.2.2-4.2.4, 5.1).
+
+    Parameters
+    ----------
+    source : B-spline JSON written by ``gridshell phlw`` (or a BSplineSurface / PHLWResult), or
+        a reference mesh (path or ``(V, F)``): the PHLW step runs first
+    mode : "phlw" (kind NCP), "cnc" (kind CNC, one normal curvature), "aa" (kind AA, n = 0)
+    curves : curves per family (or a pair), or ``spacing`` in metres; default 10 curves
+    n : CNC normal curvature (default: from the PHLW result or fitted), 1/m
+    samples : direction samples of the level-set fit (paper 48 x 48)
+    levelset_ctrl, levelset_degree, omega_f : level function (paper 12 x 12, 3, 0.1; omega_f
+        defaults to 0.01, see :data:`gridshell.ncp.levelset.LEVELSET_DEFAULTS`)
+    trace_grid : marching-squares grid in (u, v)
+    collapse_samples : dense sampling of the collapse curve (paper 1200 x 1200)
+    postopt_weights, postopt_rounds : post-optimization (Table 2 defaults)
+    frames, sim_weights : alignment simulation
+    surface_samples : the PHLW sample mesh of the bundle (surface.obj)
+    phlw_options : options of the PHLW step for a mesh source (``ctrl``, ``degree``,
+        ``transpose``, and any keyword of :func:`gridshell.ncp.phlw.optimize_phlw`)
+    progress : called with one line per stage
+
+    Returns
+    -------
+    bundle : DesignBundle (joints post-optimized, ``aligned`` the last simulated state)
+    report : JSON-ready figures (metrics, timings, stage details) plus ``"state"``, an
+        :class:`NCPState` with the arrays (not JSON)
+    """
+    if mode not in KIND:
+        raise InputError(f"unknown mode {mode!r}; use 'phlw', 'cnc' or 'aa'")
+    say = progress or (lambda _m: None)
+    timings: dict[str, float] = {}
+    t_all = time.perf_counter()
+
+    t0 = time.perf_counter()
+    surf, n_src, info = load_surface(source, mode=mode, phlw_options=phlw_options,
+                                     progress=progress)
+    timings["surface"] = time.perf_counter() - t0
+    if n is None:
+        n = n_src
+
+    t0 = time.perf_counter()
+    u, v = uniform_params(surf, samples)
+    dirs = net_directions(surf, u, v, mode=mode, n=n if mode == "cnc" else None)
+    if mode == "cnc":
+        n = float(dirs.n_rows[0])
+    timings["directions"] = time.perf_counter() - t0
+    say(f"net directions on {samples[0]} x {samples[1]} samples: beta in "
+        f"[{np.degrees(dirs.beta.min()):.1f}, {np.degrees(dirs.beta.max()):.1f}] deg")
+
+    t0 = time.perf_counter()
+    traced = trace(surf, dirs, curves=curves, spacing=spacing, n_ctrl=levelset_ctrl,
+                   degree=levelset_degree, omega_f=omega_f, grid=trace_grid, progress=progress)
+    net = traced.net
+    timings["tracing"] = time.perf_counter() - t0
+    say(f"traced {len(net.lamellae)} lamellae, {len(net.joints)} joints, {len(net.loops)} loops")
+    for note in traced.dropped:
+        say(f"note: {note}")
+
+    t0 = time.perf_counter()
+    col = collapse_curve(surf, mode=mode, n=n, samples=collapse_samples)
+    timings["collapse"] = time.perf_counter() - t0
+    say(f"collapse curve ({collapse_samples[0]} x {collapse_samples[1]} samples): length "
+        f"{col.s[-1]:.4g} m, shape {col.shape}")
+
+    t0 = time.perf_counter()
+    post = post_optimize(surf, net, traced.joint_uv, col, weights=postopt_weights,
+                         rounds=postopt_rounds, progress=progress)
+    timings["postopt"] = time.perf_counter() - t0
+
+    t0 = time.perf_counter()
+    E = net.edges()
+    d = collapse_direction(surf)
+    seq = simulate_alignment(post.V, post.r, E, d, aligned=(post.Vt, post.rt), frames=frames,
+                             weights=sim_weights, progress=progress)
+    timings["simulation"] = time.perf_counter() - t0
+
+    t0 = time.perf_counter()
+    mesh = surf.sample(*surface_samples)
+    B = plane_frame(d)
+    A2 = _register_2d((seq.aligned - seq.centroid) @ B.T, post.Vt)
+    da0 = alignability_error(post.V0, net.loops)
+    da1 = alignability_error(post.V, net.loops)
+    dl = delta_l(post.V, seq.aligned, E)
+    dn = delta_n(post.V, post.r, seq.aligned, seq.aligned_r, E)
+    dev = deviation(post.V, mesh.V, mesh.F)
+    cross = crossing_normal_curvature(surf, traced)
+    inner = interior_vertices(len(net.joints), E)
+    metrics: dict[str, Any] = {
+        "n_joints": int(len(net.joints)), "n_loops": int(len(net.loops)),
+        "n_lamellae": {"C1": len(net.family(1)), "C3": len(net.family(3))},
+        "delta_a_before": _pct(summary(da0)), "delta_a_after": _pct(summary(da1)),
+        "delta_a_reduction": float(np.nanmean(da0) / max(np.nanmean(da1), 1e-300)),
+        "delta_l": _pct(summary(dl)), "delta_n": _pct(summary(dn)),
+        "delta_n_interior": _pct(summary(dn[inner])),
+        "deviation": {"mean": dev["mean"], "max": dev["max"]},
+        "crossing_kn": {"mean": 100 * cross["mean"], "max": 100 * cross["max"],
+                        "joints": int(len(cross["joints"]))},
+        "collapse_length": float(col.s[-1]),
+        "plane_distance_before_projection": seq.plane_distance,
+    }
+    if mode == "cnc":
+        _, R = fit_circle(A2)
+        metrics["n"] = n
+        metrics["collapse_radius"] = col.radius
+        metrics["collapse_radius_error"] = 100 * col.fit.get("radius_error", float("nan"))
+        metrics["aligned_radius"] = R
+        metrics["aligned_radius_error"] = 100 * abs(R - col.radius) / col.radius
+    elif mode == "aa":
+        metrics["collapse_line_error"] = 100 * col.fit["line_error"]
+        metrics["aligned_line_error"] = 100 * line_deviation(A2)
+    timings["metrics"] = time.perf_counter() - t0
+    timings["total"] = time.perf_counter() - t_all
+    metrics["timings"] = timings
+
+    ds = max(1, len(col.points) // 600)
+    keep = np.unique(np.concatenate([np.arange(0, len(col.points), ds), [len(col.points) - 1]]))
+    curve = CollapseCurve(points=col.points[keep], normals=col.normals[keep], shape=col.shape,
+                          radius=col.radius)
+    params = {"mode": mode, "curves": curves, "spacing": spacing, "samples": list(samples),
+              "levelset": {"ctrl": list(levelset_ctrl), "degree": list(levelset_degree),
+                           "omega_f": omega_f},
+              "collapse_samples": list(collapse_samples), "frames": frames,
+              "collapse_direction": d.tolist(), "postopt_weights": post.weights, **info}
+    from ..net import Net
+
+    out_net = Net(joints=post.V, loops=net.loops, lamellae=net.lamellae)
+    bundle = DesignBundle(kind=KIND[mode], net=out_net, aligned=seq.aligned, surface_V=mesh.V,
+                          surface_F=mesh.F, metrics=metrics, params=params, collapse=curve,
+                          collapse_s=_collapse_s(traced, col, A2))
+    report = {"metrics": metrics,
+              "levelset": {f: {"align_rms_sin": fit.align_rms, "density": fit.density,
+                               "converged": fit.converged} for f, fit in traced.fits.items()},
+              "postopt": {"history": post.history, "converged": post.converged,
+                          "terms": post.report},
+              "simulation": {"history": seq.history},
+              "dropped": traced.dropped,
+              "state": NCPState(surf, traced, col, post, seq, A2)}
+    say(f"Delta_a {metrics['delta_a_before']['mean']:.3g} % -> "
+        f"{metrics['delta_a_after']['mean']:.3g} %, Delta_l max {metrics['delta_l']['max']:.3g} %, "
+        f"Delta_n max {metrics['delta_n']['max']:.3g} %")
+    return bundle, report
+
+
+def _json_report(report: dict) -> str:
+    from ..bundle import _jsonable
+
+    return json.dumps(_jsonable({k: v for k, v in report.items() if k != "state"}), indent=1,
+                      default=float) + "\n"
+
+
+def write_ncp(path: str | Path, bundle: DesignBundle, report: dict, *, render: bool = True,
+              progress: Callable[[str], None] | None = None) -> Path:
+    """Write an NCP / CNC / AA design bundle atomically.
+
+    Besides the bundle files: ``surface.json`` (the PHLW B-spline), ``report.json``,
+    ``axes_r.npy`` (rotation axes of the post-optimized joints) and ``aligned_r.npy`` (of the
+    aligned ones) for ``gridshell verify``, ``sequence/frame_000.obj ...`` (the alignment
+    sequence; the last frame equals ``aligned.obj``), and with ``render``:
+    ``sequence/frame_000.png ...``, ``alignment.gif``, ``delta_a_before.png``,
+    ``delta_a_after.png`` (Fig. 13), ``delta_l.png``, ``delta_n.png`` (Fig. 16) and
+    ``collapse.png`` (Fig. 15).
+    """
+    import io
+
+    from ..quadmesh import write_mesh
+
+    st: NCPState = report["state"]
+    net = bundle.net
+    E = net.edges()
+    loops = net.loops
+    extra: dict[str, Any] = {}
+    extra["surface.json"] = (json.dumps(st.surface.to_json(), indent=1) + "\n").encode()
+    extra["report.json"] = _json_report(report).encode()
+    for name, arr in (("axes_r.npy", st.post.r), ("aligned_r.npy", st.sequence.aligned_r)):
+        buf = io.BytesIO()
+        np.save(buf, np.asarray(arr, float))
+        extra[name] = buf.getvalue()
+    nf = len(st.sequence.V)
+    width = max(3, len(str(nf - 1)))
+    for k, V in enumerate(st.sequence.V):
+        extra[f"sequence/frame_{k:0{width}d}.obj"] = (lambda p, V=V: write_mesh(p, V, loops))
+    if render:
+        from ..render import ncp_maps
+        from ..render.net_preview import net_preview
+
+        if progress is not None:
+            progress("rendering pictures and the alignment sequence")
+        axes = [lam.axis for lam in net.lamellae]
+        for tag, V, label in (("before", st.post.V0, "traced"), ("after", st.post.V,
+                                                                  "post-optimized")):
+            vals = 100 * alignability_error(V, loops)
+
+            def _png(p: Path, V=V, vals=vals, label=label) -> None:
+                net_preview(p, bundle.surface_V, bundle.surface_F, V, loops, axes, vals,
+                            title=f"Delta_a {label}: mean {np.nanmean(vals):.3g} %, max "
+                                  f"{np.nanmax(vals):.3g} %")
+
+            extra[f"delta_a_{tag}.png"] = _png
+        dl = 100 * delta_l(net.joints, bundle.aligned, E)
+        dn = 100 * delta_n(net.joints, st.post.r, bundle.aligned, st.sequence.aligned_r, E)
+        extra["delta_l.png"] = ncp_maps.edge_map(
+            net.joints, E, dl, label="Delta_l [%]",
+            title=f"Delta_l after alignment: mean {np.nanmean(dl):.3g} %, "
+                  f"max {np.nanmax(dl):.3g} %")
+        extra["delta_n.png"] = ncp_maps.vertex_map(
+            net.joints, E, dn, label="Delta_n [%]",
+            title=f"Delta_n after alignment: mean {np.nanmean(dn):.3g} %, "
+                  f"max {np.nanmax(dn):.3g} %")
+        extra["collapse.png"] = ncp_maps.collapse_plot(
+            st.collapse.points, st.collapse.normals, st.aligned_2d,
+            title=f"collapse curve ({st.collapse.shape})")
+        pngs = ncp_maps.sequence_frames(st.sequence.V, E, title=f"{bundle.kind} alignment")
+        for k, b in enumerate(pngs):
+            extra[f"sequence/frame_{k:0{width}d}.png"] = b
+        extra["alignment.gif"] = ncp_maps.gif(pngs)
+    return write_bundle(path, bundle, extra=extra)

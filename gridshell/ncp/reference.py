@@ -1,0 +1,99 @@
+"""The initial B-spline of the PHLW design (paper 4.2.1) from a reference mesh.
+
+A structured quad grid is fitted directly: its rows give ``u`` and its columns ``v``
+(:func:`gridshell.grid.grid_from_quads`). Any other disk-like mesh (triangles, or quads that
+do not form a grid) is parameterized with libigl first
+(:func:`gridshell.igl_adapter.parameterize_disk`) and fitted as scattered points.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..bspline import BSplineSurface, fit_grid, fit_points
+from ..errors import InputError, MeshError
+
+
+@dataclass
+class InitialFit:
+    """Outcome of :func:`initial_surface`.
+
+    surface : the fitted BSplineSurface (open uniform knots on [0, 1]^2)
+    rms : root mean square fitting residual, metres
+    method : "grid" (structured quad grid, rows -> u) or "parameterized" (libigl LSCM + scattered fit)
+    grid_shape : (R, C) of the vertex grid for "grid", else None
+    """
+
+    surface: BSplineSurface
+    rms: float
+    method: str
+    grid_shape: tuple[int, int] | None = None
+
+
+def _arrays(mesh: Any, F: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    if F is None:
+        if not (hasattr(mesh, "V") and hasattr(mesh, "F")):
+            raise InputError("pass the reference as (V, F) arrays or a mesh with V and F")
+        mesh, F = mesh.V, mesh.F
+    V = np.asarray(mesh, dtype=float)
+    F = np.asarray(F)
+    if V.ndim != 2 or V.shape[1] != 3 or len(V) == 0:
+        raise MeshError(f"reference vertices must have shape (n, 3), got {V.shape}")
+    if F.ndim != 2 or F.shape[1] not in (3, 4) or len(F) == 0:
+        raise MeshError(f"reference faces must have shape (m, 3) or (m, 4), got {F.shape}")
+    return V, F.astype(np.int64)
+
+
+def initial_surface(mesh: Any, F: np.ndarray | None = None, *, n_ctrl: tuple[int, int] = (9, 9),
+                    degree: tuple[int, int] = (4, 4), smoothing: float = 1e-6,
+                    transpose: bool = False) -> InitialFit:
+    """Least-squares B-spline of a reference mesh (paper defaults: bi-degree 4, 9 x 9 control
+    points).
+
+    Parameters
+    ----------
+    mesh : (n, 3) float vertices, metres, with ``F``; or a QuadMesh / TriMesh
+    F : (m, 4) or (m, 3) int faces
+    n_ctrl : control points in u and v
+    degree : degrees in u and v
+    smoothing : relative thin-plate weight of the fit (see :func:`gridshell.bspline.fit_grid`);
+        scattered data (triangle meshes) use at least 1e-4
+    transpose : swap u and v (grid rows -> v); the PHLW rows then follow the other family
+
+    Returns
+    -------
+    InitialFit
+    """
+    V, F = _arrays(mesh, F)
+    nu, nv = (int(k) for k in n_ctrl)
+    du, dv = (int(k) for k in degree)
+    if F.shape[1] == 4:
+        from ..grid import grid_from_quads
+
+        try:
+            G = grid_from_quads(F, len(V))
+        except MeshError:
+            G = None
+        if G is not None:
+            P = V[G]
+            if transpose:
+                P = P.transpose(1, 0, 2)
+            if P.shape[0] < nu or P.shape[1] < nv:
+                raise InputError(f"the reference grid has {P.shape[0]} x {P.shape[1]} vertices, "
+                                 f"fewer than the {nu} x {nv} control points; use fewer control "
+                                 "points or a denser grid")
+            surf, rms = fit_grid(P, nu, nv, du, dv, smoothing=smoothing)
+            return InitialFit(surf, rms, "grid", (P.shape[0], P.shape[1]))
+    from ..igl_adapter import parameterize_disk
+
+    UV = parameterize_disk(V, F)
+    if transpose:
+        UV = UV[:, ::-1]
+    if len(V) < nu * nv:
+        raise InputError(f"the reference has {len(V)} vertices, fewer than the {nu} x {nv} "
+                         "control points; use fewer control points or a denser mesh")
+    surf, rms = fit_points(V, UV[:, 0], UV[:, 1], nu, nv, du, dv,
+                           smoothing=max(smoothing, 1e-4))
+    return InitialFit(surf, rms, "parameterized", None)

@@ -1,0 +1,216 @@
+"""Alignment simulation of an NCP gridshell: from the deployed to the collapsed state (paper 4.2.4).
+
+Variables: deployed joints ``V (n, 3)`` and rotation axes ``r (n, 3)``. The post-optimized
+mesh ``V*, r*`` is the reference: it takes the place of the aligned configuration in the
+constraints of :mod:`gridshell.ncp.postopt` (edge lengths ``chi_l``, common rotation axes
+``chi_r``, unit axes ``chi_u``), entering the layout as fixed blocks. The collapse direction
+``d`` is the average of the vectors from the first to the last sample of every u-row of the
+surface (all points of a row collapse onto one point); collapsing energies pull the joints onto
+the plane through the centroid of ``V*`` with normal ``d`` (``<V_j - c, d>``) and the axes into
+that plane (``<r_j, d>``).
+
+Intermediate states blend the weights: frame ``t = k / K`` weights the collapsing energies by
+``t``. The paper's proximity to ``V*`` (weight ``1 - t``) is used when no aligned configuration
+is given. With the aligned configuration ``A`` of the post-optimization (placed in the plane,
+:func:`embed_aligned`), frame ``t`` starts from and stays near the blend ``(1 - t) V* + t A``
+instead: the joint mesh is generically over-constrained (7 conditions per interior joint for 6
+unknowns), so the constraints cannot hold exactly between the two end states, and the blend
+keeps the sequence out of the folded minima the plain homotopy falls into on a pseudosphere
+(edges shrinking by up to 99 %). The last frame (``t = 1``, no proximity) is exact up to the
+solver tolerance. Laplacian fairness of ``V`` and ``r`` (off in the last frame); scaled units
+(unit bounding-box diagonal of ``V*``) as in the post-optimization.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+
+from ..bspline import BSplineSurface
+from ..errors import InputError
+from ..solver import Layout, Problem, solve
+from ..solver import terms as T
+from .postopt import (AxisPairs, EdgeLength, UnitNorm, edge_length_eq, interior_vertices,
+                      rotation_axis_eq, unit_norm_eq, vertex_pairs)
+
+__all__ = ["SIM_WEIGHTS", "collapse_direction", "AlignmentSequence", "simulate_alignment",
+           "plane_frame", "embed_aligned"]
+
+#: constraint weights as in the post-optimization (Table 2); collapse and proximity are blended
+#: (scaled units, unit diagonal; measured on a pseudosphere patch: these keep Delta_l < 1.1 % in
+#: every intermediate frame while the distance to the plane decreases monotonically)
+SIM_WEIGHTS = {"length": 1.0, "axis": 1e2, "unit": 1e2, "collapse": 1e-4, "proximity": 1e-4,
+               "fairness": 1e-5}
+
+
+def collapse_direction(surf: BSplineSurface, rows: int = 48) -> np.ndarray:
+    """Unit collapse direction ``d (3,)``: the mean of ``S(u_i, v_last) - S(u_i, v_first)``
+    over ``rows`` u-rows (paper 4.2.4)."""
+    (u0, u1), (v0, v1) = surf.domain
+    P = surf.evaluate_grid(np.linspace(u0, u1, int(rows)), np.array([v0, v1]))
+    d = (P[:, 1] - P[:, 0]).mean(axis=0)
+    nd = np.linalg.norm(d)
+    if not nd > 0:
+        raise InputError("the u-rows of the surface have no mean direction (closed rows?); "
+                         "the collapse direction is undefined")
+    return d / nd
+
+
+def plane_frame(d: np.ndarray, hint: np.ndarray | None = None) -> np.ndarray:
+    """Orthonormal ``(2, 3)`` basis of the plane with normal ``d`` (first axis along the
+    projection of ``hint`` when given)."""
+    d = np.asarray(d, float) / np.linalg.norm(d)
+    h = np.asarray(hint, float) if hint is not None else np.eye(3)[int(np.argmin(np.abs(d)))]
+    a = h - (h @ d) * d
+    if np.linalg.norm(a) < 1e-9:
+        a = np.eye(3)[int(np.argmin(np.abs(d)))]
+        a = a - (a @ d) * d
+    a /= np.linalg.norm(a)
+    return np.stack([a, np.cross(d, a)])
+
+
+@dataclass
+class AlignmentSequence:
+    """Frames of the deployment sequence (metres).
+
+    V : list of (n, 3) joints per frame, ``V[0]`` the post-optimized mesh, ``V[-1]`` aligned
+    r : list of (n, 3) unit rotation axes per frame
+    t : (K+1,) blending parameter per frame
+    direction : (3,) collapse direction ``d``; centroid : (3,) a point of the collapse plane
+    plane_distance : max distance of the last frame's joints from the plane before the final
+        projection onto it, metres
+    history : per frame ``{"frame", "t", "iterations", "energy", "message", "time"}``
+    """
+
+    V: list[np.ndarray]
+    r: list[np.ndarray]
+    t: np.ndarray
+    direction: np.ndarray
+    centroid: np.ndarray
+    plane_distance: float
+    history: list[dict] = field(default_factory=list)
+
+    @property
+    def aligned(self) -> np.ndarray:
+        return self.V[-1]
+
+    @property
+    def aligned_r(self) -> np.ndarray:
+        return self.r[-1]
+
+
+def embed_aligned(V_star: np.ndarray, r_star: np.ndarray, Vt: np.ndarray, rt: np.ndarray,
+                  direction: np.ndarray, centroid: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Place the aligned configuration ``Vt, rt (n, 2)`` of the post-optimization in the
+    collapse plane (normal ``direction`` through ``centroid``): the orthogonal map (rotation or
+    reflection, which keep ``chi_l`` and ``chi_r``) and translation of the plane that best match
+    the projection of ``V*`` and of ``r*`` (Procrustes). Returns 3D joints and axes ``(n, 3)``."""
+    B = plane_frame(direction)
+    P = np.asarray(V_star, float) - centroid
+    scale = float(np.linalg.norm(P.max(0) - P.min(0))) or 1.0
+    X = np.vstack([np.asarray(Vt, float) - np.mean(Vt, axis=0), scale * np.asarray(rt, float)])
+    Y = np.vstack([P @ B.T - (P @ B.T).mean(axis=0), scale * (np.asarray(r_star, float) @ B.T)])
+    U, _, Wt = np.linalg.svd(X.T @ Y)
+    Q = U @ Wt                                     # X Q ~ Y
+    A2 = (np.asarray(Vt, float) - np.mean(Vt, axis=0)) @ Q + (P @ B.T).mean(axis=0)
+    R2 = np.asarray(rt, float) @ Q
+    return centroid + A2 @ B, R2 @ B
+
+
+def simulate_alignment(V_star: np.ndarray, r_star: np.ndarray, edges: np.ndarray,
+                       direction: np.ndarray, *, aligned: tuple[np.ndarray, np.ndarray] | None
+                       = None, frames: int = 12,
+                       weights: dict[str, float] | None = None, max_iter: int = 40,
+                       project: bool = True, progress: Callable[[str], None] | None = None
+                       ) -> AlignmentSequence:
+    """Simulate the alignment sequence from ``V*, r*`` to the collapsed state (paper 4.2.4).
+
+    Parameters
+    ----------
+    V_star, r_star : (n, 3) post-optimized joints (metres) and unit rotation axes
+    edges : (E, 2) joint-mesh edges
+    direction : (3,) collapse direction (:func:`collapse_direction`)
+    aligned : ``(Vt, rt)`` (n, 2) aligned configuration of the post-optimization; when given,
+        it is placed in the collapse plane (:func:`embed_aligned`) and frame ``t`` starts from
+        the blend ``(1 - t) V* + t A`` (axes likewise) instead of the previous frame, which
+        keeps the homotopy out of the folded local minima of the collapsing energy
+    frames : number of steps ``K`` (``K + 1`` states including the initial one)
+    weights : overrides of :data:`SIM_WEIGHTS`
+    max_iter : Levenberg-Marquardt iterations per frame
+    project : put the last frame's joints exactly on the plane and its axes exactly in it
+    """
+    w = dict(SIM_WEIGHTS)
+    for key, val in (weights or {}).items():
+        if key not in w:
+            raise InputError(f"unknown simulation weight {key!r}; weights are {', '.join(w)}")
+        w[key] = float(val)
+    if int(frames) < 1:
+        raise InputError(f"frames must be >= 1, got {frames}")
+    Vs = np.asarray(V_star, float)
+    rs = np.asarray(r_star, float)
+    n = len(Vs)
+    E = np.asarray(edges, np.int64).reshape(-1, 2)
+    d = np.asarray(direction, float) / np.linalg.norm(direction)
+    c = Vs.mean(axis=0)
+    scale = float(np.linalg.norm(Vs.max(0) - Vs.min(0)))
+    Xs = (Vs - c) / scale
+    j, k = vertex_pairs(E)
+    lay = Layout([("V", (n, 3)), ("r", (n, 3)), ("Vt", (n, 3)), ("rt", (n, 3))])
+    x = lay.pack({"V": Xs, "r": rs, "Vt": Xs, "rt": rs})
+    fixed = lay.mask(["Vt", "rt"])
+    inner = interior_vertices(n, E)
+    from ..solver.terms import laplacian_matrix
+    Lap = laplacian_matrix(n, E, fixed_rows=np.setdiff1d(np.arange(n), inner))
+    D = np.tile(d, (n, 1))
+    prob = Problem(lay)
+    prob.add("length (chi_l)", w["length"], edge_length_eq, EdgeLength(E, "V", "Vt"))
+    prob.add("axis (chi_r)", w["axis"], rotation_axis_eq, AxisPairs(j, k, "V", "r", "Vt", "rt"))
+    prob.add("unit (chi_u)", w["unit"], unit_norm_eq, UnitNorm("r"))
+    prob.add("collapse points", 0.0, T.gliding, T.Gliding("V", np.zeros((n, 3)), D))
+    prob.add("collapse axes", 0.0, T.gliding, T.Gliding("r", np.zeros((n, 3)), D))
+    prob.add("proximity points", w["proximity"], T.closeness, T.Closeness("V", Xs))
+    prob.add("proximity axes", w["proximity"], T.closeness, T.Closeness("r", rs))
+    prob.add("fairness points", w["fairness"], T.linear, T.Linear("V", Lap))
+    prob.add("fairness axes", w["fairness"], T.linear, T.Linear("r", Lap))
+    ts = np.linspace(0.0, 1.0, int(frames) + 1)
+    Vout, rout, history = [Vs.copy()], [rs / np.linalg.norm(rs, axis=1)[:, None]], []
+    if aligned is not None:
+        A, RA = embed_aligned(Vs, rs, aligned[0], aligned[1], d, c)
+        A = (A - c) / scale
+    t0 = time.perf_counter()
+    for f, t in enumerate(ts[1:], start=1):
+        if aligned is not None:
+            rb = (1 - t) * rs + t * RA
+            rb /= np.maximum(np.linalg.norm(rb, axis=1), 1e-12)[:, None]
+            x = lay.pack({"V": (1 - t) * Xs + t * A, "r": rb, "Vt": Xs, "rt": rs})
+            prob.set_data("proximity points", T.Closeness("V", (1 - t) * Xs + t * A))
+            prob.set_data("proximity axes", T.Closeness("r", rb))
+        for name in ("collapse points", "collapse axes"):
+            prob.set_weight(name, t * w["collapse"])
+        for name in ("proximity points", "proximity axes"):
+            prob.set_weight(name, (0.0 if t >= 1 else 1.0) * w["proximity"] if aligned is not None
+                            else (1.0 - t) * w["proximity"])
+        for name in ("fairness points", "fairness axes"):   # the aligned state is exact
+            prob.set_weight(name, 0.0 if t >= 1 else w["fairness"])
+        sol = solve(prob, x, fixed=fixed, method="lm", max_iter=int(max_iter), tol_rel=1e-10)
+        x = sol.x
+        history.append({"frame": f, "t": float(t), "iterations": sol.iterations,
+                        "energy": sol.energy, "message": sol.message,
+                        "time": time.perf_counter() - t0})
+        if progress is not None:
+            progress(f"alignment frame {f}/{frames}: energy {sol.energy:.3e} "
+                     f"({sol.iterations} iterations)")
+        V = lay.view(x, "V") * scale + c
+        r = lay.view(x, "r").copy()
+        Vout.append(V)
+        rout.append(r / np.linalg.norm(r, axis=1)[:, None])
+    off = (Vout[-1] - c) @ d
+    plane_distance = float(np.max(np.abs(off)))
+    if project:
+        Vout[-1] = Vout[-1] - off[:, None] * d[None, :]
+        r = rout[-1] - (rout[-1] @ d)[:, None] * d[None, :]
+        rout[-1] = r / np.linalg.norm(r, axis=1)[:, None]
+    return AlignmentSequence(V=Vout, r=rout, t=ts, direction=d, centroid=c,
+                             plane_distance=plane_distance, history=history)

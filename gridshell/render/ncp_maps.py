@@ -1,0 +1,156 @@
+"""Headless pictures of the NCP pipeline (paper Figs. 13, 15, 16): plain arrays in, PNG bytes out.
+
+- :func:`edge_map` edges coloured by a value (``Delta_l``), :func:`vertex_map` joints coloured
+  by a value (``Delta_n``), :func:`collapse_plot` the collapse curve with its normals,
+  :func:`sequence_frames` the alignment sequence with fixed axes, :func:`gif` an animated GIF
+  of PNG frames (Pillow). Matplotlib's Agg backend; nothing needs a display.
+"""
+from __future__ import annotations
+
+import io
+from typing import Sequence
+
+import numpy as np
+
+from ..errors import InputError
+
+__all__ = ["edge_map", "vertex_map", "collapse_plot", "sequence_frames", "gif"]
+
+
+def _plt():
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    return matplotlib, plt
+
+
+def _limits(ax, P: np.ndarray) -> None:
+    lo, hi = P.min(axis=0), P.max(axis=0)
+    c, h = 0.5 * (lo + hi), 0.5 * float(np.max(hi - lo)) or 1.0
+    ax.set_xlim(c[0] - h, c[0] + h)
+    ax.set_ylim(c[1] - h, c[1] + h)
+    ax.set_zlim(c[2] - h, c[2] + h)
+    ax.set_box_aspect((1, 1, 1))
+    ax.set_axis_off()
+
+
+def _png(fig) -> bytes:
+    _, plt = _plt()
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", bbox_inches="tight")
+    plt.close(fig)
+    return buf.getvalue()
+
+
+def edge_map(V: np.ndarray, edges: np.ndarray, values: np.ndarray, *, title: str = "",
+             label: str = "", dpi: int = 110) -> bytes:
+    """PNG of the edges ``(E, 2)`` of joints ``V (n, 3)`` coloured by ``values (E,)``."""
+    from mpl_toolkits.mplot3d.art3d import Line3DCollection
+
+    matplotlib, plt = _plt()
+    V = np.asarray(V, float)
+    E = np.asarray(edges, np.int64).reshape(-1, 2)
+    vals = np.asarray(values, float).reshape(-1)
+    if len(vals) != len(E):
+        raise InputError(f"edge_map: {len(vals)} values for {len(E)} edges")
+    fig = plt.figure(figsize=(6.4, 5.2), dpi=dpi)
+    ax = fig.add_subplot(projection="3d")
+    finite = vals[np.isfinite(vals)]
+    norm = matplotlib.colors.Normalize(0.0, float(finite.max()) if len(finite) and
+                                       finite.max() > 0 else 1.0)
+    cmap = plt.get_cmap("viridis")
+    ax.add_collection3d(Line3DCollection(V[E], colors=cmap(norm(np.nan_to_num(vals))),
+                                         linewidths=2.0))
+    fig.colorbar(matplotlib.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax, shrink=0.6,
+                 label=label)
+    _limits(ax, V)
+    if title:
+        ax.set_title(title, fontsize=9)
+    return _png(fig)
+
+
+def vertex_map(V: np.ndarray, edges: np.ndarray, values: np.ndarray, *, title: str = "",
+               label: str = "", dpi: int = 110) -> bytes:
+    """PNG of joints ``V (n, 3)`` coloured by ``values (n,)`` over grey edges ``(E, 2)``."""
+    from mpl_toolkits.mplot3d.art3d import Line3DCollection
+
+    matplotlib, plt = _plt()
+    V = np.asarray(V, float)
+    E = np.asarray(edges, np.int64).reshape(-1, 2)
+    vals = np.asarray(values, float).reshape(-1)
+    if len(vals) != len(V):
+        raise InputError(f"vertex_map: {len(vals)} values for {len(V)} joints")
+    fig = plt.figure(figsize=(6.4, 5.2), dpi=dpi)
+    ax = fig.add_subplot(projection="3d")
+    ax.add_collection3d(Line3DCollection(V[E], colors=(0.5, 0.5, 0.5, 0.7), linewidths=0.8))
+    finite = vals[np.isfinite(vals)]
+    vmax = float(finite.max()) if len(finite) and finite.max() > 0 else 1.0
+    sc = ax.scatter(V[:, 0], V[:, 1], V[:, 2], c=np.nan_to_num(vals), cmap="viridis", vmin=0,
+                    vmax=vmax, s=14, depthshade=False)
+    fig.colorbar(sc, ax=ax, shrink=0.6, label=label)
+    _limits(ax, V)
+    if title:
+        ax.set_title(title, fontsize=9)
+    return _png(fig)
+
+
+def collapse_plot(points: np.ndarray, normals: np.ndarray, joints: np.ndarray | None = None, *,
+                  title: str = "", dpi: int = 110, arrows: int = 24) -> bytes:
+    """PNG of the collapse polyline ``points (k, 2)`` with some flattened normals and the
+    aligned joints ``(n, 2)`` (Fig. 15)."""
+    _, plt = _plt()
+    P = np.asarray(points, float)
+    N = np.asarray(normals, float)
+    fig, ax = plt.subplots(figsize=(6.4, 4.0), dpi=dpi)
+    ax.plot(P[:, 0], P[:, 1], "-", color="0.2", lw=1.2, label="collapse curve")
+    idx = np.unique(np.linspace(0, len(P) - 1, arrows).astype(int))
+    L = 0.05 * float(np.ptp(P, axis=0).max() or 1.0)
+    ax.quiver(P[idx, 0], P[idx, 1], N[idx, 0], N[idx, 1], angles="xy", scale_units="xy",
+              scale=1 / L, color="tab:blue", width=0.003, label="flattened normal")
+    if joints is not None:
+        J = np.asarray(joints, float)
+        ax.plot(J[:, 0], J[:, 1], "o", ms=3, color="tab:red", label="aligned joints")
+    ax.set_aspect("equal")
+    ax.legend(fontsize=7, loc="best")
+    if title:
+        ax.set_title(title, fontsize=9)
+    return _png(fig)
+
+
+def sequence_frames(frames: Sequence[np.ndarray], edges: np.ndarray, *, title: str = "",
+                    dpi: int = 80, elev: float = 25.0, azim: float = -60.0) -> list[bytes]:
+    """PNG bytes of every state ``(n, 3)`` of the alignment sequence, same axes for all."""
+    from mpl_toolkits.mplot3d.art3d import Line3DCollection
+
+    _, plt = _plt()
+    E = np.asarray(edges, np.int64).reshape(-1, 2)
+    allP = np.concatenate([np.asarray(f, float) for f in frames])
+    out = []
+    for k, V in enumerate(frames):
+        V = np.asarray(V, float)
+        fig = plt.figure(figsize=(5.0, 4.2), dpi=dpi)
+        ax = fig.add_subplot(projection="3d")
+        ax.add_collection3d(Line3DCollection(V[E], colors=(0.1, 0.2, 0.5, 0.9), linewidths=1.0))
+        ax.scatter(V[:, 0], V[:, 1], V[:, 2], s=3, color="tab:red", depthshade=False)
+        _limits(ax, allP)
+        ax.view_init(elev=elev, azim=azim)
+        ax.set_title(f"{title} frame {k}/{len(frames) - 1}".strip(), fontsize=9)
+        out.append(_png(fig))
+    return out
+
+
+def gif(pngs: Sequence[bytes], duration_ms: int = 250) -> bytes:
+    """An animated GIF (looping) of PNG frames, via Pillow."""
+    from PIL import Image
+
+    if not pngs:
+        raise InputError("gif needs at least one frame")
+    imgs = [Image.open(io.BytesIO(b)).convert("RGB") for b in pngs]
+    size = imgs[0].size
+    imgs = [im if im.size == size else im.resize(size) for im in imgs]
+    buf = io.BytesIO()
+    imgs[0].save(buf, format="GIF", save_all=True, append_images=imgs[1:], duration=duration_ms,
+                 loop=0)
+    return buf.getvalue()

@@ -1,0 +1,325 @@
+"""``report.html``: one self-contained page of a design bundle (issue #7, "the product").
+
+The page holds the kind, the parameters, the metrics against the paper's thresholds (5.1:
+mean ``Delta_a`` < 1 %, max < 3 %; ``Delta_l`` and ``Delta_n`` < 1 %) with pass/fail marks,
+every picture of the bundle (PNG and GIF as base64 ``data:`` URIs), the fabrication plan and
+sheets (SVG inline) when ``fabrication/`` exists, and the lamella table. Nothing is fetched
+from the network: inline CSS, no scripts.
+"""
+from __future__ import annotations
+
+import base64
+import html
+import json
+import math
+import os
+import re
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Callable, Iterable
+
+from ..atomic import write_text
+from ..errors import InputError
+
+__all__ = ["Check", "CHECKS", "metric_checks", "report_html", "write_report"]
+
+
+@dataclass(frozen=True)
+class Check:
+    """A metric of ``design.json`` (``{"mean", "max"}`` in %) and the paper's limits on it."""
+
+    key: str
+    label: str
+    mean_below: float | None = None
+    max_below: float | None = None
+
+
+#: metrics checked against the paper's thresholds (5.1), in display order
+CHECKS: tuple[Check, ...] = (
+    Check("alignability", "Delta_a, straight edges", 1.0, 3.0),
+    Check("alignability_arc", "Delta_a, lamella arc lengths", 1.0, 3.0),
+    Check("alignability_revolution", "Delta_a on the surface of revolution", 1.0, 3.0),
+    Check("delta_a_before", "Delta_a, traced net (before post-optimization)"),
+    Check("delta_a_after", "Delta_a, post-optimized net", 1.0, 3.0),
+    Check("delta_l", "Delta_l, edge length change on alignment", None, 1.0),
+    Check("delta_n", "Delta_n, normal curvature change on alignment", None, 1.0),
+    Check("delta_n_interior", "Delta_n at interior joints", None, 1.0),
+)
+
+#: pictures first in this order, then any other picture alphabetically
+_ORDER = ("render.png", "preview.png", "delta_a_before.png", "delta_a_after.png",
+          "delta_l.png", "delta_n.png", "curvature_diagram.png", "collapse.png", "alignment.gif")
+_CAPTIONS = {
+    "render.png": "The lamellae as ribbons on the surface, coloured by family.",
+    "preview.png": "The net on the designed surface, loops coloured by Delta_a [%].",
+    "delta_a_before.png": "Delta_a of the traced net [%] (Fig. 13c).",
+    "delta_a_after.png": "Delta_a after post-optimization [%] (Fig. 13d).",
+    "delta_l.png": "Delta_l: relative edge-length change after alignment [%] (Fig. 16).",
+    "delta_n.png": "Delta_n: relative normal-curvature change after alignment [%] (Fig. 16).",
+    "collapse.png": "The collapse curve with its flattened normals (Fig. 15).",
+    "alignment.gif": "The alignment sequence (Fig. 16).",
+    "plan.png": "Assembly plan: every lamella's id at its place.",
+}
+_MIME = {".png": "image/png", ".gif": "image/gif", ".jpg": "image/jpeg", ".jpeg": "image/jpeg"}
+MAX_SHEETS = 12
+_MARK = {"pass": "&#10003; pass", "fail": "&#10007; fail", "info": "&ndash;"}
+
+_CSS = """
+body{font-family:system-ui,-apple-system,"Segoe UI",Helvetica,Arial,sans-serif;margin:0;
+ color:#1d1f23;background:#f6f7f9;line-height:1.4}
+header{background:#1d2d44;color:#fff;padding:18px 28px}
+header h1{margin:0;font-size:22px} header p{margin:4px 0 0;opacity:.85}
+main{padding:10px 28px 40px;max-width:1200px}
+section{background:#fff;border:1px solid #dde1e6;border-radius:6px;padding:12px 18px;margin:16px 0}
+h2{font-size:17px;margin:4px 0 10px}
+table{border-collapse:collapse;font-size:13px}
+th,td{padding:3px 10px;border-bottom:1px solid #e6e8eb;text-align:left;vertical-align:top}
+ th{background:#f0f2f5} td.num{text-align:right;
+ font-variant-numeric:tabular-nums}
+.pass{color:#177a2e;font-weight:600} .fail{color:#b3261e;font-weight:600} .info{color:#6b7280}
+.verdict{display:inline-block;padding:4px 10px;border-radius:4px;font-weight:600}
+.verdict.pass{background:#e3f4e7} .verdict.fail{background:#fbe4e2}
+.verdict.info{background:#eceef1}
+figure{display:inline-block;margin:8px 12px 8px 0;vertical-align:top;max-width:100%}
+figure img{max-width:100%;border:1px solid #e6e8eb;background:#fff}
+figure.wide img{width:900px}
+figcaption{font-size:12px;color:#4b5563;max-width:620px}
+.sheet svg{width:100%;height:auto;max-width:1000px;border:1px solid #cfd4da;background:#fff}
+.sheet svg *{vector-effect:non-scaling-stroke;stroke-width:0.7px}
+.scroll{max-height:520px;overflow:auto}
+code{font-size:12px}
+"""
+
+
+def _fmt(v: Any, digits: int = 4) -> str:
+    if isinstance(v, bool) or v is None:
+        return str(v)
+    if isinstance(v, float):
+        return "nan" if math.isnan(v) else f"{v:.{digits}g}"
+    return str(v)
+
+
+def metric_checks(metrics: dict[str, Any]) -> list[dict[str, Any]]:
+    """Rows ``{key, label, mean, max, limit, status}`` of the :data:`CHECKS` present in
+    ``metrics``; ``status`` is "pass", "fail" or "info" (no limit, or values missing)."""
+    rows = []
+    for c in CHECKS:
+        m = metrics.get(c.key)
+        if not isinstance(m, dict):
+            continue
+        mean, mx = m.get("mean"), m.get("max")
+        limits, ok = [], []
+        for stat, val, lim in (("mean", mean, c.mean_below), ("max", mx, c.max_below)):
+            if lim is None:
+                continue
+            limits.append(f"{stat} &lt; {lim:g} %")
+            if isinstance(val, (int, float)) and not math.isnan(float(val)):
+                ok.append(float(val) < lim)
+        status = "info" if not limits or not ok else ("pass" if all(ok) else "fail")
+        rows.append({"key": c.key, "label": c.label, "mean": mean, "max": mx,
+                     "limit": ", ".join(limits) or "&ndash;", "status": status})
+    return rows
+
+
+def _flatten(d: Any, prefix: str = "") -> Iterable[tuple[str, Any]]:
+    if isinstance(d, dict):
+        for k, v in d.items():
+            yield from _flatten(v, f"{prefix}.{k}" if prefix else str(k))
+    else:
+        yield prefix, d
+
+
+def _value_text(v: Any, limit: int = 160) -> str:
+    if isinstance(v, list):
+        txt = json.dumps(v)
+        if len(txt) > limit:
+            txt = txt[:limit] + f" ... ({len(v)} items)"
+        return txt
+    return _fmt(v)
+
+
+def _kv_table(items: Iterable[tuple[str, Any]]) -> str:
+    rows = "".join(f"<tr><th>{html.escape(k)}</th><td>{html.escape(_value_text(v))}</td></tr>"
+                   for k, v in items)
+    return f"<table>{rows}</table>" if rows else "<p class=info>none</p>"
+
+
+def _data_uri(path: Path) -> str:
+    mime = _MIME.get(path.suffix.lower(), "application/octet-stream")
+    return f"data:{mime};base64," + base64.b64encode(path.read_bytes()).decode("ascii")
+
+
+def _figure(path: Path, caption: str, wide: bool = False) -> str:
+    cls = ' class="wide"' if wide else ""
+    return (f'<figure{cls}><img src="{_data_uri(path)}" alt="{html.escape(path.name)}">'
+            f"<figcaption><code>{html.escape(path.name)}</code> {html.escape(caption)}"
+            "</figcaption></figure>")
+
+
+_XMLNS = re.compile(r'\s+xmlns(:[\w-]+)?="[^"]*"')
+
+
+def _inline_svg(path: Path, tag: str) -> str:
+    """The ``<svg>`` element of an SVG file for inlining in HTML: no XML prolog, doctype,
+    comments or namespace declarations (HTML5 knows the SVG namespace), ids prefixed by
+    ``tag`` so several drawings can share a page, and no scripts or external references."""
+    text = path.read_text(encoding="utf-8", errors="replace")
+    start = text.find("<svg")
+    if start < 0:
+        raise InputError(f"{path} is not an SVG drawing (no <svg> element)")
+    text = text[start:]
+    text = re.sub(r"<!--.*?-->", "", text, flags=re.S)
+    text = re.sub(r"<script\b.*?</script>", "", text, flags=re.S | re.I)
+    text = _XMLNS.sub("", text)
+    text = text.replace("xlink:href", "href")
+    text = re.sub(r'\b(href|src)="(?!#)[^"]*"', "", text)  # only internal references survive
+    text = re.sub(r'\bid="([^"]*)"', lambda m: f'id="{tag}-{m.group(1)}"', text)
+    text = re.sub(r'url\(#([^)]*)\)', lambda m: f"url(#{tag}-{m.group(1)})", text)
+    text = re.sub(r'href="#([^"]*)"', lambda m: f'href="#{tag}-{m.group(1)}"', text)
+    return text
+
+
+def _pictures(d: Path) -> list[Path]:
+    pics = [p for p in d.iterdir() if p.is_file() and p.suffix.lower() in _MIME]
+    rank = {n: i for i, n in enumerate(_ORDER)}
+    return sorted(pics, key=lambda p: (rank.get(p.name, len(rank)), p.name))
+
+
+def _lamella_table(lamellae: list[dict]) -> str:
+    head = ("<tr><th>id</th><th>family</th><th>length [m]</th><th>joints</th>"
+            "<th>joint spacing [m] min / max</th></tr>")
+    rows = []
+    for r in lamellae:
+        s = r.get("joint_s") or []
+        gaps = [b - a for a, b in zip(s[:-1], s[1:])]
+        sp = f"{min(gaps):.4g} / {max(gaps):.4g}" if gaps else "&ndash;"
+        rows.append(f"<tr><td class=num>{int(r['id'])}</td><td>C{int(r['family'])}</td>"
+                    f"<td class=num>{float(r.get('length', float('nan'))):.4f}</td>"
+                    f"<td class=num>{len(r.get('joints', []))}</td><td class=num>{sp}</td></tr>")
+    return f'<div class="scroll"><table>{head}{"".join(rows)}</table></div>'
+
+
+def _fabrication_section(d: Path) -> str:
+    fab = d / "fabrication"
+    if not fab.is_dir():
+        return ""
+    parts = ['<section id="fabrication"><h2>Fabrication</h2>']
+    info = fab / "fabrication.json"
+    if info.is_file():
+        try:
+            rep = json.loads(info.read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            rep = {}
+        keys = ("shape", "n_strips", "n_pieces", "n_sheets", "n_joint_marks", "utilisation",
+                "labels_dropped", "radius_mm")
+        parts.append(_kv_table((k, rep[k]) for k in keys if k in rep))
+    plan = fab / "plan.png"
+    if plan.is_file():
+        parts.append(_figure(plan, _CAPTIONS["plan.png"], wide=True))
+    sheets = sorted(p for p in fab.glob("sheet_*.svg"))
+    for k, p in enumerate(sheets[:MAX_SHEETS]):
+        parts.append(f'<figure class="sheet">{_inline_svg(p, f"s{k}")}<figcaption>'
+                     f"<code>{html.escape(p.name)}</code> cut sheet (DXF beside it)"
+                     "</figcaption></figure>")
+    if len(sheets) > MAX_SHEETS:
+        parts.append(f"<p class=info>{len(sheets) - MAX_SHEETS} more sheets in "
+                     "<code>fabrication/</code>.</p>")
+    parts.append("</section>")
+    return "".join(parts)
+
+
+def report_html(bundle_dir: str | os.PathLike) -> str:
+    """The HTML text of the report of ``bundle_dir`` (see :func:`write_report`)."""
+    from .. import __version__
+    from ..bundle import read_design_json
+
+    d = Path(bundle_dir)
+    design = read_design_json(d)
+    kind = str(design["kind"])
+    metrics = design.get("metrics") or {}
+    params = design.get("params") or {}
+    lams = design["lamellae"]
+    checks = metric_checks(metrics)
+    decided = [r["status"] for r in checks if r["status"] != "info"]
+    if not decided:
+        verdict = '<span class="verdict info">no thresholded metrics stored</span>'
+    elif all(s == "pass" for s in decided):
+        verdict = '<span class="verdict pass">&#10003; within the paper\'s thresholds</span>'
+    else:
+        verdict = (f'<span class="verdict fail">&#10007; {decided.count("fail")} of '
+                   f"{len(decided)} checks fail the paper's thresholds</span>")
+    fam = {f: sum(1 for r in lams if int(r["family"]) == f) for f in (1, 3)}
+    total = sum(float(r.get("length", 0.0)) for r in lams)
+    title = f"{kind} alignable lamella gridshell &mdash; {html.escape(d.resolve().name)}"
+    overview = [("kind", kind), ("units", design.get("units", "m")),
+                ("joints", design.get("n_joints")), ("net-loops", design.get("n_loops")),
+                ("lamellae", f"{len(lams)} (C1: {fam[1]}, C3: {fam[3]})"),
+                ("total lamella length [m]", f"{total:.4g}")]
+    if "collapse" in design:
+        c = design["collapse"]
+        overview.append(("collapse curve", f"{c.get('shape')}" + (
+            f", radius {c['radius']:.4g} m" if c.get("radius") else "")))
+
+    rows = "".join(
+        f"<tr><td>{html.escape(r['label'])}<br><code>{r['key']}</code></td>"
+        f"<td class=num>{_fmt(r['mean'])}</td><td class=num>{_fmt(r['max'])}</td>"
+        f"<td>{r['limit']}</td><td class={r['status']}>{_MARK[r['status']]}</td></tr>"
+        for r in checks)
+    check_table = ("<table><tr><th>metric</th><th>mean [%]</th><th>max [%]</th>"
+                   f"<th>paper threshold</th><th>result</th></tr>{rows}</table>") if rows \
+        else "<p class=info>No alignability metrics stored in design.json.</p>"
+    checked = {r["key"] for r in checks}
+    other = [(k, v) for k, v in _flatten({k: v for k, v in metrics.items()
+                                          if k not in checked and k != "timings"})]
+    timings = list(_flatten(metrics.get("timings", {})))
+
+    pics = _pictures(d)
+    figs = "".join(_figure(p, _CAPTIONS.get(p.name, ""), wide=p.name == "render.png")
+                   for p in pics) or "<p class=info>No pictures in the bundle; run " \
+                                     "<code>gridshell render DIR</code>.</p>"
+    files = sorted(p.name + ("/" if p.is_dir() else "") for p in d.iterdir()
+                   if not p.name.startswith("."))
+    parts = [
+        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">",
+        f"<title>{title}</title><style>{_CSS}</style></head><body>",
+        f"<header><h1>{title}</h1><p>design report written by gridshell {__version__} "
+        "&middot; self-contained: no external resources</p></header><main>",
+        f'<section id="overview"><h2>Overview</h2><p>{verdict}</p>{_kv_table(overview)}'
+        "</section>",
+        f'<section id="metrics"><h2>Metrics (paper 5.1)</h2>{check_table}',
+        "<h2>Other metrics</h2>" + _kv_table(other) if other else "",
+        "</section>",
+        f'<section id="pictures"><h2>Pictures</h2>{figs}</section>',
+        _fabrication_section(d),
+        f'<section id="lamellae"><h2>Lamellae</h2>{_lamella_table(lams)}</section>',
+        f'<section id="parameters"><h2>Parameters</h2>{_kv_table(_flatten(params))}',
+        ("<h2>Timings [s]</h2>" + _kv_table(timings)) if timings else "",
+        "</section>",
+        f'<section id="files"><h2>Files</h2><p><code>{html.escape(", ".join(files))}</code>'
+        "</p></section>",
+        "</main></body></html>\n",
+    ]
+    return "".join(parts)
+
+
+def write_report(bundle_dir: str | os.PathLike, path: str | os.PathLike | None = None, *,
+                 progress: Callable[[str], None] | None = None) -> Path:
+    """Write the self-contained ``report.html`` of a design bundle, atomically.
+
+    Parameters
+    ----------
+    bundle_dir : path-like
+        The design bundle (output of ``gridshell gg`` / ``gridshell ncp``).
+    path : path-like, optional
+        Output file (default ``bundle_dir/report.html``).
+
+    Returns
+    -------
+    Path
+        The written file.
+    """
+    out = Path(bundle_dir) / "report.html" if path is None else Path(path)
+    if progress is not None:
+        progress(f"writing {out}")
+    write_text(out, report_html(bundle_dir))
+    return out

@@ -1,0 +1,60 @@
+"""FD cases of the PHLW surface-design terms (gridshell.ncp.phlw, paper 4.2.1).
+
+A small bi-cubic B-spline (5 x 4 control points, 3 x 4 samples) with random control points
+and random auxiliary variables near their consistent values, so every product term is active.
+"""
+import numpy as np
+
+from gridshell.bspline import BSplineSurface
+from gridshell.ncp import phlw as P
+
+
+def _setup(rng, mode="phlw"):
+    u0, v0 = np.meshgrid(np.linspace(0, 1, 5), np.linspace(0, 1, 4), indexing="ij")
+    ctrl = np.stack([u0, v0, 0.3 * (u0 ** 2 - v0 ** 2)], axis=-1) + 0.05 * rng.normal(size=(5, 4, 3))
+    surf = BSplineSurface.from_control_grid(ctrl, 3, 3)
+    u, v = P.sample_params(surf, (3, 4))
+    data = P.make_samples(surf, u, v, mode)
+    lay = P.make_layout(surf.n_ctrl, 12, 3, mode)
+    aux = P.init_auxiliary(surf.ctrl.reshape(-1, 3), data)
+    vals = {"C": surf.ctrl.reshape(-1, 3), **aux, "t": rng.normal(size=3)}
+    if mode == "phlw":
+        vals["n"] = rng.normal(size=3)
+    elif mode == "cnc":
+        vals["n"] = rng.normal(size=1)
+    x = lay.pack(vals)
+    x = x + 0.1 * rng.normal(size=x.size)   # off the constraint manifold
+    return lay, x, data
+
+
+def _case(mode="phlw"):
+    def make(rng):
+        return _setup(rng, mode)
+    return make
+
+
+def _gliding(rng):
+    lay, x, data = _setup(rng)
+    k = data.ops["S"].shape[0]
+    n = rng.normal(size=(k, 3))
+    n /= np.linalg.norm(n, axis=1)[:, None]
+    return lay, x, P.SampleGliding(data.ops["S"], rng.normal(size=(k, 3)), n)
+
+
+def _target_all_modes(rng):
+    # the target with a shared n (cnc); the phlw and aa variants are checked in test_phlw.py
+    return _setup(rng, "cnc")
+
+
+CASES = {
+    "gridshell.ncp.phlw.normal_eq": _case(),
+    "gridshell.ncp.phlw.first_form_eq": _case(),
+    "gridshell.ncp.phlw.delta_eq": _case(),
+    "gridshell.ncp.phlw.sqrt_delta_eq": _case(),
+    "gridshell.ncp.phlw.second_form_eq": _case(),
+    "gridshell.ncp.phlw.curvature_eq": _case(),
+    "gridshell.ncp.phlw.principal_eq": _case(),
+    "gridshell.ncp.phlw.phlw_target": _target_all_modes,
+    "gridshell.ncp.phlw.beta_fairness": _case(),
+    "gridshell.ncp.phlw.sample_gliding": _gliding,
+}

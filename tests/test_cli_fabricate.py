@@ -1,0 +1,83 @@
+"""``gridshell fabricate`` through main([...]): GG and NCP bundles on disk, bad parameters."""
+from __future__ import annotations
+
+import csv
+import json
+
+import pytest
+from fab_cases import make_bundle, read_dxf_sheet
+
+from gridshell.bundle import write_bundle
+from gridshell.cli.main import main
+
+ISSUE_ARGS = ["--width", "20", "--thickness", "1", "--hole", "3", "--sheet", "600x400",
+              "--scale", "1:10"]
+
+
+@pytest.fixture(scope="module")
+def bundles(tmp_path_factory):
+    root = tmp_path_factory.mktemp("bundles")
+    write_bundle(root / "gg", make_bundle("GG"))
+    write_bundle(root / "ncp", make_bundle("NCP", nr=4, nc=4))
+    return root
+
+
+@pytest.mark.parametrize("name", ["gg", "ncp"])
+def test_fabricate_from_the_cli(bundles, name, capsys):
+    d = bundles / name
+    code = main(["fabricate", str(d), *ISSUE_ARGS, "-q", "--json"])
+    assert code == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["ok"] and "utilisation [%]" in summary
+    out = d / "fabrication"
+    rep = json.loads((out / "fabrication.json").read_text())
+    assert rep["kind"] == name.upper()
+    assert rep["n_strips"] == (9 if name == "gg" else 8)
+    for k in range(rep["n_sheets"]):
+        doc, parts = read_dxf_sheet(out / f"sheet_{k + 1:02d}.dxf")
+        assert doc.header["$INSUNITS"] == 4
+    with open(out / "cutlist.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    assert len(rows) == rep["n_pieces"]
+    assert {"lamella", "family", "flat_length_mm", "joint_positions_mm", "sheet",
+            "piece"} <= set(rows[0])
+    assert (out / "plan.png").stat().st_size > 0 and (out / "plan.svg").is_file()
+
+
+def test_summary_in_text(bundles, tmp_path, capsys):
+    assert main(["fabricate", str(bundles / "gg"), "-o", str(tmp_path / "o"), "--joints", "marks",
+                 "--no-labels", "--dxf-version", "R12", "--segments", "--kerf", "0.1",
+                 "--no-plan"]) == 0
+    cap = capsys.readouterr()
+    out = cap.out
+    assert "writing" in cap.err and "plan" not in cap.err
+    assert not (tmp_path / "o" / "plan.png").exists()
+    assert "sheets" in out and "utilisation" in out and "pieces split" in out
+
+
+@pytest.mark.parametrize("args,message", [
+    (["--hole", "25"], "hole diameter"),                       # hole wider than the strip
+    (["--sheet", "600x15"], "does not fit the sheet"),        # strip wider than the sheet
+    (["--width", "-20"], "--width"),                           # negative sizes
+    (["--gap", "-5"], "--gap"),
+    (["--scale", "1:0"], "scale"),
+    (["--sheet", "big"], "sheet size"),
+    (["--joints", "slots"], "orthogonal"),                     # slots on a GG design
+])
+def test_nonsensical_parameters_fail_before_writing(bundles, tmp_path, capsys, args, message):
+    out = tmp_path / "out"
+    code = main(["fabricate", str(bundles / "gg"), "-o", str(out), "-q", *args])
+    assert code == 2
+    assert message in capsys.readouterr().err
+    assert not out.exists()
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_bad_bundle_and_unsafe_output(bundles, tmp_path, capsys):
+    assert main(["fabricate", str(tmp_path / "nothing"), "-q"]) == 2
+    # refuse to replace the bundle or a foreign directory
+    assert main(["fabricate", str(bundles / "gg"), "-o", str(bundles / "gg"), "-q"]) == 2
+    (tmp_path / "mine").mkdir()
+    (tmp_path / "mine" / "notes.txt").write_text("keep")
+    assert main(["fabricate", str(bundles / "gg"), "-o", str(tmp_path / "mine"), "-q"]) == 2
+    assert (tmp_path / "mine" / "notes.txt").read_text() == "keep"

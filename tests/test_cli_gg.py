@@ -1,0 +1,87 @@
+"""Tests of the ``gridshell gg`` and ``gridshell verify`` commands, called through main([...])."""
+from __future__ import annotations
+
+import io
+import json
+
+import numpy as np
+import pytest
+from gg_cases import helicoid_grid
+
+from gridshell.bundle import DesignBundle, read_bundle, write_bundle
+from gridshell.cli.main import main
+from gridshell.grid import grid_quads
+from gridshell.net import Lamella, Net
+from gridshell.quadmesh import write_mesh
+
+
+def _helicoid_target(tmp_path, n=12):
+    P = helicoid_grid(n, n, c=0.5)
+    path = tmp_path / "helicoid.obj"
+    write_mesh(path, P.reshape(-1, 3), grid_quads(n, n))
+    return path
+
+
+def test_gg_then_verify(tmp_path, capsys):
+    target = _helicoid_target(tmp_path)
+    out = tmp_path / "design"
+    code = main(["gg", str(target), "-o", str(out), "--grid", "12", "12", "--lamellae", "5",
+                 "-q", "--json"])
+    assert code == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["ok"]
+    b = read_bundle(out)
+    assert b.kind == "GG" and len(b.net.loops) > 0 and (out / "preview.png").is_file()
+    assert b.revolution_V is not None
+    assert main(["verify", str(out), "--per-loop"]) == 0
+    res = json.loads(capsys.readouterr().out)
+    stored = b.metrics
+    assert res["alignability"]["mean"] == pytest.approx(stored["alignability"]["mean"], rel=1e-6)
+    assert res["alignability_arc"]["max"] == pytest.approx(stored["alignability_arc"]["max"],
+                                                           rel=1e-6, abs=1e-9)
+    assert len(res["per_loop"]["alignability"]) == len(b.net.loops)
+    assert res["geodesic_turning"] == pytest.approx(stored["geodesic_turning"], rel=1e-6)
+    assert res["deviation"]["max"] == pytest.approx(stored["deviation"]["max"], rel=1e-6)
+    assert res["delta_l"] is None
+
+
+def test_gg_bad_targets_leave_no_output(tmp_path):
+    out = tmp_path / "design"
+    assert main(["gg", str(tmp_path / "missing.obj"), "-o", str(out), "-q"]) != 0
+    assert not out.exists()
+    # a closed tube is not a disk
+    n = 8
+    ang = np.linspace(0, 2 * np.pi, n + 1)[:-1]
+    z = np.linspace(0, 1, 4)
+    V = np.array([[np.cos(a), np.sin(a), h] for h in z for a in ang])
+    F = [[i * n + j, i * n + (j + 1) % n, (i + 1) * n + (j + 1) % n, (i + 1) * n + j]
+         for i in range(3) for j in range(n)]
+    tube = tmp_path / "tube.obj"
+    write_mesh(tube, V, np.array(F))
+    assert main(["gg", str(tube), "-o", str(out), "-q"]) != 0
+    assert not out.exists()
+
+
+def test_verify_ncp_bundle_with_and_without_rotation_axes(tmp_path, capsys):
+    # a flat 3 x 3 joint grid with its two lamella families; aligned = a 10 % stretch
+    i, j = np.meshgrid(np.arange(3.0), np.arange(3.0), indexing="ij")
+    V = np.stack([j.ravel(), i.ravel(), np.zeros(9)], 1)
+    G = np.arange(9).reshape(3, 3)
+    lams = [Lamella(k, 1, G[k], [0, 1, 2], V[G[k]]) for k in range(3)]
+    lams += [Lamella(3 + k, 3, G[:, k], [0, 1, 2], V[G[:, k]]) for k in range(3)]
+    net = Net(V, grid_quads(3, 3), lams)
+    r = np.tile([0, 0, 1.0], (9, 1))
+    b = DesignBundle(kind="NCP", net=net, aligned=1.1 * V, surface_V=V, surface_F=grid_quads(3, 3))
+    buf = io.BytesIO()
+    np.save(buf, r)
+    write_bundle(tmp_path / "ncp", b, extra={"axes_r.npy": buf.getvalue(),
+                                              "aligned_r.npy": buf.getvalue()})
+    assert main(["verify", str(tmp_path / "ncp")]) == 0
+    res = json.loads(capsys.readouterr().out)
+    assert res["alignability"]["max"] == pytest.approx(0.0, abs=1e-12)
+    assert res["delta_l"]["max"] == pytest.approx(10.0)
+    assert "geodesic_turning" not in res
+    write_bundle(tmp_path / "ncp2", b)
+    assert main(["verify", str(tmp_path / "ncp2")]) == 0
+    assert json.loads(capsys.readouterr().out)["delta_n"] is None
+    assert main(["verify", str(tmp_path / "nothing")]) == 2

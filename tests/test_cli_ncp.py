@@ -1,0 +1,54 @@
+"""``gridshell ncp`` from the command line (small sizes: the API tests check the numbers)."""
+import json
+
+import numpy as np
+
+from gridshell.cli.main import main
+from gridshell.grid import grid_quads
+from gridshell.quadmesh import write_mesh
+
+from ncp_cases import pseudosphere, torus_grid
+
+SMALL = ["--curves", "6", "--samples", "24", "24", "--collapse-samples", "200", "200",
+         "--frames", "2", "--rounds", "1"]
+
+
+def test_cli_from_a_bspline_json_then_verify(tmp_path, capsys):
+    src = tmp_path / "surface.json"
+    pseudosphere().save(src)
+    out = tmp_path / "aa"
+    assert main(["ncp", str(src), "-o", str(out), "--mode", "aa", "--json", *SMALL]) == 0
+    captured = capsys.readouterr()
+    summary = json.loads(captured.out)
+    assert summary["ok"] and summary["kind"] == "AA"
+    assert "collapse curve" in captured.err and "post-optimization" in captured.err
+    for name in ("design.json", "aligned.obj", "alignment.gif", "axes_r.npy",
+                 "sequence/frame_002.obj"):
+        assert (out / name).is_file(), name
+    assert main(["verify", str(out)]) == 0
+    v = json.loads(capsys.readouterr().out)
+    assert v["ok"] and v["kind"] == "AA" and v["delta_l"]["max"] < 1
+    assert v["stored"]["aligned_line_error"] < 0.5
+
+
+def test_cli_from_a_mesh_runs_the_phlw_step(tmp_path, capsys):
+    P = torus_grid(12, 12)
+    ref = tmp_path / "torus.obj"
+    write_mesh(ref, P.reshape(-1, 3), grid_quads(12, 12))
+    out = tmp_path / "cnc"
+    code = main(["ncp", str(ref), "-o", str(out), "--mode", "cnc", "--no-render", "-q",
+                 "--phlw-ctrl", "6", "6", "--phlw-samples", "7", "7", "--phlw-outer", "1",
+                 "--phlw-max-iter", "3", *SMALL])
+    assert code == 0
+    d = json.loads((out / "design.json").read_text())
+    assert d["kind"] == "CNC" and d["collapse"]["shape"] == "circle"
+    assert not (out / "alignment.gif").exists()
+    assert "CNC design" in capsys.readouterr().out
+
+
+def test_cli_reports_bad_input(tmp_path, capsys):
+    bad = tmp_path / "bad.json"
+    bad.write_text("{}")
+    assert main(["ncp", str(bad), "-o", str(tmp_path / "x")]) == 2
+    assert "error" in capsys.readouterr().err
+    assert not np.any([p.name == "x" for p in tmp_path.iterdir()])

@@ -1,0 +1,131 @@
+"""Nesting (issue item 4): rows first-fit decreasing, stacks of congruent curved strips,
+sheets as needed, splices for lamellae longer than a sheet."""
+from __future__ import annotations
+
+import csv
+
+import numpy as np
+import pytest
+import shapely
+from fab_cases import make_bundle, read_dxf_sheet
+
+from fabrication import FabParams, fabricate
+from fabrication.nesting import check_layout, nest
+from fabrication.part import build_part
+from fabrication.splice import extent, split_strip
+from fabrication.strips import strips_from_bundle
+
+
+def _layout(kind, **kw):
+    b = make_bundle(kind, nr=kw.pop("nr", 4), nc=kw.pop("nc", 5))
+    params = FabParams(**kw)
+    parts = [build_part(p, params) for s in strips_from_bundle(b, params)
+             for p in split_strip(s, params)]
+    return parts, nest(parts, params), params
+
+
+def _assert_valid(layout, gap):
+    check_layout(layout, gap)
+    W, H = layout.sheet
+    box = shapely.box(0, 0, W, H)
+    for k in range(layout.n_sheets):
+        polys = [p.polygon(0.001) for p in layout.on_sheet(k)]
+        assert polys, "empty sheet"
+        for i, P in enumerate(polys):
+            assert box.contains(P)
+            for Q in polys[i + 1:]:
+                assert P.distance(Q) >= gap - 0.02
+
+
+def test_rows_first_fit_decreasing_fill_several_sheets():
+    parts, layout, params = _layout("GG", sheet="250x100", gap=4, nr=5, nc=6)
+    assert layout.n_sheets > 1
+    _assert_valid(layout, 4)
+    # straight strips stay axis-parallel, in rows of the strip width
+    for p in layout.parts:
+        x0, y0, x1, y1 = p.polygon().bounds
+        assert y1 - y0 == pytest.approx(20.0)
+    # first-fit decreasing: no later sheet holds a strip that fits the gap left in a row
+    # of an earlier sheet
+    ys = {}
+    for p, s in zip(layout.parts, layout.sheet_of):
+        x0, y0, x1, y1 = p.polygon().bounds
+        ys.setdefault((s, round(y0, 6)), []).append(x1)
+    free = {key: 250 - 4 - max(v) for key, v in ys.items()}
+    for p, s in zip(layout.parts, layout.sheet_of):
+        L = p.polygon().bounds[2] - p.polygon().bounds[0]
+        assert not any(f >= L + 4 + 1e-6 for (sh, _), f in free.items() if sh < s)
+
+
+def test_portrait_sheet():
+    parts, layout, params = _layout("GG", sheet="100x300", gap=3)
+    _assert_valid(layout, 3)
+    for p in layout.parts:
+        x0, y0, x1, y1 = p.polygon().bounds
+        assert y1 - y0 > x1 - x0        # strips run along the long side
+
+
+def test_congruent_arcs_nest_in_stacks():
+    parts, layout, params = _layout("CNC", sheet="600x400", gap=5)
+    _assert_valid(layout, 5)
+    assert layout.n_sheets == 1
+    # congruent arcs nest: consecutive ones in a stack are much closer than their height
+    on = sorted(layout.on_sheet(0), key=lambda p: p.polygon().bounds[1])
+    steps = [(q.polygon().bounds[1] - p.polygon().bounds[1], p.strip)
+             for p, q in zip(on[:-1], on[1:]) if abs(p.strip.length - q.strip.length) < 1e-6]
+    assert len(steps) >= 6
+    for dy, s in steps:
+        # two copies of an arc strip of half angle phi, shifted along the symmetry axis,
+        # are width + gap apart (normal to the arcs) at their ends when dy = (w + g) / cos phi
+        phi = s.length / (2 * s.axis.radius)
+        h = np.ptp(np.asarray(s.axis.point(np.linspace(s.s0, s.s1, 50), 10.0))[:, 1]) + 20
+        assert 25 - 1e-6 <= dy <= 25 / np.cos(phi) + 0.5 < h
+
+
+def test_ncp_pieces_stack_on_several_sheets():
+    parts, layout, params = _layout("NCP", sheet="300x120", gap=5, nr=4, nc=4)
+    assert layout.n_sheets >= 2
+    _assert_valid(layout, 5)
+
+
+def test_long_lamellae_are_split_at_joints_with_the_stated_overlap(tmp_path):
+    b = make_bundle("GG", nr=3, nc=8, a=0.2, stretch=0.05)
+    params = FabParams(scale="1:2", sheet="600x300", margin=15)
+    strips = strips_from_bundle(b, params)
+    long = [s for s in strips if extent(s)[0] > 590]
+    assert long
+    for s in long:
+        pieces = split_strip(s, params)
+        assert len(pieces) >= 2
+        for a, c in zip(pieces[:-1], pieces[1:]):
+            k = a.splices[-1]["splice_joint"]
+            assert c.s0 == pytest.approx(s.joint_s[k] - 15)   # margin before joint k
+            ov = (s.joint_s[k + 1] - s.joint_s[k]) + 30              # default overlap
+            assert a.s1 - c.s0 == pytest.approx(ov)
+            assert a.splices[-1]["shared_joints"] == [k, k + 1]
+        assert np.unique(np.concatenate([p.joint_s for p in pieces])) == pytest.approx(s.joint_s)
+    # a stated overlap
+    params2 = FabParams(scale="1:2", sheet="600x300", margin=15, overlap=40)
+    pieces = split_strip(long[0], params2)
+    assert pieces[0].s1 - pieces[1].s0 == pytest.approx(40)
+    # through fabricate: no overlaps, the cut list says so
+    rep = fabricate(b, tmp_path / "fab", params, plan=False)
+    assert rep["pieces_split"] and rep["n_pieces"] > rep["n_strips"]
+    parts = []
+    for k in range(rep["n_sheets"]):
+        parts += read_dxf_sheet(tmp_path / "fab" / f"sheet_{k + 1:02d}.dxf")[1]
+    assert len(parts) == rep["n_pieces"]
+    with open(tmp_path / "fab" / "cutlist.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    split_rows = [r for r in rows if r["piece"] != "1/1"]
+    assert split_rows and all("overlaps piece" in r["splice"] for r in split_rows)
+    assert {int(r["lamella"]) for r in split_rows} == {d["lamella"] for d in rep["pieces_split"]}
+
+
+def test_a_sheet_smaller_than_a_joint_spacing_is_an_input_error():
+    from gridshell.errors import InputError
+
+    b = make_bundle("GG")
+    params = FabParams(scale="1:1", sheet="100x60")
+    with pytest.raises(InputError, match="larger --sheet"):
+        split_strip(strips_from_bundle(b, params)[0], params)

@@ -1,0 +1,187 @@
+"""Tests of the GG surface design (gridshell.gg.design, gridshell.gg.initial; paper 4.1.1)."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from gg_cases import catenoid, helicoid_grid, revolution_grid, sphere
+
+from gridshell.errors import InputError, MeshError
+from gridshell.gg.design import (GGWeights, design_gg_surface, geodesic_residual,
+                                 length_residual_rel)
+from gridshell.gg.initial import initial_grid
+from gridshell.grid import grid_quads
+from gridshell.quadmesh import QuadMesh
+
+
+def _diag(P):
+    X = P.reshape(-1, 3)
+    return float(np.linalg.norm(X.max(axis=0) - X.min(axis=0)))
+
+
+def _quads(P):
+    R, C = P.shape[:2]
+    return P.reshape(-1, 3), grid_quads(R, C)
+
+
+def _dome_grid(R=12, C=10, b=2.2):
+    """Elliptic paraboloid z = -(x^2/2 + y^2/b), not rotationally symmetric for b != 2."""
+    x, y = np.meshgrid(np.linspace(-1, 1, R), np.linspace(-0.8, 0.8, C), indexing="ij")
+    return np.stack([x, y, -(x ** 2 / 2.0 + y ** 2 / b)], axis=-1)
+
+
+def _moved(d, P):
+    return float(np.linalg.norm(d.P - P, axis=2).max()) / _diag(P) * 100
+
+
+# ----------------------------------------------------------------------------- fixed points
+
+def _dome_of_revolution():
+    s = 0.3 + 1.1 * np.linspace(0, 1, 12) ** 1.3  # non-uniform spacing along the meridians
+    return revolution_grid(sphere(1.0), s, np.linspace(0.0, 1.6, 10))
+
+
+@pytest.mark.parametrize("make, moved_max", [(_dome_of_revolution, 0.1),
+                                            (lambda: helicoid_grid(12, 10, c=0.5), 0.5)],
+                         ids=["sphere-dome", "helicoid"])
+def test_rotationally_isometric_grids_are_fixed_points(make, moved_max):
+    P = make()
+    # the constraints hold exactly at the input
+    assert np.abs(geodesic_residual(P)).max() < 1e-10
+    assert max(length_residual_rel(P).values()) < 1e-10
+    d = design_gg_surface(*_quads(P), P)
+    assert d.report["before"]["geodesic"]["max"] < 1e-10
+    assert d.report["before"]["parallel_lengths"]["max"] < 1e-10 * _diag(P)
+    assert d.report["before"]["meridian_lengths"]["max"] < 1e-10 * _diag(P)
+    assert d.converged
+    assert _moved(d, P) < moved_max
+    assert d.deviation["max"] < moved_max
+    np.testing.assert_allclose(d.l, np.linalg.norm(np.diff(d.P, axis=1), axis=2).mean(1),
+                               rtol=1e-6)
+    assert d.h.shape == (P.shape[0] - 1,) and d.l.shape == (P.shape[0],)
+
+
+# ----------------------------------------------------------------------------- real work
+
+def test_noisy_catenoid_converges_near_the_target():
+    P = revolution_grid(catenoid(1.0), np.linspace(-0.8, 0.8, 12), np.linspace(0.0, 1.5, 10))
+    rng = np.random.default_rng(0)
+    Pn = P + rng.uniform(-1, 1, P.shape) * 0.01 * _diag(P) / np.sqrt(3)  # |noise| <= 1 %
+    V, F = _quads(Pn)
+    assert np.abs(geodesic_residual(Pn)).max() > 1e-2
+    msgs = []
+    d = design_gg_surface(V, F, Pn, progress=msgs.append)
+    assert d.converged
+    assert d.geodesic_residual_max < 1e-6 and d.length_residual_rel_max < 1e-6
+    assert np.abs(geodesic_residual(d.P)).max() == pytest.approx(d.geodesic_residual_max)
+    assert d.deviation["max"] < 1.0
+    assert d.report["after"]["geodesic"]["rms"] < 1e-3 * d.report["before"]["geodesic"]["rms"]
+    # every solver run lowers its energy; the constraint energy drops by orders of magnitude
+    assert all(h["energy"] <= h["energy0"] for h in d.history)
+    assert msgs and "converged" in msgs[-1]
+
+
+def test_elliptic_dome_grid_and_triangles():
+    P = _dome_grid()
+    d = design_gg_surface(*_quads(P), P)
+    assert d.converged, d.history[-1]
+    assert d.geodesic_residual_max < 1e-6 and d.length_residual_rel_max < 1e-6
+    assert d.deviation["mean"] < 1.0 and d.deviation["max"] < 3.0
+    # the same target as triangles: the grid is built by parameterization
+    V, Q = _quads(_dome_grid(15, 13))
+    T = np.concatenate([Q[:, [0, 1, 2]], Q[:, [0, 2, 3]]])
+    P0 = initial_grid(V, T, grid=(12, 10), direction=90.0)
+    assert P0.shape == (12, 10, 3)
+    # meridians (P0[:, j]) run along y as asked
+    m = P0[-1, :] - P0[0, :]
+    assert np.all(np.abs(m[:, 1]) > 5 * np.abs(m[:, 0]))
+    d = design_gg_surface(V, T, P0)
+    assert d.converged
+    assert d.deviation["mean"] < 1.0 and d.deviation["max"] < 3.0
+
+
+# ----------------------------------------------------------------------------- initial grid
+
+def test_initial_grid_from_a_structured_quad_grid():
+    P = _dome_grid(9, 7)
+    mesh = QuadMesh(*_quads(P))
+    np.testing.assert_array_equal(initial_grid(mesh, meridians="cols"), P)
+    np.testing.assert_array_equal(initial_grid(mesh, meridians="rows"), P.transpose(1, 0, 2))
+    np.testing.assert_array_equal(initial_grid(*_quads(P), meridians="cols"), P)
+    Pr = initial_grid(mesh, meridians="cols", grid=(5, 4))
+    assert Pr.shape == (5, 4, 3)
+    np.testing.assert_allclose(Pr[[0, 0, -1, -1], [0, -1, 0, -1]], P[[0, 0, -1, -1], [0, -1, 0, -1]])
+
+
+def test_initial_grid_from_triangles_follows_a_3d_direction():
+    V, Q = _quads(_dome_grid(13, 11))
+    T = np.concatenate([Q[:, [0, 1, 2]], Q[:, [0, 2, 3]]])
+    P0 = initial_grid(V, T, grid=(8, 6), direction=[1.0, 0.0, 0.0])
+    m = P0[-1, :] - P0[0, :]
+    assert np.all(np.abs(m[:, 0]) > 5 * np.abs(m[:, 1]))
+    # lifted onto the target: every sample is a point of the surface z = f(x, y)
+    np.testing.assert_allclose(P0[..., 2], -(P0[..., 0] ** 2 / 2 + P0[..., 1] ** 2 / 2.2),
+                               atol=0.01)
+    # covers most of the target
+    assert np.ptp(P0[..., 0]) > 1.6 and np.ptp(P0[..., 1]) > 1.2
+
+
+# ----------------------------------------------------------------------------- bad input
+
+def _cylinder(R=6, C=8):
+    th = np.linspace(0, 2 * np.pi, C, endpoint=False)
+    z = np.linspace(0, 1, R)
+    V = np.stack([np.cos(th)[None].repeat(R, 0), np.sin(th)[None].repeat(R, 0),
+                  z[:, None].repeat(C, 1)], -1).reshape(-1, 3)
+    G = np.arange(R * C).reshape(R, C)
+    G = np.concatenate([G, G[:, :1]], axis=1)
+    F = np.stack([G[:-1, :-1], G[:-1, 1:], G[1:, 1:], G[1:, :-1]], -1).reshape(-1, 4)
+    return V, F
+
+
+def test_bad_targets_are_named():
+    V, F = _cylinder()
+    with pytest.raises(MeshError, match="not a disk"):
+        initial_grid(V, F)
+    T = np.concatenate([F[:, [0, 1, 2]], F[:, [0, 2, 3]]])
+    with pytest.raises(MeshError, match="not a disk"):
+        initial_grid(V, T)
+    with pytest.raises(InputError, match="too coarse"):
+        initial_grid(*_quads(_dome_grid(3, 6)))
+    with pytest.raises(InputError, match="too coarse"):
+        initial_grid(*_quads(_dome_grid(6, 6)), grid=(3, 8))
+    # an L-shaped quad mesh is a disk but not a structured grid
+    V, F = _quads(_dome_grid(6, 6))
+    G = np.arange(36).reshape(6, 6)
+    keep = [k for k, f in enumerate(F) if not (f.min() // 6 >= 3 and f.min() % 6 >= 3)]
+    F = F[keep]
+    used = np.unique(F)
+    remap = np.full(36, -1)
+    remap[used] = np.arange(len(used))
+    with pytest.raises(MeshError, match="not a structured quad grid.*triangles"):
+        initial_grid(V[used], remap[F])
+    with pytest.raises(InputError, match="meridians"):
+        initial_grid(*_quads(_dome_grid(6, 6)), meridians="diagonal")
+    with pytest.raises(InputError, match="direction applies to triangle"):
+        initial_grid(*_quads(_dome_grid(6, 6)), direction=30.0)
+    assert G.shape == (6, 6)
+
+
+def test_bad_design_arguments_are_named():
+    P = _dome_grid(6, 6)
+    V, F = _quads(P)
+    with pytest.raises(InputError, match="too coarse"):
+        design_gg_surface(V, F, P[:3])
+    with pytest.raises(InputError, match=r"shape \(R, C, 3\)"):
+        design_gg_surface(V, F, P.reshape(-1, 3))
+    with pytest.raises(InputError, match="unknown GG design weight"):
+        design_gg_surface(V, F, P, weights={"closenes": 1.0})
+    with pytest.raises(InputError, match=">= 0"):
+        GGWeights.coerce(GGWeights(fairness=-1.0))
+
+
+def test_non_convergence_is_reported_not_raised():
+    P = _dome_grid(8, 8, b=1.0)
+    d = design_gg_surface(*_quads(P), P, outer=1, max_iter=1, polish_iter=0)
+    assert not d.converged
+    assert d.geodesic_residual_max > 1e-6
+    assert np.isfinite(d.deviation["max"])

@@ -1,0 +1,109 @@
+"""Tests of gridshell.gg.pipeline: net from a GG mesh, collapse, metrics, the whole pipeline."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from gg_cases import catenoid, helicoid_grid, revolution_grid
+
+from gridshell.errors import InputError
+from gridshell.grid import grid_quads
+from gridshell.gg.pipeline import collapse_gg, design_gg, gg_metrics, gg_net_from_mesh, write_gg
+
+
+def _mesh(P):
+    R, C = P.shape[:2]
+    return P.reshape(-1, 3), grid_quads(R, C)
+
+
+def test_exact_surface_of_revolution_gives_an_alignable_net():
+    P = revolution_grid(catenoid(1.0), np.linspace(-1.0, 1.0, 25), np.linspace(0.0, 2.0, 25))
+    st = gg_net_from_mesh(P, n_lamellae=8, crossing_angle=90.0)
+    V, F = _mesh(P)
+    m = gg_metrics(st["net"], V, F, net_rev=st["net_rev"], target=(V, F))
+    assert m["alignability"]["mean"] < 0.1 and m["alignability_arc"]["max"] < 0.1
+    assert m["alignability_revolution"]["max"] < 1e-6
+    assert m["geodesic_turning"] < 2.0
+    assert m["deviation_joints"]["max"] < 0.1
+
+
+def test_helicoid_net_meets_the_paper_bounds():
+    P = helicoid_grid(25, 25, c=0.5)
+    st = gg_net_from_mesh(P, n_lamellae=8, crossing_angle=70.0, at_parallel=0.3)
+    V, F = _mesh(P)
+    m = gg_metrics(st["net"], V, F, target=(V, F))
+    assert m["alignability"]["mean"] < 1.0 and m["alignability"]["max"] < 3.0
+    assert m["geodesic_turning"] < 2.0
+    assert m["deviation_joints"]["max"] < 1.0
+
+
+def test_collapse_keeps_lamella_lengths_between_joints():
+    P = helicoid_grid(21, 21, c=0.5)
+    net = gg_net_from_mesh(P, n_lamellae=6, crossing_angle=90.0)["net"]
+    aligned, info = collapse_gg(net)
+    assert info["mismatch_max"] < 1e-4 and info["components"] == 1
+    np.testing.assert_allclose(aligned[:, 1:], 0.0)
+    for lam in net.lamellae:
+        x = aligned[lam.joints, 0]
+        np.testing.assert_allclose(np.diff(x), np.diff(lam.joint_s), atol=2e-4)
+    # a net-loop closes on the line: A -> B -> C and A -> D -> C end at the same x
+    A, B, C, D = (aligned[net.loops[:, i], 0] for i in range(4))
+    assert np.all(B > A) and np.all(D > A) and np.all(C > B) and np.all(C > D)
+
+
+def test_offsets_in_metres_place_curves_on_the_reference_parallel():
+    P = revolution_grid(catenoid(1.0), np.linspace(-1.0, 1.0, 21), np.linspace(0.0, 2.0, 21))
+    st = gg_net_from_mesh(P, offsets=([0.3, 0.5, 1.2], [0.1, 0.9, 1.8]), crossing_angle=90.0)
+    r_star = 1.0  # the catenoid's neck is the middle parallel
+    np.testing.assert_allclose(st["inet"].offsets1 * r_star, [0.3, 0.5, 1.2], rtol=1e-6)
+    with pytest.raises(InputError, match="pair"):
+        gg_net_from_mesh(P, offsets=([0.3],), crossing_angle=90.0)
+
+
+def test_write_gg_bundle(tmp_path):
+    P = helicoid_grid(15, 15, c=0.5)
+    st = gg_net_from_mesh(P, n_lamellae=5, crossing_angle=90.0)
+    from gridshell.bundle import DesignBundle, read_design_json
+    V, F = _mesh(P)
+    aligned, _ = collapse_gg(st["net"])
+    b = DesignBundle(kind="GG", net=st["net"], aligned=aligned, surface_V=V, surface_F=F,
+                     metrics=gg_metrics(st["net"], V, F))
+    out = write_gg(tmp_path / "b", b)
+    assert (out / "preview.png").stat().st_size > 1000
+    d = read_design_json(out)
+    assert d["kind"] == "GG" and len(d["lamellae"]) == len(st["net"].lamellae)
+
+
+# ----------------------------------------------------------------------------- whole pipeline
+
+
+def test_design_gg_on_an_exact_surface_of_revolution():
+    P = revolution_grid(catenoid(1.0), np.linspace(-0.8, 0.8, 12), np.linspace(0.0, 1.5, 12))
+    bundle, report = design_gg(_mesh(P), grid=(12, 12), n_lamellae=6, crossing_angle=90.0)
+    m = bundle.metrics
+    assert bundle.kind == "GG"
+    assert m["alignability"]["mean"] < 0.1
+    assert m["deviation"]["max"] < 1.0
+
+
+def test_design_gg_on_a_helicoid():
+    P = helicoid_grid(12, 12, c=0.5)
+    bundle, _ = design_gg(_mesh(P), grid=(12, 12), n_lamellae=6, crossing_angle=80.0)
+    m = bundle.metrics
+    assert m["deviation"]["max"] < 1.0
+    assert m["alignability"]["mean"] < 1.0 and m["alignability"]["max"] < 3.0
+    assert m["geodesic_turning"] < 2.0
+
+
+def test_design_gg_on_a_dome_triangle_mesh():
+    # elliptic paraboloid z = -(x^2/a + y^2/b): no exact geodesic alignable net exists on it
+    x, y = np.meshgrid(np.linspace(-1, 1, 11), np.linspace(-0.8, 0.8, 9), indexing="ij")
+    V = np.stack([x.ravel(), y.ravel(), -(x.ravel() ** 2 / 2.0 + y.ravel() ** 2 / 1.2)], 1)
+    Q = grid_quads(11, 9)
+    T = np.concatenate([Q[:, [0, 1, 2]], Q[:, [0, 2, 3]]])
+    bundle, _ = design_gg((V, T), grid=(10, 10), n_lamellae=5, crossing_angle=90.0)
+    m = bundle.metrics
+    assert np.isfinite(m["deviation"]["max"]) and m["deviation"]["max"] >= 0.0
+    # on the designed surface the net is alignable up to the paper's bounds
+    assert m["alignability"]["mean"] < 1.0 and m["alignability"]["max"] < 3.0
+    assert m["alignability_revolution"]["max"] < 1e-3
+    assert len(bundle.net.loops) > 0

@@ -1,0 +1,75 @@
+"""Level-set tracing of NCP nets (gridshell.ncp.levelset, paper 4.2.2, eqs. 4.12-4.13)."""
+import numpy as np
+import pytest
+
+from gridshell.errors import InputError
+from gridshell.metrics import alignability_error
+from gridshell.ncp import levelset as LS
+from gridshell.ncp.directions import net_directions, uniform_params
+
+from ncp_cases import pseudosphere, torus
+
+
+def test_level_values_by_count_and_spacing():
+    assert np.allclose(LS.level_values(0.0, 1.0, count=3), [0.25, 0.5, 0.75])
+    assert np.allclose(LS.level_values(0.0, 1.0, spacing=0.3), [0.2, 0.5, 0.8])
+    for kw in ({}, {"count": 2, "spacing": 0.1}, {"count": 0}, {"spacing": -1.0}):
+        with pytest.raises(InputError):
+            LS.level_values(0.0, 1.0, **kw)
+    assert np.allclose(LS.level_values(0.0, 1.0, spacing=5.0), [0.5])   # the middle curve
+
+
+def test_level_function_reproduces_u_and_v():
+    surf = torus()
+    F = LS.level_function(surf, np.arange(144.0), (12, 12), (3, 3))
+    u, v = np.array([0.1, 0.73]), np.array([0.4, 0.95])
+    assert np.allclose(F.evaluate(u, v)[:, :2], np.stack([u, v], 1))
+
+
+@pytest.fixture(scope="module")
+def torus_net():
+    surf = torus()
+    d = net_directions(surf, *uniform_params(surf, (24, 24)), mode="phlw")
+    return surf, LS.trace(surf, d, curves=8, grid=(160, 160), axis_points=200)
+
+
+def test_level_functions_follow_the_net_directions(torus_net):
+    _, tn = torus_net
+    for f in (1, 3):
+        assert tn.fits[f].align_rms < 5e-3          # |sin| of the level set / e_f angle
+        assert abs(tn.fits[f].density - 1) < 1e-2   # dxi(e_f+1) ~ 1 (eq. 4.13)
+
+
+def test_traced_net_is_consistent(torus_net):
+    surf, tn = torus_net
+    net = tn.net
+    F1, F3 = tn.fits[1].F, tn.fits[3].F
+    i, j = tn.joint_ij.T
+    uv = tn.joint_uv
+    # joints: both levels at once, on the surface
+    assert np.allclose(LS.evaluate_xi(F1, uv[:, 0], uv[:, 1]), tn.levels[1][i], atol=1e-9)
+    assert np.allclose(LS.evaluate_xi(F3, uv[:, 0], uv[:, 1]), tn.levels[3][j], atol=1e-9)
+    assert np.allclose(net.joints, surf.evaluate(uv[:, 0], uv[:, 1]))
+    # loops: A has the least u, C the largest (A->B->C and A->D->C overlap upon alignment)
+    Lu = uv[net.loops, 0]
+    assert np.all(np.argmin(Lu, axis=1) == 0) and np.all(np.argmax(Lu, axis=1) == 2)
+    assert len(net.loops) > 10
+    # lamellae: joints are axis vertices, joint_s increases, u increases along the axis
+    for lam, auv, jidx in zip(net.lamellae, tn.axis_uv, tn.axis_joint_index):
+        assert np.allclose(lam.axis[jidx], net.joints[lam.joints])
+        assert np.all(np.diff(lam.joint_s) > 0) and auv[-1, 0] > auv[0, 0]
+        F = F1 if lam.family == 1 else F3
+        lev = LS.evaluate_xi(F, auv[:, 0], auv[:, 1])
+        assert np.ptp(lev) < 1e-8
+    assert len(net.family(1)) == len(net.family(3)) == 8
+    da = alignability_error(net.joints, net.loops)
+    assert np.mean(da) < 0.005 and np.max(da) < 0.01
+
+
+def test_pseudosphere_asymptotic_net_before_post_optimization():
+    """Acceptance (AA, before post-optimization): mean Delta_a < 1 %, max < 3 %."""
+    surf = pseudosphere()
+    d = net_directions(surf, *uniform_params(surf, (48, 48)), mode="aa")
+    tn = LS.trace(surf, d, curves=10)
+    da = alignability_error(tn.net.joints, tn.net.loops)
+    assert np.mean(da) < 0.01 and np.max(da) < 0.03

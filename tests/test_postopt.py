@@ -1,0 +1,88 @@
+"""Post-optimization and alignment simulation of NCP joint meshes (gridshell.ncp.postopt,
+gridshell.ncp.simulate, paper 4.2.4)."""
+import numpy as np
+import pytest
+
+from gridshell.errors import InputError
+from gridshell.metrics import alignability_error, delta_l, delta_n
+from gridshell.ncp import levelset as LS
+from gridshell.ncp import postopt as PO
+from gridshell.ncp.collapse import collapse_curve
+from gridshell.ncp.directions import net_directions, uniform_params
+from gridshell.ncp.simulate import collapse_direction, embed_aligned, simulate_alignment
+from gridshell.solver import Layout
+
+from ncp_cases import pseudosphere
+
+
+def _rotation(rng):
+    Q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    return Q
+
+
+def test_constraints_vanish_on_consistent_configurations():
+    rng = np.random.default_rng(0)
+    n = 6
+    E = np.array([[0, 1], [1, 2], [2, 3], [3, 4], [4, 5], [5, 0], [1, 4]])
+    V = rng.normal(size=(n, 3))
+    r = rng.normal(size=(n, 3))
+    r /= np.linalg.norm(r, axis=1)[:, None]
+    Q = _rotation(rng)
+    lay = Layout([("V", (n, 3)), ("r", (n, 3)), ("Vt", (n, 3)), ("rt", (n, 3))])
+    x = lay.pack({"V": V, "r": r, "Vt": V @ Q.T + 1.0, "rt": r @ Q.T})
+    j, k = PO.vertex_pairs(E)
+    assert np.allclose(PO.edge_length_eq(x, lay, PO.EdgeLength(E)).r, 0)
+    assert np.allclose(PO.rotation_axis_eq(x, lay, PO.AxisPairs(j, k)).r, 0)
+    assert np.allclose(PO.unit_norm_eq(x, lay, PO.UnitNorm("rt")).r, 0)
+    # a 3D -> 2D isometry of a planar configuration keeps lengths and axis offsets
+    P2 = rng.normal(size=(n, 2))
+    a2 = rng.normal(size=(n, 2))
+    a2 /= np.linalg.norm(a2, axis=1)[:, None]
+    lay2 = Layout([("V", (n, 3)), ("r", (n, 3)), ("Vt", (n, 2)), ("rt", (n, 2))])
+    B = _rotation(rng)[:2]
+    x2 = lay2.pack({"V": P2 @ B, "r": a2 @ B, "Vt": P2, "rt": a2})
+    assert np.allclose(PO.edge_length_eq(x2, lay2, PO.EdgeLength(E)).r, 0)
+    assert np.allclose(PO.rotation_axis_eq(x2, lay2, PO.AxisPairs(j, k)).r, 0)
+
+
+@pytest.fixture(scope="module")
+def pseudo_post():
+    surf = pseudosphere()
+    d = net_directions(surf, *uniform_params(surf, (48, 48)), mode="aa")
+    tn = LS.trace(surf, d, curves=10)
+    col = collapse_curve(surf, mode="aa", samples=(400, 400))
+    post = PO.post_optimize(surf, tn.net, tn.joint_uv, col)
+    return surf, tn, col, post
+
+
+def test_post_optimization_lowers_alignability_error_tenfold(pseudo_post):
+    surf, tn, col, post = pseudo_post
+    before = alignability_error(post.V0, tn.net.loops).mean()
+    after = alignability_error(post.V, tn.net.loops).mean()
+    assert before / after > 10
+    # joints stay on the surface: within 0.5 % of its diagonal
+    _, S, _ = PO.surface_closest(surf, post.V, post.uv)
+    diag = np.linalg.norm(np.ptp(surf.sample(30, 30).V, axis=0))
+    assert np.max(np.linalg.norm(post.V - S, axis=1)) / diag < 0.005
+    assert np.allclose(np.linalg.norm(post.r, axis=1), 1)
+    assert post.report["length (chi_l)"]["max"] < 1e-8       # polished constraints
+    with pytest.raises(InputError, match="unknown post-optimization weight"):
+        PO.post_optimize(surf, tn.net, tn.joint_uv, col, weights={"omega_x": 1})
+
+
+def test_alignment_sequence_collapses_onto_the_plane(pseudo_post):
+    surf, tn, _, post = pseudo_post
+    E = tn.net.edges()
+    d = collapse_direction(surf)
+    seq = simulate_alignment(post.V, post.r, E, d, aligned=(post.Vt, post.rt), frames=4)
+    assert len(seq.V) == 5 and np.allclose(seq.V[0], post.V)
+    off = [np.max(np.abs((V - seq.centroid) @ d)) for V in seq.V]
+    assert all(a > b for a, b in zip(off, off[1:])) and off[-1] < 1e-12
+    assert np.max(np.abs(seq.aligned_r @ d)) < 1e-12
+    assert np.nanmax(delta_l(post.V, seq.aligned, E)) < 0.01
+    assert np.nanmax(delta_n(post.V, post.r, seq.aligned, seq.aligned_r, E)) < 0.01
+    # every intermediate frame keeps the edge lengths within a few percent
+    for V in seq.V[1:-1]:
+        assert np.nanmax(delta_l(post.V, V, E)) < 0.05
+    A, RA = embed_aligned(post.V, post.r, post.Vt, post.rt, d, seq.centroid)
+    assert np.allclose(delta_l(post.V, A, E), delta_l(post.V, seq.aligned, E), atol=1e-6)

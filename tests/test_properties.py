@@ -1,0 +1,145 @@
+"""Property-based tests (hypothesis) of small geometry kernels.
+
+Settings stay modest (50 examples, no deadline) so the suite stays fast on a shared machine.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
+
+from gridshell.bspline import basis_matrix
+from gridshell.metrics import alignability_error
+from gridshell.net import polyline_arclength, polyline_length
+from gridshell.render.ribbons import ribbon_polygons
+from gridshell.solver.layout import Layout
+
+SETTINGS = settings(max_examples=50, deadline=None)
+coord = st.floats(-100, 100, allow_nan=False, allow_infinity=False)
+
+
+def points(min_n=1, max_n=30):
+    return st.integers(min_n, max_n).flatmap(lambda n: arrays(np.float64, (n, 3), elements=coord))
+
+
+def rotation(seed: int) -> np.ndarray:
+    """A random proper rotation (QR of a Gaussian matrix, sign-fixed)."""
+    Q, R = np.linalg.qr(np.random.default_rng(seed).normal(size=(3, 3)))
+    Q = Q * np.sign(np.diag(R))
+    return Q if np.linalg.det(Q) > 0 else -Q
+
+
+@SETTINGS
+@given(points())
+def test_arclength_is_monotone_and_ends_at_the_length(P):
+    s = polyline_arclength(P)
+    assert s.shape == (len(P),) and s[0] == 0.0
+    assert np.all(np.diff(s) >= 0)
+    assert s[-1] == pytest.approx(polyline_length(P), rel=1e-12, abs=1e-12)
+
+
+@SETTINGS
+@given(points(2), st.integers(0, 2**32 - 1), arrays(np.float64, 3, elements=coord))
+def test_arclength_is_invariant_under_rigid_motion(P, seed, t):
+    Q = P @ rotation(seed).T + t
+    np.testing.assert_allclose(polyline_arclength(Q), polyline_arclength(P), rtol=1e-9,
+                               atol=1e-9)
+
+
+shapes = st.one_of(st.just(()), st.integers(0, 4).map(lambda n: (n,)),
+                   st.tuples(st.integers(0, 4), st.integers(1, 3)))
+
+
+@SETTINGS
+@given(st.lists(shapes, min_size=1, max_size=5), st.integers(0, 2**32 - 1))
+def test_layout_pack_unpack_round_trip(block_shapes, seed):
+    rng = np.random.default_rng(seed)
+    layout = Layout([(f"b{i}", s) for i, s in enumerate(block_shapes)])
+    assert layout.size == sum(int(np.prod(s)) for s in block_shapes)
+    values = {f"b{i}": rng.normal(size=s) for i, s in enumerate(block_shapes)}
+    x = layout.pack(values)
+    back = layout.unpack(x)
+    assert list(back) == layout.names
+    for name, v in values.items():
+        assert back[name].shape == layout.shape(name)
+        np.testing.assert_array_equal(back[name].reshape(-1), np.asarray(v).reshape(-1))
+        np.testing.assert_array_equal(x[layout.indices(name)].reshape(-1),
+                                      np.asarray(v).reshape(-1))
+    np.testing.assert_array_equal(layout.pack(back), x)
+    assert layout.mask(layout.names).sum() == layout.size
+
+
+quads = arrays(np.float64, (4, 3), elements=st.floats(-10, 10, allow_nan=False))
+
+
+@SETTINGS
+@given(quads, st.integers(0, 2**32 - 1), arrays(np.float64, 3, elements=coord),
+       st.floats(0.01, 100))
+def test_alignability_error_is_invariant_under_similarity(V, seed, t, scale):
+    sides = np.linalg.norm(V - np.roll(V, 1, axis=0), axis=1)
+    assume(sides.sum() > 1e-3)
+    loops = [[0, 1, 2, 3]]
+    W = scale * V @ rotation(seed).T + t
+    assert alignability_error(W, loops)[0] == pytest.approx(alignability_error(V, loops)[0],
+                                                            rel=1e-7, abs=1e-9)
+
+
+@SETTINGS
+@given(arrays(np.float64, (3, 3), elements=st.floats(-10, 10, allow_nan=False)))
+def test_parallelograms_are_alignable(X):
+    A, u, v = X
+    assume(np.linalg.norm(u) + np.linalg.norm(v) > 1e-3)
+    V = np.array([A, A + u, A + u + v, A + v])
+    # rounding of (A + u) - A is at most ~eps |A| / |u|: far below 1e-9 here
+    assert alignability_error(V, [[0, 1, 2, 3]])[0] == pytest.approx(0.0, abs=1e-9)
+
+
+@st.composite
+def knot_vectors(draw):
+    degree = draw(st.integers(1, 5))
+    n_ctrl = draw(st.integers(degree + 1, degree + 8))
+    # interior knots strictly inside the domain, on a 1/64 grid (repeats allowed): clamped
+    # ends of multiplicity exactly degree + 1 and no denormal spans
+    inner = sorted(k / 64 for k in draw(st.lists(st.integers(1, 63), min_size=n_ctrl - degree - 1,
+                                                 max_size=n_ctrl - degree - 1)))
+    lo = draw(st.floats(-5, 5))
+    span = draw(st.floats(0.1, 10))
+    knots = lo + span * np.concatenate([np.zeros(degree + 1), inner, np.ones(degree + 1)])
+    return degree, knots
+
+
+@SETTINGS
+@given(knot_vectors(), st.lists(st.floats(0.0, 1.0), min_size=1, max_size=20))
+def test_bspline_basis_is_a_partition_of_unity(dk, ts):
+    degree, knots = dk
+    lo, hi = knots[degree], knots[-degree - 1]
+    t = lo + (hi - lo) * np.asarray(ts)
+    B = basis_matrix(knots, degree, t).toarray()
+    assert B.shape == (len(t), len(knots) - degree - 1)
+    np.testing.assert_allclose(B.sum(axis=1), 1.0, atol=1e-9)
+    assert B.min() >= -1e-12
+    assert (np.abs(B) > 1e-12).sum(axis=1).max() <= degree + 1  # local support
+    for d in (1, 2):  # derivatives of a partition of unity sum to zero
+        D = basis_matrix(knots, degree, t, deriv=d).toarray()
+        np.testing.assert_allclose(D.sum(axis=1), 0.0, atol=1e-6 * (1 + np.abs(D).max()))
+
+
+@SETTINGS
+@given(points(2, 20), st.floats(0.001, 10.0), st.booleans())
+def test_ribbon_has_the_width_and_contains_the_axis(P, width, tangent):
+    seg = np.linalg.norm(np.diff(P, axis=0), axis=1)
+    assume(seg.min() > 1e-3)
+    # a normal field perpendicular to the tangent: any unit vector orthogonal to it
+    T = np.gradient(P, axis=0)
+    assume(np.linalg.norm(T, axis=1).min() > 1e-6)
+    ref = np.where(np.abs(T[:, [0]]) < 0.9 * np.linalg.norm(T, axis=1, keepdims=True),
+                   [[1.0, 0, 0]], [[0, 1.0, 0]])
+    N = np.cross(T, ref)
+    N /= np.linalg.norm(N, axis=1, keepdims=True)
+    Q = ribbon_polygons(P, N, width, tangent)
+    assert Q.shape == (len(P) - 1, 4, 3)
+    np.testing.assert_allclose(np.linalg.norm(Q[:, 3] - Q[:, 0], axis=1), width, rtol=1e-9)
+    np.testing.assert_allclose(0.5 * (Q[:, 0] + Q[:, 3]), P[:-1],
+                               atol=1e-9 * (1 + np.abs(P).max()))

@@ -1,0 +1,104 @@
+"""Tests of gridshell.render.ribbons and gridshell.render.sequence on small synthetic bundles."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from PIL import Image
+from render_cases import make_bundle, write_case
+
+from gridshell.errors import InputError
+from gridshell.render.ribbons import (FAMILY_COLOURS, ribbon_polygons, render_bundle,
+                                      render_ribbons, view_angles)
+from gridshell.render.sequence import read_sequence, render_bundle_sequence, sequence_files
+
+SIZE = (320, 240)
+
+
+def _image(path) -> np.ndarray:
+    with Image.open(path) as im:
+        assert im.format == "PNG"
+        assert im.size == SIZE
+        return np.asarray(im.convert("RGB"), float)
+
+
+def _has_colour(img: np.ndarray, rgb, tol: float = 60.0) -> bool:
+    """Some pixels close to ``rgb`` (0..1) up to shading (same hue, dimmed)."""
+    c = np.asarray(rgb) * 255
+    # shading scales the colour by k in [0.5, 1]: compare to the best k per pixel
+    k = np.clip((img @ c) / (c @ c), 0.4, 1.0)
+    d = np.linalg.norm(img - k[..., None] * c, axis=-1)
+    return int((d < tol).sum()) > 50
+
+
+def test_ribbon_offsets_tangent_and_normal():
+    x = np.linspace(0, 1, 5)
+    axis = np.stack([x, np.zeros_like(x), np.zeros_like(x)], axis=1)
+    n = np.tile([0.0, 0.0, 1.0], (5, 1))
+    flat = ribbon_polygons(axis, n, 0.2, tangent=True)
+    assert flat.shape == (4, 4, 3)
+    assert np.allclose(flat[..., 2], 0.0)  # GG: in the surface
+    assert np.allclose(np.abs(flat[..., 1]), 0.1)
+    up = ribbon_polygons(axis, n, 0.2, tangent=False)
+    assert np.allclose(up[..., 1], 0.0)  # NCP: standing on the surface
+    assert np.allclose(np.abs(up[..., 2]), 0.1)
+
+
+def test_view_looks_at_the_broad_side_from_above():
+    rng = np.random.default_rng(0)
+    P = rng.uniform(-1, 1, (200, 3)) * [3.0, 1.0, 0.05]  # flat, long along x
+    elev, azim = view_angles(P)
+    assert elev == pytest.approx(35.0, abs=3.0)  # 90 - default tilt 55
+    # the camera looks mostly across the long x extent (from -y or +y)
+    assert abs(np.cos(np.radians(azim))) < 0.5
+
+
+@pytest.mark.parametrize("kind", ["GG", "NCP"])
+def test_render_ribbons_png(tmp_path, kind):
+    b = make_bundle(kind)
+    lams = b.net.lamellae
+    out = render_ribbons(tmp_path / "r.png", [lam.axis for lam in lams],
+                         [lam.family for lam in lams], b.surface_V, b.surface_F, b.net.joints,
+                         kind=kind, width=0.12, size=SIZE, title="test")
+    img = _image(out)
+    assert img.std() > 10  # not blank
+    assert _has_colour(img, FAMILY_COLOURS[1]) and _has_colour(img, FAMILY_COLOURS[3])
+    assert not list(tmp_path.glob(".*"))  # atomic: no temporary file left
+
+
+def test_render_bundle_writes_render_png(tmp_path):
+    d = write_case(tmp_path / "b", "GG")
+    out = render_bundle(d, size=SIZE)
+    assert out == d / "render.png"
+    assert _image(out).std() > 10
+
+
+def test_render_rejects_bad_input(tmp_path):
+    b = make_bundle()
+    axes = [lam.axis for lam in b.net.lamellae]
+    with pytest.raises(InputError, match="one family per lamella"):
+        render_ribbons(tmp_path / "x.png", axes, [1], b.surface_V, b.surface_F)
+    with pytest.raises(InputError, match="kind"):
+        render_ribbons(tmp_path / "x.png", axes, [1] * len(axes), b.surface_V, b.surface_F,
+                       kind="XY")
+    with pytest.raises(InputError, match="output path"):
+        render_bundle(b)
+    assert not (tmp_path / "x.png").exists()
+
+
+def test_sequence_frames_and_gif(tmp_path):
+    d = write_case(tmp_path / "b", "NCP", sequence=True)
+    assert [p.name for p in sequence_files(d)] == [f"frame_{k:03d}.obj" for k in range(3)]
+    frames, F = read_sequence(d)
+    assert len(frames) == 3 and F.shape == (9, 4)
+    np.testing.assert_allclose(frames[-1], make_bundle("NCP").aligned)
+    res = render_bundle_sequence(d, dpi=40)
+    assert [p.name for p in res["frames"]] == [f"frame_{k:03d}.png" for k in range(3)]
+    with Image.open(res["gif"]) as im:
+        assert im.format == "GIF" and im.n_frames == 3 and im.info.get("loop") == 0
+
+
+def test_sequence_missing(tmp_path):
+    d = write_case(tmp_path / "b", "GG")
+    assert sequence_files(d) == []
+    with pytest.raises(InputError, match="no sequence"):
+        read_sequence(d)
