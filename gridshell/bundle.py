@@ -172,7 +172,7 @@ def read_design_json(path: str | Path) -> dict:
 
 def read_bundle(path: str | Path) -> DesignBundle:
     """Read a design bundle directory written by :func:`write_bundle`."""
-    from .quadmesh import read_mesh, read_polylines
+    from .quadmesh import read_configuration, read_mesh, read_polylines
 
     path = Path(path)
     d = read_design_json(path)
@@ -180,7 +180,11 @@ def read_bundle(path: str | Path) -> DesignBundle:
         if not (path / name).is_file():
             raise InputError(f"design bundle {path} lacks {name}; re-run the design command")
     net_mesh = read_mesh(path / "net.obj", kind="quad")
-    aligned = read_mesh(path / "aligned.obj", kind="quad")
+    # collapsed loops are degenerate by design: only the vertices, unchecked
+    aligned = read_configuration(path / "aligned.obj")[0]
+    if aligned.shape != net_mesh.V.shape:
+        raise InputError(f"{path}: aligned.obj has {len(aligned)} vertices but net.obj "
+                         f"{len(net_mesh.V)}; re-run the design command")
     axes = read_polylines(path / "axes.obj")
     if len(axes) != len(d["lamellae"]):
         raise InputError(f"{path}: axes.obj has {len(axes)} polylines but design.json "
@@ -196,7 +200,7 @@ def read_bundle(path: str | Path) -> DesignBundle:
     collapse_s = {int(r["id"]): np.asarray(r["collapse_s"], float)
                   for r in d["lamellae"] if "collapse_s" in r} or None
     collapse = CollapseCurve.from_json(d["collapse"]) if "collapse" in d else None
-    return DesignBundle(kind=d["kind"], net=net, aligned=aligned.V, surface_V=surf.V,
+    return DesignBundle(kind=d["kind"], net=net, aligned=aligned, surface_V=surf.V,
                         surface_F=surf.F, metrics=d.get("metrics", {}),
                         params=d.get("params", {}), collapse=collapse, collapse_s=collapse_s,
                         revolution_V=rev_V, revolution_F=rev_F, units=d.get("units", "m"))

@@ -765,6 +765,27 @@ def _read_raw(path: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return V, P, sizes
 
 
+def read_configuration(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Vertices ``V (n,3)``, padded faces ``(m,k)`` (``-1`` padded) and face sizes ``(m,)`` of a
+    mesh file, without the geometry checks of :func:`read_mesh`.
+
+    For configurations that are degenerate by design: a collapsed (aligned) net puts every
+    joint of a loop on one line, which :func:`validate_mesh` rejects as zero-area faces. The
+    file must still parse and hold at least one vertex (:class:`MeshError` otherwise);
+    coordinates must be finite.
+    """
+    path = Path(path)
+    V, P, sizes = _read_raw(path)
+    V = np.asarray(V, dtype=np.float64).reshape(-1, 3)
+    if not np.all(np.isfinite(V)):
+        raise MeshError(f"{path.name}: {int((~np.isfinite(V)).any(axis=1).sum())} vertices have "
+                        "NaN or infinite coordinates; re-export the mesh")
+    if len(P) and (P.max() >= len(V)):
+        raise MeshError(f"{path.name}: a face refers to vertex {int(P.max())} but the file has "
+                        f"{len(V)} vertices; the file is truncated or corrupt")
+    return V, P, sizes
+
+
 def read_mesh(path: str | os.PathLike, kind: str = "any") -> QuadMesh | TriMesh:
     """Read an OBJ, PLY (ASCII or binary) or OFF mesh, keeping vertex and face order.
 

@@ -5,7 +5,7 @@ import json
 import numpy as np
 import pytest
 
-from gridshell.bundle import read_design_json
+from gridshell.bundle import read_bundle, read_design_json
 from gridshell.cli.verify import verify_bundle
 from gridshell.ncp.pipeline import design_ncp, write_ncp
 
@@ -49,7 +49,9 @@ def test_aa_bundle_files_and_verify(aa_bundle):
         assert (out / name).stat().st_size > 0, name
     assert (out / "alignment.gif").read_bytes()[:6] in (b"GIF89a", b"GIF87a")
     assert (out / "sequence/frame_012.obj").read_text() == (out / "aligned.obj").read_text()
-    # (read_bundle rejects aligned.obj: its collapsed loops have zero area; read design.json)
+    # the collapsed configuration (zero-area loops by design) reads back with the bundle
+    rb = read_bundle(out)
+    np.testing.assert_allclose(rb.aligned, bundle.aligned, atol=1e-12)
     d = read_design_json(out)
     assert d["kind"] == "AA" and d["collapse"]["shape"] == "line"
     for rec in d["lamellae"]:

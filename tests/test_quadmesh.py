@@ -268,3 +268,23 @@ def test_too_large(monkeypatch):
 def test_quadmesh_checks_input():
     with pytest.raises(MeshError):
         QuadMesh(np.zeros((3, 3)), [[0, 1, 2]])
+
+
+def test_read_configuration_accepts_a_collapsed_net_but_not_garbage(tmp_path):
+    from gridshell.quadmesh import read_configuration
+    # a collapsed net: every loop's joints on the x axis, zero area by design
+    V = np.array([[0.0, 0, 0], [1, 0, 0], [2, 0, 0], [1.5, 0, 0]])
+    F = np.array([[0, 1, 2, 3]])
+    write_mesh(tmp_path / "aligned.obj", V, F)
+    with pytest.raises(MeshError, match="degenerate"):
+        read_mesh(tmp_path / "aligned.obj", kind="quad")
+    V2, P, sizes = read_configuration(tmp_path / "aligned.obj")
+    np.testing.assert_array_equal(V2, V)
+    np.testing.assert_array_equal(P[:, :4], F)
+    assert sizes.tolist() == [4]
+    (tmp_path / "bad.obj").write_text("v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 9\n")
+    with pytest.raises(MeshError, match="vertex"):
+        read_configuration(tmp_path / "bad.obj")
+    (tmp_path / "nan.obj").write_text("v 0 0 nan\nv 1 0 0\nv 1 1 0\nf 1 2 3\n")
+    with pytest.raises(MeshError, match="NaN"):
+        read_configuration(tmp_path / "nan.obj")

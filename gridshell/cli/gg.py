@@ -12,9 +12,9 @@ def add_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("target", help="target surface mesh (OBJ, PLY, OFF), metres, one disk")
     p.add_argument("-o", "--output", required=True, metavar="DIR",
                    help="output design bundle directory (replaced atomically)")
-    p.add_argument("--meridians", choices=("rows", "cols"), default="rows",
+    p.add_argument("--meridians", choices=("rows", "cols"), default="cols",
                    help="for a quad-grid target: grid lines that become the meridians "
-                        "(geodesics of the designed surface); default rows")
+                        "(geodesics of the designed surface); default cols")
     p.add_argument("--grid", nargs=2, type=int, metavar=("R", "C"),
                    help="resolution of the designed mesh: R parallels x C meridians")
     p.add_argument("--direction", type=float, metavar="DEG",

@@ -17,15 +17,6 @@ def add_args(p: argparse.ArgumentParser) -> None:
                    help="also list Delta_a of every net-loop")
 
 
-def _read_vertices_unchecked(path: Path) -> np.ndarray:
-    """Vertices of an OBJ whose faces may be degenerate by design (a collapsed configuration
-    puts every joint of a loop on one line, which the mesh checks reject)."""
-    from ..quadmesh import _read_raw
-
-    V, _, _ = _read_raw(path)
-    return np.asarray(V, float)
-
-
 def verify_bundle(path: str | Path) -> dict[str, Any]:
     """Metrics of the bundle at ``path`` recomputed from design.json, net.obj, axes.obj,
     surface.obj (and aligned.obj, axes_r.npy, aligned_r.npy when present)."""
@@ -34,7 +25,7 @@ def verify_bundle(path: str | Path) -> dict[str, Any]:
     from ..metrics import (alignability_error, alignability_error_arc, delta_l, delta_n,
                            deviation, geodesic_turning, summary)
     from ..net import Lamella, Net
-    from ..quadmesh import read_mesh, read_polylines
+    from ..quadmesh import read_configuration, read_mesh, read_polylines
 
     path = Path(path)
     d = read_design_json(path)
@@ -73,7 +64,7 @@ def verify_bundle(path: str | Path) -> dict[str, Any]:
             out["deviation_joints"] = {"mean": dj["mean"], "max": dj["max"]}
     r_star, r_a = path / "axes_r.npy", path / "aligned_r.npy"
     if r_star.is_file() and r_a.is_file() and (path / "aligned.obj").is_file():
-        Va = _read_vertices_unchecked(path / "aligned.obj")
+        Va = read_configuration(path / "aligned.obj")[0]
         rs, ra = np.load(r_star), np.load(r_a)
         E = net.edges()
         out["delta_l"] = {k: 100 * v for k, v in summary(delta_l(net.joints, Va, E)).items()}

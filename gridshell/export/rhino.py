@@ -130,13 +130,13 @@ def export_3dm(bundle_dir, path: str | os.PathLike, *,
     Path
         ``path``.
     """
-    from ..render._bundle import load_bundle
+    from ..bundle import read_bundle
 
     path = Path(path)
     if path.suffix.lower() != ".3dm":
         raise InputError(f"{path.name}: a Rhino file needs the extension .3dm")
     if isinstance(bundle_dir, (str, os.PathLike)):
-        bundle, name = load_bundle(bundle_dir), Path(bundle_dir).resolve().name
+        bundle, name = read_bundle(bundle_dir), Path(bundle_dir).resolve().name
     else:
         bundle, name = bundle_dir, ""
     if progress is not None:

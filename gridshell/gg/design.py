@@ -238,9 +238,16 @@ class GGWeights:
         Boundary vertices glide on the initial boundary polylines, 0.1.
     fairness : float
         Second differences along meridians and parallels in the first round, 1e-4;
-        multiplied by ``fairness_decay`` every round.
+        multiplied by ``fairness_decay`` every round (smooths noise in the target).
     fairness_decay : float
         Factor of the fairness weight per round, 0.3.
+    elastic : float
+        Change of the second differences from their values at the start of each round, 3:
+        resists folding (without it the constraints fold the mesh over itself on targets far
+        from a GG surface - on a dome parallels pile up and meridians reverse while every
+        constraint holds) and leaves a GG mesh a fixed point.
+    elastic_decay : float
+        Factor of the elastic weight per round, 0.6.
     proximity : float
         Closeness to the positions at the start of each round, 1e-2: resists the tangential
         drift nothing else resists (and the fairness' pull along the surface).
@@ -258,6 +265,8 @@ class GGWeights:
     boundary: float = 0.1
     fairness: float = 1e-4
     fairness_decay: float = 0.3
+    elastic: float = 3.0
+    elastic_decay: float = 0.6
     proximity: float = 1e-2
     soften: float = 0.5
     polish_proximity: float = 1e-8
@@ -400,7 +409,7 @@ def _figures(P: np.ndarray) -> tuple[float, float]:
 
 
 def design_gg_surface(target_V: Any, target_F: Any, P0: Any, *,
-                      weights: GGWeights | Mapping[str, float] | None = None, outer: int = 6,
+                      weights: GGWeights | Mapping[str, float] | None = None, outer: int = 10,
                       max_iter: int = 4, polish_iter: int = 20, tol_geodesic: float = 1e-6,
                       tol_length: float = 1e-6, progress: Progress = None) -> GGDesign:
     """Optimize ``P0`` into a rotationally isometric geodesic-parallel mesh near a target
@@ -473,6 +482,7 @@ def design_gg_surface(target_V: Any, target_F: Any, P0: Any, *,
                 .add("closeness", w.closeness * s2, T.gliding, _surface_gliding(X, V, Ft))
                 .add("boundary", w.boundary * s2, T.gliding, _boundary_gliding(X, P0flat, sides))
                 .add("fairness", w.fairness * s2, T.linear, T.Linear("P", D))
+                .add("elastic", w.elastic * s2, T.linear, T.Linear("P", D, D @ X))
                 .add("proximity", w.proximity * s2, T.closeness, T.Closeness("P", X.copy())))
 
     prob = build(P0flat)
@@ -488,6 +498,7 @@ def design_gg_surface(target_V: Any, target_F: Any, P0: Any, *,
         wf = w.fairness * w.fairness_decay ** k
         soft = w.soften ** k
         prob.set_weight("fairness", wf * s2)
+        prob.set_weight("elastic", w.elastic * w.elastic_decay ** k * s2)
         for name, wk in (("closeness", w.closeness), ("boundary", w.boundary),
                          ("proximity", w.proximity)):
             prob.set_weight(name, wk * soft * s2)

@@ -161,7 +161,7 @@ def _from_triangles(V: np.ndarray, F: np.ndarray, grid: tuple[int, int] | None,
     return P
 
 
-def initial_grid(target: Any, F: Any = None, *, meridians: str = "rows",
+def initial_grid(target: Any, F: Any = None, *, meridians: str = "cols",
                  grid: tuple[int, int] | None = None, direction: Any = None) -> np.ndarray:
     """Initial GG grid ``P0 (R, C, 3)`` on a target surface.
 

@@ -201,7 +201,7 @@ def _load_target(target: Any) -> tuple[np.ndarray, np.ndarray, str | None]:
     raise InputError("the target must be a mesh file path, a QuadMesh/TriMesh or a (V, F) pair")
 
 
-def design_gg(target: Any, *, meridians: str = "rows", grid: tuple[int, int] | None = None,
+def design_gg(target: Any, *, meridians: str = "cols", grid: tuple[int, int] | None = None,
               direction: float | None = None, n_lamellae: int | None = 10,
               spacing: float | None = None, crossing_angle: float = 90.0,
               at_parallel: float = 0.5,
@@ -243,7 +243,10 @@ def design_gg(target: Any, *, meridians: str = "rows", grid: tuple[int, int] | N
     _say(progress, f"target: {len(V)} vertices, {len(F)} faces")
     P0 = initial_grid(V, F, meridians=meridians, grid=grid, direction=direction)
     _say(progress, f"initial grid {P0.shape[0]} x {P0.shape[1]}; designing the GG surface")
-    P, design_report = design_gg_surface(P0, (V, F), weights=weights, progress=progress)
+    design = design_gg_surface(V, F, P0, weights=weights, progress=progress)
+    P, design_report = design.P, dict(design.report, converged=design.converged,
+                                      history=design.history,
+                                      deviation=design.deviation)
     stage = gg_net_from_mesh(P, n_lamellae=n_lamellae, spacing=spacing,
                              crossing_angle=crossing_angle, at_parallel=at_parallel,
                              offsets=offsets, angle=angle, progress=progress)

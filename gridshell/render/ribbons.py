@@ -303,11 +303,11 @@ def render_bundle(bundle, path: str | os.PathLike | None = None, *,
     ``width`` is in metres (default a quarter of the median joint spacing); further keyword
     arguments go to :func:`render_ribbons`.
     """
-    from ._bundle import load_bundle
+    from ..bundle import read_bundle
 
     if isinstance(bundle, (str, os.PathLike)):
         directory = Path(bundle)
-        b = load_bundle(directory)
+        b = read_bundle(directory)
         path = directory / "render.png" if path is None else path
     else:
         b = bundle

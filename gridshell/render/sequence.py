@@ -44,7 +44,7 @@ def read_sequence(bundle_dir: str | os.PathLike) -> tuple[list[np.ndarray], np.n
     InputError
         No ``sequence/frame_*.obj`` in the bundle, or frames of different sizes.
     """
-    from ..quadmesh import _read_raw
+    from ..quadmesh import read_configuration
 
     files = sequence_files(bundle_dir)
     if not files:
@@ -52,7 +52,7 @@ def read_sequence(bundle_dir: str | os.PathLike) -> tuple[list[np.ndarray], np.n
                          "written by 'gridshell ncp'")
     frames, F = [], None
     for p in files:
-        V, P, sizes = _read_raw(p)
+        V, P, sizes = read_configuration(p)
         V = np.asarray(V, float).reshape(-1, 3)
         if F is None:
             if not len(P) or np.any(sizes != 4):

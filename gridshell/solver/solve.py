@@ -68,9 +68,14 @@ def _free_columns(n: int, fixed: np.ndarray | None) -> np.ndarray:
 
 
 def factorized(A: sp.csc_matrix) -> Callable[[np.ndarray], np.ndarray]:
-    """A solver for the symmetric positive definite ``A``; factors once (SuperLU, MMD ordering
-    of A^T+A, which measured fastest here: see benchmarks/solver.py)."""
-    lu = spla.splu(sp.csc_matrix(A), permc_spec="MMD_AT_PLUS_A",
+    """A solver for the symmetric positive definite ``A``; factors once.
+
+    SuperLU in symmetric mode: MMD ordering of ``A^T + A`` and diagonal pivots only
+    (``diag_pivot_thresh=0``, safe for the damped normal equations, which are SPD). With
+    SuperLU's default partial pivoting, off-diagonal pivots destroy the ordering and the fill
+    grows 10-20x on stiff problems; see benchmarks/solver.py for the measured choice.
+    """
+    lu = spla.splu(sp.csc_matrix(A), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
                    options={"SymmetricMode": True})
     return lu.solve
 
