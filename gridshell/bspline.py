@@ -110,6 +110,9 @@ def _local_basis(knots: np.ndarray, degree: int, t: np.ndarray,
     k = len(t)
     # Span s with knots[s] <= t < knots[s+1]; the right domain end falls in the last span.
     span = np.clip(np.searchsorted(knots, t, side="right") - 1, p, n_ctrl - 1)
+    # at the right end (and with an interior knot equal to it) use the last non-empty span
+    hi = knots[n_ctrl]
+    span = np.where(t >= hi, int(np.searchsorted(knots, hi, side="left")) - 1, span)
     first = span - p
     if deriv > p:
         return first, np.zeros((k, p + 1))

@@ -234,3 +234,20 @@ def test_sample_quad_mesh():
                                surf.evaluate_grid(np.linspace(0, 1, 5), np.linspace(0, 1, 4)))
     with pytest.raises(InputError):
         surf.sample(1, 4)
+
+
+@pytest.mark.parametrize("knots,degree", [([0, 0, 1, 1, 1], 1), ([0, 0, 0, 1, 1, 1, 1], 2),
+                                          ([0, 0, 0.5, 1, 1, 1], 1)])
+def test_basis_at_the_right_end_with_a_repeated_end_knot(knots, degree):
+    # an interior knot equal to the end knot leaves an empty last span; the right end must
+    # still be evaluated (partition of unity) as the limit from the left (scipy gives 0 there)
+    from scipy.interpolate import BSpline
+    t = np.linspace(knots[degree], knots[len(knots) - degree - 1], 7)
+    B = basis_matrix(np.asarray(knots, float), degree, t).toarray()
+    np.testing.assert_allclose(B.sum(axis=1), 1.0, atol=1e-14)
+    n = len(knots) - degree - 1
+    for i in range(n):
+        c = np.zeros(n)
+        c[i] = 1.0
+        ref = BSpline(np.asarray(knots, float), c, degree)(np.minimum(t, t[-1] - 1e-13))
+        np.testing.assert_allclose(B[:, i], ref, atol=1e-11)

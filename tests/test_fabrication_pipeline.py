@@ -16,9 +16,22 @@ MM = 100.0      # mm per design metre at 1:10
 R_DESIGN = 1.0  # CNC collapse radius, m
 
 
+_MADE: dict = {}
+
+
+def _made(kind, tmp_path_factory):
+    """Bundle of ``kind`` fabricated once per test session."""
+    if kind not in _MADE:
+        _MADE[kind] = _fabricate(kind, tmp_path_factory)
+    return _MADE[kind]
+
+
 @pytest.fixture(scope="module", params=["GG", "CNC", "NCP"])
 def made(request, tmp_path_factory):
-    kind = request.param
+    return _made(request.param, tmp_path_factory)
+
+
+def _fabricate(kind, tmp_path_factory):
     shape = dict(nr=4, nc=4) if kind == "NCP" else dict(nr=4, nc=5)
     b = make_bundle(kind, R=R_DESIGN, **shape)
     out = tmp_path_factory.mktemp(kind) / "fab"
@@ -126,10 +139,8 @@ def test_dxf_header_layers_and_order(made):
         assert not any(e.dxftype() in ("TEXT", "MTEXT") for e in doc.modelspace())
 
 
-def test_cnc_arcs_have_radius_one_over_n(made):
-    kind, b, out, rep, sheets = made
-    if kind != "CNC":
-        pytest.skip("CNC only")
+def test_cnc_arcs_have_radius_one_over_n(tmp_path_factory):
+    kind, b, out, rep, sheets = _made("CNC", tmp_path_factory)
     R = R_DESIGN * MM
     for _, parts in sheets:
         for p in parts:
@@ -147,10 +158,8 @@ def test_cnc_arcs_have_radius_one_over_n(made):
             assert r_holes == pytest.approx(R, rel=1e-3)
 
 
-def test_ncp_strips_are_congruent(made):
-    kind, b, out, rep, sheets = made
-    if kind != "NCP":
-        pytest.skip("NCP only")
+def test_ncp_strips_are_congruent(tmp_path_factory):
+    kind, b, out, rep, sheets = _made("NCP", tmp_path_factory)
     parts = [p for _, ps in sheets for p in ps]
     ref = parts[0]
     for p in parts[1:]:
