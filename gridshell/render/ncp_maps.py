@@ -112,10 +112,13 @@ def collapse_plot(points: np.ndarray, normals: np.ndarray, joints: np.ndarray | 
     if joints is not None:
         J = np.asarray(joints, float)
         ax.plot(J[:, 0], J[:, 1], "o", ms=3, color="tab:red", label="aligned joints")
-    ax.set_aspect("equal")
-    ax.legend(fontsize=7, loc="best")
+    # a nearly straight curve would make a sliver of a plot: widen the y range instead
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel("m", fontsize=8)
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=3, frameon=False)
     if title:
         ax.set_title(title, fontsize=9)
+    fig.tight_layout()
     return _png(fig)
 
 
