@@ -19,7 +19,8 @@ import numpy as np
 from gridshell.bspline import BSplineSurface, fit_grid
 from gridshell.metrics import alignability_error, delta_l, delta_n
 from gridshell.ncp.collapse import collapse_curve
-from gridshell.ncp.directions import net_directions, uniform_params
+from gridshell.bspline import uniform_params
+from gridshell.ncp.directions import net_directions
 from gridshell.ncp.levelset import trace
 from gridshell.ncp.pipeline import design_ncp, write_ncp
 from gridshell.ncp.postopt import post_optimize

@@ -74,13 +74,7 @@ class Path:
 
 def arc_points(p0: np.ndarray, p1: np.ndarray, b: float, tol: float) -> np.ndarray:
     """Points ``(k,2)`` from ``p0`` to ``p1`` (both included) on the arc of bulge ``b``."""
-    theta = 4.0 * np.arctan(b)
-    chord = p1 - p0
-    c = np.linalg.norm(chord)
-    r = c / (2.0 * np.sin(theta / 2.0))
-    u = chord / c
-    centre = 0.5 * (p0 + p1) + np.array([-u[1], u[0]]) * r * np.cos(theta / 2.0)
-    rr = abs(r)
+    centre, rr, theta = arc_geometry(p0, p1, b)
     step = 2.0 * np.arccos(max(-1.0, 1.0 - tol / rr)) if tol < rr else np.pi / 4
     k = max(int(np.ceil(abs(theta) / step)), 1)
     a0 = np.arctan2(*(p0 - centre)[::-1])

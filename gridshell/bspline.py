@@ -45,6 +45,7 @@ __all__ = [
     "fit_grid",
     "fit_points",
     "open_uniform_knots",
+    "uniform_params",
 ]
 
 
@@ -621,3 +622,15 @@ def fit_points(P: np.ndarray, u: np.ndarray, v: np.ndarray, n_ctrl_u: int = 9,
     _fit_checks(n_ctrl_u, n_ctrl_v, degree_u, degree_v, smoothing)
     surf = BSplineSurface.from_control_grid(np.zeros((n_ctrl_u, n_ctrl_v, 3)), degree_u, degree_v)
     return _solve_fit(surf, surf.operator(u, v), P, smoothing)
+
+
+def uniform_params(surf: BSplineSurface, samples: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
+    """Uniform sample parameters ``u (a,)``, ``v (b,)`` over the surface domain, ends included."""
+    try:
+        a, b = (int(s) for s in samples)
+    except (TypeError, ValueError):
+        raise InputError(f"samples must be a pair of integers, got {samples!r}") from None
+    if a < 2 or b < 2:
+        raise InputError(f"sampling needs at least 2 x 2 samples, got {a} x {b}")
+    (u0, u1), (v0, v1) = surf.domain
+    return np.linspace(u0, u1, a), np.linspace(v0, v1, b)

@@ -5,7 +5,8 @@ import pytest
 from gridshell.errors import InputError
 from gridshell.metrics import alignability_error
 from gridshell.ncp import levelset as LS
-from gridshell.ncp.directions import net_directions, uniform_params
+from gridshell.bspline import uniform_params
+from gridshell.ncp.directions import net_directions
 
 from ncp_cases import pseudosphere, torus
 

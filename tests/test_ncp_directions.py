@@ -3,8 +3,8 @@ import numpy as np
 import pytest
 
 from gridshell.errors import InputError, NoNetError
-from gridshell.ncp.directions import (net_angle, net_directions, row_normal_curvature,
-                                      uniform_params)
+from gridshell.bspline import uniform_params
+from gridshell.ncp.directions import net_angle, net_directions, row_normal_curvature
 
 from ncp_cases import pseudosphere, torus
 

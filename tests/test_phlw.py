@@ -13,7 +13,7 @@ benchmarks/phlw.py runs the paper's 9 x 9 / 18 x 18.
 import numpy as np
 import pytest
 
-from gridshell.bspline import BSplineSurface, fit_grid
+from gridshell.bspline import BSplineSurface, fit_grid, uniform_params
 from gridshell.errors import InputError
 from gridshell.grid import grid_quads
 from gridshell.ncp import phlw as P
@@ -71,7 +71,7 @@ def test_fit_rows_reports_secant_rows():
 
 def test_auxiliaries_satisfy_every_constraint_exactly():
     surf, _ = fitted(saddle())
-    u, v = P.sample_params(surf, (6, 5))
+    u, v = uniform_params(surf, (6, 5))
     data = P.make_samples(surf, u, v, "phlw")
     lay = P.make_layout(surf.n_ctrl, 30, 6, "phlw")
     aux = P.init_auxiliary(surf.ctrl.reshape(-1, 3), data)

@@ -8,7 +8,8 @@ from gridshell.metrics import alignability_error, delta_l, delta_n
 from gridshell.ncp import levelset as LS
 from gridshell.ncp import postopt as PO
 from gridshell.ncp.collapse import collapse_curve
-from gridshell.ncp.directions import net_directions, uniform_params
+from gridshell.bspline import uniform_params
+from gridshell.ncp.directions import net_directions
 from gridshell.ncp.simulate import collapse_direction, embed_aligned, simulate_alignment
 from gridshell.solver import Layout
 

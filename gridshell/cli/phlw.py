@@ -55,7 +55,8 @@ def _load_reference(path: str, args: Any) -> tuple[Any, Any, Any]:
 
 
 def run(args: Any) -> int:
-    from ..ncp.phlw import optimize_phlw, row_relation_residual, sample_params, write_phlw
+    from ..bspline import uniform_params
+    from ..ncp.phlw import optimize_phlw, row_relation_residual, write_phlw
     from .common import Progress, print_summary
 
     progress = Progress(args)
@@ -72,7 +73,7 @@ def run(args: Any) -> int:
                         check_samples=tuple(args.check_samples), progress=progress.callback)
     for line in res.diagnostics:
         progress(f"note: {line}")
-    u, v = sample_params(res.surface, tuple(args.check_samples))
+    u, v = uniform_params(res.surface, tuple(args.check_samples))
     dense = row_relation_residual(res.surface, u, v, mode=args.mode)
     progress(f"writing {args.output}")
     files = write_phlw(args.output, res, sample_grid=tuple(args.check_samples))

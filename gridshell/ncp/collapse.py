@@ -27,7 +27,8 @@ import numpy as np
 
 from ..bspline import BSplineSurface
 from ..errors import InputError, NoNetError
-from .directions import grid_curvature, net_angle, row_normal_curvature, uniform_params
+from ..bspline import uniform_params
+from .directions import grid_curvature, net_angle, row_normal_curvature
 
 __all__ = ["CollapseResult", "collapse_chords", "integrate_collapse", "collapse_curve",
            "fit_circle", "line_deviation", "closest_on_polyline"]

@@ -22,26 +22,18 @@ from typing import Literal
 
 import numpy as np
 
-from ..bspline import BSplineSurface
+from ..bspline import BSplineSurface, uniform_params
 from ..diffgeo import curvatures, fundamental_forms
 from ..errors import InputError, NoNetError
 
 Mode = Literal["phlw", "cnc", "aa"]
 
 __all__ = ["NetDirections", "grid_curvature", "row_normal_curvature", "net_angle",
-           "net_directions", "uniform_params"]
+           "net_directions"]
 
 #: samples per direction for a global fit of the constant normal curvature (mode "cnc")
 CNC_FIT_SAMPLES = 64
 
-
-def uniform_params(surf: BSplineSurface, samples: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
-    """Uniform ``(u (a,), v (b,))`` over the surface domain, ends included."""
-    a, b = (int(s) for s in samples)
-    if a < 2 or b < 2:
-        raise InputError(f"sampling needs at least 2 x 2 samples, got {a} x {b}")
-    (u0, u1), (v0, v1) = surf.domain
-    return np.linspace(u0, u1, a), np.linspace(v0, v1, b)
 
 
 def grid_curvature(surf: BSplineSurface, u: np.ndarray, v: np.ndarray,

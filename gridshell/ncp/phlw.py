@@ -41,7 +41,7 @@ from typing import Any, Callable, Literal, NamedTuple
 import numpy as np
 import scipy.sparse as sp
 
-from ..bspline import BSplineSurface
+from ..bspline import BSplineSurface, uniform_params
 from ..diffgeo import curvatures, fundamental_forms, principal_directions
 from ..errors import InputError
 from ..solver import Layout, Problem, TermResult, result, solve, term
@@ -87,14 +87,6 @@ class Samples(NamedTuple):
     row: np.ndarray
     n_index: np.ndarray | None
 
-
-def sample_params(surf: BSplineSurface, samples: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
-    """Uniform sample parameters ``u (rows,)``, ``v (cols,)`` over the domain (endpoints included)."""
-    rows, cols = (int(s) for s in samples)
-    if rows < 2 or cols < 2:
-        raise InputError(f"samples must be at least 2 x 2, got {rows} x {cols}")
-    (u0, u1), (v0, v1) = surf.domain
-    return np.linspace(u0, u1, rows), np.linspace(v0, v1, cols)
 
 
 def make_samples(surf: BSplineSurface, u: np.ndarray, v: np.ndarray,
@@ -513,7 +505,7 @@ def phlw_energy(surf: BSplineSurface, n_rows: np.ndarray | None, t_rows: np.ndar
     dict : ``total``, ``principal`` (the ``F, M`` part), ``target`` (``omega_t * sum chi_t^2``),
         ``target_rms`` (RMS of ``chi_t`` in 1/m^2 of the scaled geometry).
     """
-    u, v = sample_params(surf, samples)
+    u, v = uniform_params(surf, samples)
     g = _grid_geometry(surf, u, v)
     if scale is None:
         S = g["S"].reshape(-1, 3)
@@ -596,7 +588,7 @@ def net_direction_check(surf: BSplineSurface, n_rows: np.ndarray | None,
         if samples is None:
             m = 18 if n_rows is None or np.size(n_rows) == 1 else int(np.size(n_rows))
             samples = (m, m)
-        u_samples, v_samples = sample_params(surf, samples)
+        u_samples, v_samples = uniform_params(surf, samples)
     u = np.asarray(u_samples, float)
     v = np.asarray(v_samples, float)
     if n_rows is None:
@@ -605,7 +597,7 @@ def net_direction_check(surf: BSplineSurface, n_rows: np.ndarray | None,
         n = np.full(len(u), float(np.ravel(n_rows)[0]))
     else:
         nr = np.asarray(n_rows, float).ravel()
-        ur = sample_params(surf, (len(nr), 2))[0] if u_rows is None else np.asarray(u_rows, float)
+        ur = uniform_params(surf, (len(nr), 2))[0] if u_rows is None else np.asarray(u_rows, float)
         n = np.interp(u, ur, nr)
     g = _grid_geometry(surf, u, v)
     kI, kII = g["kI"], g["kII"]
@@ -693,7 +685,7 @@ def deviation_percent(surf: BSplineSurface, V: np.ndarray, F: np.ndarray,
     mesh's bounding-box diagonal."""
     from ..igl_adapter import closest_points
 
-    u, v = sample_params(surf, samples)
+    u, v = uniform_params(surf, samples)
     P = surf.evaluate_grid(u, v).reshape(-1, 3)
     d2, _, _ = closest_points(P, V, F)
     diag = float(np.linalg.norm(V.max(0) - V.min(0)))
@@ -756,7 +748,7 @@ def optimize_phlw(surf: BSplineSurface, reference: Any, *, mode: Mode = "phlw",
         raise InputError("the reference mesh has zero extent; pass a real surface")
     Vs = (V - center) / diag
     s0 = _scaled_surface(surf, center, diag)
-    u, v = sample_params(s0, samples)
+    u, v = uniform_params(s0, samples)
     R = len(u)
     data = make_samples(s0, u, v, mode)
     lay = make_layout(s0.n_ctrl, R * len(v), R, mode)

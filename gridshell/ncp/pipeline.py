@@ -22,7 +22,8 @@ from ..errors import InputError
 from ..metrics import alignability_error, delta_l, delta_n, deviation, summary
 from .collapse import (CollapseResult, closest_on_polyline, collapse_curve, fit_circle,
                        line_deviation)
-from .directions import net_directions, uniform_params
+from ..bspline import uniform_params
+from .directions import net_directions
 from .levelset import TracedNet, trace
 from .postopt import PostOptResult, interior_vertices, post_optimize
 from .simulate import AlignmentSequence, collapse_direction, plane_frame, simulate_alignment

@@ -13,35 +13,11 @@ from typing import Sequence
 import numpy as np
 
 from ..errors import InputError
+from .figure import cube_limits, png_bytes, pyplot
 
 __all__ = ["edge_map", "vertex_map", "collapse_plot", "sequence_frames", "gif"]
 
 
-def _plt():
-    import matplotlib
-
-    matplotlib.use("Agg", force=False)
-    import matplotlib.pyplot as plt
-
-    return matplotlib, plt
-
-
-def _limits(ax, P: np.ndarray) -> None:
-    lo, hi = P.min(axis=0), P.max(axis=0)
-    c, h = 0.5 * (lo + hi), 0.5 * float(np.max(hi - lo)) or 1.0
-    ax.set_xlim(c[0] - h, c[0] + h)
-    ax.set_ylim(c[1] - h, c[1] + h)
-    ax.set_zlim(c[2] - h, c[2] + h)
-    ax.set_box_aspect((1, 1, 1))
-    ax.set_axis_off()
-
-
-def _png(fig) -> bytes:
-    _, plt = _plt()
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", bbox_inches="tight")
-    plt.close(fig)
-    return buf.getvalue()
 
 
 def edge_map(V: np.ndarray, edges: np.ndarray, values: np.ndarray, *, title: str = "",
@@ -49,7 +25,9 @@ def edge_map(V: np.ndarray, edges: np.ndarray, values: np.ndarray, *, title: str
     """PNG of the edges ``(E, 2)`` of joints ``V (n, 3)`` coloured by ``values (E,)``."""
     from mpl_toolkits.mplot3d.art3d import Line3DCollection
 
-    matplotlib, plt = _plt()
+    import matplotlib
+
+    plt = pyplot()
     V = np.asarray(V, float)
     E = np.asarray(edges, np.int64).reshape(-1, 2)
     vals = np.asarray(values, float).reshape(-1)
@@ -65,10 +43,10 @@ def edge_map(V: np.ndarray, edges: np.ndarray, values: np.ndarray, *, title: str
                                          linewidths=2.0))
     fig.colorbar(matplotlib.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax, shrink=0.6,
                  label=label)
-    _limits(ax, V)
+    cube_limits(ax, V)
     if title:
         ax.set_title(title, fontsize=9)
-    return _png(fig)
+    return png_bytes(fig)
 
 
 def vertex_map(V: np.ndarray, edges: np.ndarray, values: np.ndarray, *, title: str = "",
@@ -76,7 +54,7 @@ def vertex_map(V: np.ndarray, edges: np.ndarray, values: np.ndarray, *, title: s
     """PNG of joints ``V (n, 3)`` coloured by ``values (n,)`` over grey edges ``(E, 2)``."""
     from mpl_toolkits.mplot3d.art3d import Line3DCollection
 
-    matplotlib, plt = _plt()
+    plt = pyplot()
     V = np.asarray(V, float)
     E = np.asarray(edges, np.int64).reshape(-1, 2)
     vals = np.asarray(values, float).reshape(-1)
@@ -90,17 +68,17 @@ def vertex_map(V: np.ndarray, edges: np.ndarray, values: np.ndarray, *, title: s
     sc = ax.scatter(V[:, 0], V[:, 1], V[:, 2], c=np.nan_to_num(vals), cmap="viridis", vmin=0,
                     vmax=vmax, s=14, depthshade=False)
     fig.colorbar(sc, ax=ax, shrink=0.6, label=label)
-    _limits(ax, V)
+    cube_limits(ax, V)
     if title:
         ax.set_title(title, fontsize=9)
-    return _png(fig)
+    return png_bytes(fig)
 
 
 def collapse_plot(points: np.ndarray, normals: np.ndarray, joints: np.ndarray | None = None, *,
                   title: str = "", dpi: int = 110, arrows: int = 24) -> bytes:
     """PNG of the collapse polyline ``points (k, 2)`` with some flattened normals and the
     aligned joints ``(n, 2)`` (Fig. 15)."""
-    _, plt = _plt()
+    plt = pyplot()
     P = np.asarray(points, float)
     N = np.asarray(normals, float)
     fig, ax = plt.subplots(figsize=(6.4, 4.0), dpi=dpi)
@@ -119,7 +97,7 @@ def collapse_plot(points: np.ndarray, normals: np.ndarray, joints: np.ndarray | 
     if title:
         ax.set_title(title, fontsize=9)
     fig.tight_layout()
-    return _png(fig)
+    return png_bytes(fig)
 
 
 def sequence_frames(frames: Sequence[np.ndarray], edges: np.ndarray, *, title: str = "",
@@ -127,7 +105,7 @@ def sequence_frames(frames: Sequence[np.ndarray], edges: np.ndarray, *, title: s
     """PNG bytes of every state ``(n, 3)`` of the alignment sequence, same axes for all."""
     from mpl_toolkits.mplot3d.art3d import Line3DCollection
 
-    _, plt = _plt()
+    plt = pyplot()
     E = np.asarray(edges, np.int64).reshape(-1, 2)
     allP = np.concatenate([np.asarray(f, float) for f in frames])
     out = []
@@ -137,10 +115,10 @@ def sequence_frames(frames: Sequence[np.ndarray], edges: np.ndarray, *, title: s
         ax = fig.add_subplot(projection="3d")
         ax.add_collection3d(Line3DCollection(V[E], colors=(0.1, 0.2, 0.5, 0.9), linewidths=1.0))
         ax.scatter(V[:, 0], V[:, 1], V[:, 2], s=3, color="tab:red", depthshade=False)
-        _limits(ax, allP)
+        cube_limits(ax, allP)
         ax.view_init(elev=elev, azim=azim)
         ax.set_title(f"{title} frame {k}/{len(frames) - 1}".strip(), fontsize=9)
-        out.append(_png(fig))
+        out.append(png_bytes(fig))
     return out
 
 

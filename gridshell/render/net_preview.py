@@ -47,10 +47,11 @@ def net_preview(path: str | Path, V: np.ndarray, F: np.ndarray, joints: np.ndarr
         ``path``.
     """
     import matplotlib
-
-    matplotlib.use("Agg", force=False)
-    import matplotlib.pyplot as plt
     from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
+
+    from .figure import cube_limits, pyplot
+
+    plt = pyplot()
 
     V = np.asarray(V, float)
     F = np.asarray(F, np.int64)
@@ -83,13 +84,7 @@ def net_preview(path: str | Path, V: np.ndarray, F: np.ndarray, joints: np.ndarr
         ax.add_collection3d(Line3DCollection(np.concatenate(segs), colors=(0.1, 0.1, 0.1, 0.8),
                                              linewidths=0.6))
     pts = np.concatenate([V, J]) if len(J) else V
-    lo, hi = pts.min(axis=0), pts.max(axis=0)
-    c, h = 0.5 * (lo + hi), 0.5 * float(np.max(hi - lo)) or 1.0
-    ax.set_xlim(c[0] - h, c[0] + h)
-    ax.set_ylim(c[1] - h, c[1] + h)
-    ax.set_zlim(c[2] - h, c[2] + h)
-    ax.set_box_aspect((1, 1, 1))
-    ax.set_axis_off()
+    cube_limits(ax, pts)
     if title:
         ax.set_title(title, fontsize=9)
     path = Path(path)

@@ -5,7 +5,7 @@ and random auxiliary variables near their consistent values, so every product te
 """
 import numpy as np
 
-from gridshell.bspline import BSplineSurface
+from gridshell.bspline import BSplineSurface, uniform_params
 from gridshell.ncp import phlw as P
 
 
@@ -13,7 +13,7 @@ def _setup(rng, mode="phlw"):
     u0, v0 = np.meshgrid(np.linspace(0, 1, 5), np.linspace(0, 1, 4), indexing="ij")
     ctrl = np.stack([u0, v0, 0.3 * (u0 ** 2 - v0 ** 2)], axis=-1) + 0.05 * rng.normal(size=(5, 4, 3))
     surf = BSplineSurface.from_control_grid(ctrl, 3, 3)
-    u, v = P.sample_params(surf, (3, 4))
+    u, v = uniform_params(surf, (3, 4))
     data = P.make_samples(surf, u, v, mode)
     lay = P.make_layout(surf.n_ctrl, 12, 3, mode)
     aux = P.init_auxiliary(surf.ctrl.reshape(-1, 3), data)
