@@ -13,7 +13,8 @@ import numpy as np
 from .errors import InputError
 from .net import Net
 
-__all__ = ["alignability_error", "alignability_error_arc", "delta_l", "delta_n", "deviation",
+__all__ = ["alignability_error", "alignability_error_arc", "crossing_normal_curvature",
+           "crossing_normal_curvature_on_mesh", "delta_l", "delta_n", "deviation",
            "geodesic_turning", "loop_side_lengths", "summary"]
 
 
@@ -267,6 +268,76 @@ def geodesic_turning(net_or_axes: Net | Sequence[np.ndarray], V: np.ndarray,
             kg_max = max(kg_max, float(np.abs(kg_i[ok]).max()))
     ratio = kg_int / kappa_int if kappa_int > 0 else 0.0
     return {"ratio": ratio, "kg_integral": kg_int, "kappa_integral": kappa_int, "kg_max": kg_max}
+
+
+def crossing_normal_curvature(net: Net, axis_normals: Sequence[np.ndarray],
+                              joint_index: Sequence[np.ndarray],
+                              scale: np.ndarray) -> dict[str, Any]:
+    """Normal curvature of the two lamella axes crossing at each interior joint (NCP, 3.4).
+
+    ``kn`` from :func:`gridshell.diffgeo.normal_geodesic_curvature` on each dense axis with
+    the surface normals at its points; the relative difference at a joint is
+    ``|kn_1 - kn_3| / max(|kn_1|, |kn_3|, scale)`` with ``scale`` the radius of Euler's circle
+    ``|kappa_II - kappa_I| / 2`` there (keeps it meaningful where ``kn = 0``, AA).
+
+    Parameters
+    ----------
+    net : Net
+        Joints and lamellae with their dense axes (metres).
+    axis_normals : list of (k_i, 3) float
+        Surface normals at the axis points, one array per lamella.
+    joint_index : list of (j_i,) int
+        Index of each of the lamella's joints among its axis points.
+    scale : (n_joints,) float
+        ``|kappa_II - kappa_I| / 2`` at every joint, 1/m.
+
+    Returns
+    -------
+    dict
+        ``rel (m,)`` (fraction), ``joints (m,)``, ``kn1, kn3 (m,)`` 1/m, ``mean``, ``max``.
+    """
+    from .diffgeo import normal_geodesic_curvature
+
+    kn_at: dict[int, dict[int, float]] = {}
+    for lam, N, jidx in zip(net.lamellae, axis_normals, joint_index):
+        if len(lam.axis) < 3:
+            continue
+        kn, _ = normal_geodesic_curvature(lam.axis, N)
+        for jj, vi in zip(np.asarray(lam.joints).tolist(), np.asarray(jidx).tolist()):
+            if 0 < vi < len(lam.axis) - 1:
+                kn_at.setdefault(jj, {})[lam.family] = float(kn[vi])
+    joints = np.array(sorted(j for j, d in kn_at.items() if len(d) == 2), np.int64)
+    if len(joints) == 0:
+        return {"rel": np.zeros(0), "joints": joints, "kn1": np.zeros(0), "kn3": np.zeros(0),
+                "mean": float("nan"), "max": float("nan")}
+    k1 = np.array([kn_at[j][1] for j in joints])
+    k3 = np.array([kn_at[j][3] for j in joints])
+    sc = np.asarray(scale, float)[joints]
+    rel = np.abs(k1 - k3) / np.maximum.reduce([np.abs(k1), np.abs(k3), np.nan_to_num(sc)])
+    return {"rel": rel, "joints": joints, "kn1": k1, "kn3": k3, "mean": float(rel.mean()),
+            "max": float(rel.max())}
+
+
+def crossing_normal_curvature_on_mesh(net: Net, V: np.ndarray, F: np.ndarray) -> dict[str, Any]:
+    """:func:`crossing_normal_curvature` with normals and principal curvatures of a surface
+    mesh ``(V, F)`` (e.g. a bundle's ``surface.obj``): what ``gridshell verify`` measures on
+    ``axes.obj``; joints are located on their axes by arc length (``joint_s``)."""
+    from .igl_adapter import closest_points, closest_points_with_normals, principal_curvature
+    from .net import polyline_arclength
+
+    axes = [np.asarray(lam.axis, float) for lam in net.lamellae]
+    _, N = closest_points_with_normals(np.concatenate(axes), V, F)
+    normals = np.split(N, np.cumsum([len(a) for a in axes])[:-1])
+    jidx = []
+    for lam, a in zip(net.lamellae, axes):
+        s = polyline_arclength(a)
+        jidx.append(np.abs(s[None, :] - np.asarray(lam.joint_s, float)[:, None]).argmin(axis=1))
+    _, _, k1, k2 = principal_curvature(V, F, radius=2)
+    _, face, C = closest_points(net.joints, V, F)
+    tri = np.asarray(F, np.int64)[face]
+    nearest = tri[np.arange(len(tri)), np.linalg.norm(V[tri] - C[:, None], axis=2).argmin(1)]
+    scale = np.abs(k2[nearest] - k1[nearest]) / 2
+    return crossing_normal_curvature(net, normals, jidx, scale)
 
 
 def summary(values: np.ndarray) -> dict[str, float]:

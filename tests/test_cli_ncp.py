@@ -29,6 +29,8 @@ def test_cli_from_a_bspline_json_then_verify(tmp_path, capsys):
     v = json.loads(capsys.readouterr().out)
     assert v["ok"] and v["kind"] == "AA" and v["delta_l"]["max"] < 1
     assert v["stored"]["aligned_line_error"] < 0.5
+    # measured on axes.obj with the normals of surface.obj: the crossing lamellae agree
+    assert v["crossing_kn"]["joints"] > 10 and v["crossing_kn"]["max"] < 5
 
 
 def test_cli_from_a_mesh_runs_the_phlw_step(tmp_path, capsys):

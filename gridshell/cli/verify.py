@@ -22,7 +22,8 @@ def verify_bundle(path: str | Path) -> dict[str, Any]:
     surface.obj (and aligned.obj, axes_r.npy, aligned_r.npy when present)."""
     from ..bundle import read_design_json
     from ..errors import InputError, MeshError
-    from ..metrics import (alignability_error, alignability_error_arc, delta_l, delta_n,
+    from ..metrics import (alignability_error, alignability_error_arc,
+                           crossing_normal_curvature_on_mesh, delta_l, delta_n,
                            deviation, geodesic_turning, summary)
     from ..net import Lamella, Net
     from ..quadmesh import read_configuration, read_mesh, read_polylines
@@ -51,6 +52,10 @@ def verify_bundle(path: str | Path) -> dict[str, Any]:
     }
     if d["kind"] == "GG":
         out["geodesic_turning"] = 100 * geodesic_turning(net, surf.V, surf.F)["ratio"]
+    else:  # orthogonal lamellae: equal normal curvature of the two axes at every joint
+        ck = crossing_normal_curvature_on_mesh(net, surf.V, surf.F)
+        out["crossing_kn"] = {"mean": 100 * ck["mean"], "max": 100 * ck["max"],
+                              "joints": int(len(ck["joints"]))}
     target = (d.get("params") or {}).get("target")
     if target:
         try:

@@ -89,41 +89,17 @@ def load_surface(source: Any, *, mode: str, phlw_options: dict | None = None,
 
 
 def crossing_normal_curvature(surf: BSplineSurface, traced: TracedNet) -> dict[str, Any]:
-    """Normal curvature of the two lamella axes crossing at each interior joint.
+    """:func:`gridshell.metrics.crossing_normal_curvature` on the traced axes with the B-spline
+    normals at their parameters and Euler's-circle radius at the joints (1/m, fractions)."""
+    from ..diffgeo import surface_curvature
+    from ..metrics import crossing_normal_curvature as crossing
 
-    ``kn`` from :func:`gridshell.diffgeo.normal_geodesic_curvature` on the dense axes with the
-    B-spline normals at their traced parameters; the relative difference at a joint is
-    ``|kn_1 - kn_3| / max(|kn_1|, |kn_3|, |kappa_II - kappa_I| / 2)`` (the last term, the radius
-    of Euler's circle, keeps it meaningful where ``n = 0``, AA).
-
-    Returns
-    -------
-    dict : ``rel (m,)``, ``joints (m,)``, ``kn1, kn3 (m,)`` 1/m, ``mean``, ``max``
-    """
-    from ..diffgeo import normal_geodesic_curvature, surface_curvature
-
-    kn_at: dict[int, dict[int, float]] = {}
-    for lam, uv, jidx in zip(traced.net.lamellae, traced.axis_uv, traced.axis_joint_index):
-        if len(lam.axis) < 3:
-            continue
-        N = np.cross(surf.evaluate(uv[:, 0], uv[:, 1], 1, 0),
-                     surf.evaluate(uv[:, 0], uv[:, 1], 0, 1))
-        kn, _ = normal_geodesic_curvature(lam.axis, N)
-        for jj, vi in zip(lam.joints.tolist(), jidx.tolist()):
-            if 0 < vi < len(lam.axis) - 1:
-                kn_at.setdefault(jj, {})[lam.family] = float(kn[vi])
-    joints = np.array(sorted(j for j, d in kn_at.items() if len(d) == 2), np.int64)
-    if len(joints) == 0:
-        return {"rel": np.zeros(0), "joints": joints, "kn1": np.zeros(0), "kn3": np.zeros(0),
-                "mean": float("nan"), "max": float("nan")}
-    k1 = np.array([kn_at[j][1] for j in joints])
-    k3 = np.array([kn_at[j][3] for j in joints])
-    uv = traced.joint_uv[joints]
+    normals = [np.cross(surf.evaluate(uv[:, 0], uv[:, 1], 1, 0),
+                        surf.evaluate(uv[:, 0], uv[:, 1], 0, 1)) for uv in traced.axis_uv]
+    uv = traced.joint_uv
     g = surface_curvature(surf, uv[:, 0], uv[:, 1])
-    scale = np.abs(g["kII"] - g["kI"]) / 2
-    rel = np.abs(k1 - k3) / np.maximum.reduce([np.abs(k1), np.abs(k3), scale])
-    return {"rel": rel, "joints": joints, "kn1": k1, "kn3": k3, "mean": float(rel.mean()),
-            "max": float(rel.max())}
+    return crossing(traced.net, normals, traced.axis_joint_index,
+                    np.abs(g["kII"] - g["kI"]) / 2)
 
 
 def _collapse_s(traced: TracedNet, collapse: CollapseResult,
