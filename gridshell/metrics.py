@@ -313,7 +313,9 @@ def crossing_normal_curvature(net: Net, axis_normals: Sequence[np.ndarray],
     k1 = np.array([kn_at[j][1] for j in joints])
     k3 = np.array([kn_at[j][3] for j in joints])
     sc = np.asarray(scale, float)[joints]
-    rel = np.abs(k1 - k3) / np.maximum.reduce([np.abs(k1), np.abs(k3), np.nan_to_num(sc)])
+    den = np.maximum.reduce([np.abs(k1), np.abs(k3), np.nan_to_num(sc)])
+    # a flat spot (all zero) has equal normal curvatures: difference 0
+    rel = np.divide(np.abs(k1 - k3), den, out=np.zeros_like(den), where=den > 0)
     return {"rel": rel, "joints": joints, "kn1": k1, "kn3": k3, "mean": float(rel.mean()),
             "max": float(rel.max())}
 

@@ -85,3 +85,20 @@ def test_verify_ncp_bundle_with_and_without_rotation_axes(tmp_path, capsys):
     assert main(["verify", str(tmp_path / "ncp2")]) == 0
     assert json.loads(capsys.readouterr().out)["delta_n"] is None
     assert main(["verify", str(tmp_path / "nothing")]) == 2
+
+
+def test_unconverged_design_is_an_error_unless_allowed(tmp_path, capsys):
+    # a dome: far from any GG surface, one round and no projection cannot meet 1e-6
+    x, y = np.meshgrid(np.linspace(-1, 1, 9), np.linspace(-0.8, 0.8, 7), indexing="ij")
+    V = np.stack([x.ravel(), y.ravel(), -(x.ravel() ** 2 / 2.0 + y.ravel() ** 2 / 1.2)], 1)
+    target = tmp_path / "dome.obj"
+    write_mesh(target, V, grid_quads(9, 7))
+    out = tmp_path / "design"
+    args = ["gg", str(target), "-o", str(out), "--rounds", "1", "--polish", "0", "-q"]
+    assert main(args) == 4
+    err = capsys.readouterr().err
+    assert "did not converge" in err and "Traceback" not in err
+    assert not out.exists() and not list(tmp_path.glob(".design*"))
+    assert main([*args, "--allow-unconverged", "--no-preview"]) == 0
+    assert "did NOT converge" in capsys.readouterr().out
+    assert (out / "design.json").is_file()

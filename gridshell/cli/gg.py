@@ -29,6 +29,13 @@ def add_args(p: argparse.ArgumentParser) -> None:
                         "degrees (default 90)")
     p.add_argument("--at", type=float, default=0.5, metavar="FRAC",
                    help="reference parallel as a fraction of the meridian length (default 0.5)")
+    p.add_argument("--rounds", type=int, default=10, metavar="N",
+                   help="outer rounds of the surface optimization (default 10)")
+    p.add_argument("--polish", type=int, default=20, metavar="N",
+                   help="iterations of the final projection onto the constraints (default 20)")
+    p.add_argument("--allow-unconverged", action="store_true",
+                   help="write the design even if the surface optimization misses its "
+                        "tolerances (default: exit code 4, nothing written)")
     p.add_argument("--no-preview", action="store_true", help="do not render preview.png")
 
 
@@ -42,12 +49,16 @@ def run(args: Any) -> int:
                                grid=tuple(args.grid) if args.grid else None,
                                direction=args.direction, n_lamellae=n, spacing=args.spacing,
                                crossing_angle=args.angle, at_parallel=args.at,
+                               rounds=args.rounds, polish_iter=args.polish,
+                               allow_unconverged=args.allow_unconverged,
                                progress=progress.callback)
     progress(f"writing {args.output}")
     out = write_gg(args.output, bundle, preview=not args.no_preview)
     m = bundle.metrics
     summary = {
         "bundle": str(out),
+        "surface optimization": "converged" if bundle.params["converged"]
+                                else "did NOT converge (--allow-unconverged)",
         "joints / loops / lamellae": f"{m['n_joints']} / {m['n_loops']} / "
                                      f"{m['n_lamellae']['C1']} + {m['n_lamellae']['C3']}",
         "Delta_a straight [%]": m["alignability"],

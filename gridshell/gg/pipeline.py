@@ -21,7 +21,7 @@ from scipy.sparse.csgraph import connected_components
 from scipy.sparse.linalg import lsqr
 
 from ..bundle import DesignBundle, write_bundle
-from ..errors import InputError
+from ..errors import ConvergenceError, InputError
 from ..grid import grid_quads
 from ..metrics import (alignability_error, alignability_error_arc, deviation, geodesic_turning,
                        summary)
@@ -207,6 +207,7 @@ def design_gg(target: Any, *, meridians: str = "cols", grid: tuple[int, int] | N
               at_parallel: float = 0.5,
               offsets: tuple[Sequence[float], Sequence[float]] | None = None,
               weights: dict[str, float] | None = None, angle: float | None = None,
+              rounds: int = 10, polish_iter: int = 20, allow_unconverged: bool = False,
               progress: Progress = None) -> tuple[DesignBundle, dict[str, Any]]:
     """Design a geodesic alignable gridshell on (an approximation of) a target surface.
 
@@ -225,8 +226,19 @@ def design_gg(target: Any, *, meridians: str = "cols", grid: tuple[int, int] | N
         The net (see :func:`gg_net_from_mesh`).
     weights : dict, optional
         Weights of the surface optimization (see ``design_gg_surface``).
+    rounds, polish_iter : int
+        Outer rounds and final projection iterations of the surface optimization.
+    allow_unconverged : bool
+        Return a design whose surface optimization missed its tolerances (flagged in
+        ``report["design"]["converged"]`` and ``bundle.params``) instead of raising.
     progress : callable, optional
         Receives one-line progress messages.
+
+    Raises
+    ------
+    ConvergenceError
+        The surface optimization did not meet its tolerances (and ``allow_unconverged`` is
+        off): no GG net would be alignable on it.
 
     Returns
     -------
@@ -243,7 +255,15 @@ def design_gg(target: Any, *, meridians: str = "cols", grid: tuple[int, int] | N
     _say(progress, f"target: {len(V)} vertices, {len(F)} faces")
     P0 = initial_grid(V, F, meridians=meridians, grid=grid, direction=direction)
     _say(progress, f"initial grid {P0.shape[0]} x {P0.shape[1]}; designing the GG surface")
-    design = design_gg_surface(V, F, P0, weights=weights, progress=progress)
+    design = design_gg_surface(V, F, P0, weights=weights, outer=rounds,
+                               polish_iter=polish_iter, progress=progress)
+    if not design.converged and not allow_unconverged:
+        raise ConvergenceError(
+            f"the GG surface optimization did not converge (geodesic residual "
+            f"{design.geodesic_residual_max:.2e} rad, edge-length spread "
+            f"{design.length_residual_rel_max:.2e}; tolerances 1e-6): the net would not be "
+            "alignable. Give it more rounds / polish iterations, a coarser grid, or a target "
+            "closer to a surface of revolution (or allow an unconverged design explicitly)")
     P, design_report = design.P, dict(design.report, converged=design.converged,
                                       history=design.history,
                                       deviation=design.deviation)
@@ -264,7 +284,8 @@ def design_gg(target: Any, *, meridians: str = "cols", grid: tuple[int, int] | N
               "direction": direction, "n_lamellae": n_lamellae, "spacing": spacing,
               "crossing_angle": crossing_angle, "at_parallel": at_parallel,
               "offsets": [list(map(float, o)) for o in offsets] if offsets else None,
-              "weights": weights, "dphi": rev.dphi, "total_angle": rev.total_angle,
+              "weights": weights, "converged": design.converged, "dphi": rev.dphi,
+              "total_angle": rev.total_angle,
               "clairaut_c": inet.c, "s_star": inet.s_star}
     bundle = DesignBundle(kind="GG", net=net, aligned=aligned, surface_V=sV, surface_F=sF,
                           metrics=metrics, params=params, revolution_V=rV, revolution_F=rF)
