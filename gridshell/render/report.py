@@ -48,7 +48,8 @@ CHECKS: tuple[Check, ...] = (
 
 #: pictures first in this order, then any other picture alphabetically
 _ORDER = ("render.png", "preview.png", "delta_a_before.png", "delta_a_after.png",
-          "delta_l.png", "delta_n.png", "curvature_diagram.png", "collapse.png", "alignment.gif")
+          "delta_l.png", "delta_n.png", "curvature_diagram.png", "collapse.png", "states.png",
+          "alignment.gif")
 _CAPTIONS = {
     "render.png": "The lamellae as ribbons on the surface, coloured by family.",
     "preview.png": "The net on the designed surface, loops coloured by Delta_a [%].",
@@ -57,6 +58,9 @@ _CAPTIONS = {
     "delta_l.png": "Delta_l: relative edge-length change after alignment [%] (Fig. 16).",
     "delta_n.png": "Delta_n: relative normal-curvature change after alignment [%] (Fig. 16).",
     "collapse.png": "The collapse curve with its flattened normals (Fig. 15).",
+    "curvature_diagram.png": "Curvature diagram of the PHLW surface: samples in the (H, K) "
+                             "plane, one line per u-row (Figs. 11, 13a).",
+    "states.png": "The deployed net and its collapsed state (all joints on one line).",
     "alignment.gif": "The alignment sequence (Fig. 16).",
     "plan.png": "Assembly plan: every lamella's id at its place.",
 }

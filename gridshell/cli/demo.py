@@ -1,0 +1,308 @@
+"""``gridshell demo``: the whole product on the bundled meshes, in one output directory.
+
+1. **GG** on the freeform dome (``gridshell/data/dome.obj``): design, design bundle, verification
+   from the files, ribbons ``render.png``, the deployed and collapsed states, Rhino ``.3dm``,
+   DXF/SVG cut files, ``report.html``;
+2. **CNC** pavilion from the torus zone (``gridshell/data/torus_patch.obj``): PHLW step (mode
+   ``cnc``, with its curvature diagram), net, collapse circle, post-optimization, alignment
+   sequence (``sequence/frame_*``, ``alignment.gif``), colour maps, verification, render, Rhino
+   ``.3dm``, cut files (arcs of one circle), ``report.html``.
+
+Everything is written into a temporary directory that replaces ``-o DIR`` only when all of it
+succeeded; ``DIR/demo.json`` holds the summary printed at the end.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from pathlib import Path
+from typing import Any
+
+HELP = ("run the bundled demo: a GG gridshell on a dome and a CNC gridshell for a pavilion, "
+        "verified, simulated, rendered, exported to Rhino and cut (DXF/SVG)")
+
+MARKER = "demo.json"
+
+#: sizes of the full and the --quick demo
+SIZES: dict[str, dict[str, Any]] = {
+    "full": {"gg": {"grid": (16, 16), "n_lamellae": 8},
+             "phlw": {"samples": (18, 18), "outer": 4, "max_iter": 40},
+             "ncp": {"curves": 12, "samples": (48, 48), "collapse_samples": (1200, 1200),
+                     "frames": 12, "postopt_rounds": 3}},
+    "quick": {"gg": {"grid": (12, 12), "n_lamellae": 6},
+              "phlw": {"samples": (10, 10), "outer": 1, "max_iter": 10},
+              "ncp": {"curves": 8, "samples": (32, 32), "collapse_samples": (400, 400),
+                      "frames": 4, "postopt_rounds": 2}},
+}
+
+#: cut files of a 1:10 model in 1 mm polypropylene (the paper's prototypes, Fig. 21), mm
+FABRICATION = {"width": 20.0, "thickness": 1.0, "hole": 3.0, "sheet": "600x400",
+               "scale": "1:10"}
+
+
+def add_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("-o", "--output", default="out/demo", metavar="DIR",
+                   help="output directory, replaced only when the whole demo succeeded "
+                        "(default out/demo); an existing directory must be an earlier demo "
+                        "output")
+    p.add_argument("--quick", action="store_true",
+                   help="smaller sizes: coarser grids, fewer lamellae and frames (a check that "
+                        "everything runs, in a fraction of the time)")
+    p.add_argument("--only", choices=("gg", "ncp"),
+                   help="run only the GG or only the NCP (CNC) part")
+
+
+def _check_output(out: Path) -> None:
+    from ..errors import InputError
+
+    if out.exists():
+        if not out.is_dir():
+            raise InputError(f"{out} exists and is not a directory; choose another -o")
+        if any(out.iterdir()) and not (out / MARKER).is_file():
+            raise InputError(f"{out} exists and is not the output of 'gridshell demo' (no "
+                             f"{MARKER}); choose another -o or remove it")
+
+
+def _states_png(V, aligned, F, title: str) -> bytes:
+    """One PNG of the deployed net (left) and its collapsed state (right), same axes."""
+    import io
+
+    from PIL import Image, ImageOps
+
+    from ..quadmesh import mesh_edges
+    from ..render import ncp_maps
+    from ..render.ribbons import view_angles
+
+    elev, azim = view_angles(V)
+    pngs = ncp_maps.sequence_frames([V, aligned], mesh_edges(F, len(V)), title=title,
+                                    dpi=110, elev=elev, azim=azim)
+    a, b = (Image.open(io.BytesIO(x)).convert("RGB") for x in pngs)
+    if a.size == b.size:  # crop the common white margin (same box: same scale in both)
+        boxes = [ImageOps.invert(im).getbbox() for im in (a, b)]
+        if all(boxes):
+            pad = 12
+            box = (max(min(bx[0] for bx in boxes) - pad, 0),
+                   max(min(bx[1] for bx in boxes) - pad, 0),
+                   min(max(bx[2] for bx in boxes) + pad, a.width),
+                   min(max(bx[3] for bx in boxes) + pad, a.height))
+            a, b = a.crop(box), b.crop(box)
+    gap = 24
+    img = Image.new("RGB", (a.width + gap + b.width, max(a.height, b.height)), "white")
+    img.paste(a, (0, 0))
+    img.paste(b, (a.width + gap, 0))
+    buf = io.BytesIO()
+    img.save(buf, format="PNG")
+    return buf.getvalue()
+
+
+def _agrees(v: dict, stored: dict, keys: tuple[tuple[str, str], ...]) -> bool:
+    """Whether the verified figures reproduce the stored ones (relative 1e-6)."""
+    import math
+
+    for vk, sk in keys:
+        for stat in ("mean", "max"):
+            a, b = float(v[vk][stat]), float(stored[sk][stat])
+            if not math.isclose(a, b, rel_tol=1e-6, abs_tol=1e-12):
+                return False
+    return True
+
+
+def _checks(metrics: dict) -> str:
+    from ..render.report import metric_checks
+
+    rows = [r for r in metric_checks(metrics) if r["status"] != "info"]
+    failed = [r["key"] for r in rows if r["status"] == "fail"]
+    if not failed:
+        return f"pass ({len(rows)} of {len(rows)} within the paper's thresholds)"
+    return f"FAIL: {', '.join(failed)}"
+
+
+def _finish(d: Path, label: str, name: str, fab_params: dict, progress) -> dict[str, Any]:
+    """Render, export, cut and report a written bundle ``d``; returns the fabrication report."""
+    from fabrication import fabricate
+
+    from ..export.rhino import export_3dm
+    from ..render.report import write_report
+    from ..render.ribbons import render_bundle
+
+    progress(f"{label}: rendering render.png (lamellae as ribbons)")
+    render_bundle(d)
+    progress(f"{label}: exporting {name}.3dm (Rhino)")
+    export_3dm(d, d / f"{name}.3dm")
+    progress(f"{label}: cut files ({fab_params['scale']}, {fab_params['thickness']:g} mm "
+             "polypropylene)")
+    fab = fabricate(d, d / "fabrication", fab_params, progress=progress.detail)
+    progress(f"{label}: writing report.html")
+    write_report(d)
+    return fab
+
+
+def _gg(root: Path, sizes: dict, progress) -> dict[str, Any]:
+    from .. import data
+    from ..atomic import write_bytes
+    from ..gg.pipeline import design_gg, write_gg
+    from .verify import verify_bundle
+
+    t0 = time.perf_counter()
+    target = data.path("dome.obj")
+    progress(f"GG: designing a geodesic gridshell on {target.name} (grid "
+             f"{sizes['grid'][0]} x {sizes['grid'][1]}, {sizes['n_lamellae']} lamellae)")
+    bundle, report = design_gg(target, grid=sizes["grid"], n_lamellae=sizes["n_lamellae"],
+                               progress=progress.detail)
+    d = root / "gg"
+    progress("GG: writing the design bundle and its pictures")
+    write_gg(d, bundle)
+    write_bytes(d / "states.png", _states_png(
+        bundle.net.joints, bundle.aligned, bundle.net.loops,
+        "GG deployed (0), collapsed (1):"))
+    progress("GG: verifying the bundle from its files")
+    v = verify_bundle(d)
+    fab = _finish(d, "GG", "gg", FABRICATION, progress)
+    m = bundle.metrics
+    return {
+        "dir": d, "kind": "GG", "target": target.name,
+        "lamellae": f"{m['n_lamellae']['C1']} + {m['n_lamellae']['C3']}",
+        "joints": v["n_joints"], "loops": v["n_loops"],
+        "delta_a": v["alignability"], "delta_a_arc": v["alignability_arc"],
+        "geodesic_turning": v["geodesic_turning"], "deviation": v["deviation"],
+        "verified": _agrees(v, m, (("alignability", "alignability"),
+                                   ("alignability_arc", "alignability_arc"))),
+        "checks": _checks(m), "revolution": report["revolution"]["method"],
+        "fabrication": fab, "time": time.perf_counter() - t0,
+    }
+
+
+def _ncp(root: Path, sizes: dict, progress) -> dict[str, Any]:
+    from .. import data
+    from ..atomic import write_bytes
+    from ..ncp.phlw import optimize_phlw, write_phlw
+    from ..ncp.pipeline import design_ncp, write_ncp
+    from ..ncp.reference import initial_surface
+    from ..quadmesh import read_mesh
+    from .verify import verify_bundle
+
+    t0 = time.perf_counter()
+    ref = data.path("torus_patch.obj")
+    ph = sizes["phlw"]
+    progress(f"CNC: PHLW step on {ref.name} (mode cnc, {ph['samples'][0]} x {ph['samples'][1]} "
+             f"samples, {ph['outer']} rounds)")
+    mesh = read_mesh(ref, kind="any")
+    init = initial_surface(mesh.V, mesh.F)
+    res = optimize_phlw(init.surface, (mesh.V, mesh.F), mode="cnc", samples=ph["samples"],
+                        outer=ph["outer"], max_iter=ph["max_iter"],
+                        progress=lambda msg: progress(f"CNC: PHLW {msg}"))
+    write_phlw(root / "phlw", res)
+    nc = sizes["ncp"]
+    progress(f"CNC: tracing the net ({nc['curves']} curves per family), collapse circle, "
+             "post-optimization, alignment simulation")
+    bundle, report = design_ncp(res, mode="cnc", curves=nc["curves"], samples=nc["samples"],
+                                collapse_samples=nc["collapse_samples"], frames=nc["frames"],
+                                postopt_rounds=nc["postopt_rounds"], progress=progress.detail)
+    bundle.params.update(source=str(ref), phlw_deviation=res.deviation,
+                         phlw_converged=res.converged)
+    d = root / "ncp"
+    progress("CNC: writing the bundle, the alignment sequence, alignment.gif and colour maps")
+    write_ncp(d, bundle, report, render=True, progress=progress.detail)
+    write_bytes(d / "curvature_diagram.png", (root / "phlw" / "curvature_diagram.png").read_bytes())
+    progress("CNC: verifying the bundle from its files")
+    v = verify_bundle(d)
+    fab = _finish(d, "CNC", "ncp", FABRICATION, progress)
+    m = bundle.metrics
+    return {
+        "dir": d, "kind": bundle.kind, "reference": ref.name,
+        "lamellae": f"{m['n_lamellae']['C1']} + {m['n_lamellae']['C3']}",
+        "joints": m["n_joints"], "loops": m["n_loops"],
+        "delta_a_before": m["delta_a_before"], "delta_a_after": v["alignability"],
+        "delta_l": v["delta_l"], "delta_n": v["delta_n"],
+        "deviation": m["deviation"], "phlw_deviation": res.deviation,
+        "n": m["n"], "collapse_radius": m["collapse_radius"],
+        "aligned_radius_error": m["aligned_radius_error"],
+        "frames": len(list((d / "sequence").glob("frame_*.obj"))),
+        "verified": _agrees(v, m, (("alignability", "delta_a_after"), ("delta_l", "delta_l"),
+                                   ("delta_n", "delta_n"))),
+        "checks": _checks(m), "fabrication": fab, "time": time.perf_counter() - t0,
+    }
+
+
+def _mm(d: dict) -> dict[str, float]:
+    return {"mean": d["mean"], "max": d["max"]}
+
+
+def _sheets(fab: dict) -> str:
+    W, H = fab["params"]["sheet"]
+    f = FABRICATION
+    return (f"{fab['n_sheets']} x {W:g} x {H:g} mm, {fab['n_pieces']} {fab['shape']} strips "
+            f"({f['scale']}, {f['width']:g} mm wide, {f['thickness']:g} mm polypropylene)")
+
+
+def _summary(out: Path, gg: dict | None, ncp: dict | None, total: float) -> dict[str, Any]:
+    s: dict[str, Any] = {"output": str(out)}
+    if gg is not None:
+        s["GG dome"] = f"{out / 'gg'}/ (report.html, render.png, states.png, gg.3dm, fabrication/)"
+        s["GG lamellae / joints / loops"] = f"{gg['lamellae']} / {gg['joints']} / {gg['loops']}"
+        s["GG Delta_a [%]"] = _mm(gg["delta_a"])
+        s["GG Delta_a arc length [%]"] = _mm(gg["delta_a_arc"])
+        s["GG geodesic turning [%]"] = gg["geodesic_turning"]
+        s["GG deviation from dome [% diag]"] = _mm(gg["deviation"])
+        s["GG paper thresholds"] = gg["checks"]
+        s["GG cut files"] = _sheets(gg["fabrication"])
+    if ncp is not None:
+        s["CNC pavilion"] = (f"{out / 'ncp'}/ (report.html, render.png, alignment.gif, "
+                             "ncp.3dm, fabrication/)")
+        s["CNC lamellae / joints / loops"] = (f"{ncp['lamellae']} / {ncp['joints']} / "
+                                              f"{ncp['loops']}")
+        s["CNC Delta_a traced [%]"] = _mm(ncp["delta_a_before"])
+        s["CNC Delta_a post-optimized [%]"] = _mm(ncp["delta_a_after"])
+        s["CNC Delta_l [%]"] = _mm(ncp["delta_l"])
+        s["CNC Delta_n [%]"] = _mm(ncp["delta_n"])
+        s["CNC deviation [% diag]"] = {"joints from surface": ncp["deviation"]["max"],
+                                       "surface from reference": ncp["phlw_deviation"]}
+        s["CNC collapse circle"] = (f"radius {ncp['collapse_radius']:.4g} m (n = {ncp['n']:.4g} "
+                                    f"1/m), aligned joints off it "
+                                    f"{ncp['aligned_radius_error']:.2g} %, {ncp['frames']} frames")
+        s["CNC paper thresholds"] = ncp["checks"]
+        s["CNC cut files"] = _sheets(ncp["fabrication"])
+    s["verified from the files"] = "yes" if all(
+        r["verified"] for r in (gg, ncp) if r is not None) else "NO: stored and recomputed differ"
+    s["time [s]"] = {**({"gg": gg["time"]} if gg else {}), **({"ncp": ncp["time"]} if ncp else {}),
+                     "total": total}
+    return s
+
+
+def _nested(summary: dict, gg: dict | None, ncp: dict | None) -> dict[str, Any]:
+    """``demo.json``: the printed summary and the figures of each part (no tmp paths)."""
+    def part(r: dict | None) -> dict | None:
+        if r is None:
+            return None
+        keep = {k: v for k, v in r.items() if k not in ("dir", "fabrication")}
+        f = r["fabrication"]
+        keep["fabrication"] = {k: f[k] for k in ("n_strips", "n_pieces", "n_sheets", "shape",
+                                                  "utilisation")}
+        return keep
+
+    return {"summary": summary, "gg": part(gg), "ncp": part(ncp)}
+
+
+def run(args: Any) -> int:
+    from ..atomic import atomic_dir, write_text
+    from .common import Progress, print_summary
+
+    progress = Progress(args)
+    out = Path(args.output)
+    _check_output(out)
+    sizes = SIZES["quick" if args.quick else "full"]
+    t0 = time.perf_counter()
+    gg = ncp = None
+    with atomic_dir(out) as tmp:
+        if args.only in (None, "gg"):
+            gg = _gg(tmp, sizes["gg"], progress)
+        if args.only in (None, "ncp"):
+            ncp = _ncp(tmp, sizes, progress)
+        summary = _summary(out, gg, ncp, time.perf_counter() - t0)
+        write_text(tmp / MARKER, json.dumps(_nested(summary, gg, ncp), indent=1,
+                                            default=str) + "\n")
+    progress(f"done: {out}")
+    print_summary(args, f"gridshell demo{' (--quick)' if args.quick else ''}: "
+                        f"{time.perf_counter() - t0:.0f} s", summary)
+    return 0
