@@ -152,9 +152,10 @@ class FabParams:
                 raise InputError("--hole must be positive with --joints hole; "
                                  "use --joints marks for joints without holes")
             if self.hole >= self.width - 2 * self.kerf:
+                less = f" less twice the kerf {self.kerf:g} mm" if self.kerf else ""
                 raise InputError(f"hole diameter {self.hole:g} mm is not smaller than the strip "
-                                 f"width {self.width:g} mm; choose a smaller --hole or a "
-                                 "wider --width")
+                                 f"width {self.width:g} mm{less}; choose a smaller --hole"
+                                 f"{', a smaller --kerf' if self.kerf else ''} or a wider --width")
             if self.margin < self.hole / 2 + 0.5:
                 raise InputError(f"end margin {self.margin:g} mm leaves no material beyond the end "
                                  f"holes (diameter {self.hole:g} mm); give --margin >= "

@@ -85,3 +85,41 @@ def atomic_dir(path: str | os.PathLike, overwrite: bool = True) -> Iterator[Path
     finally:
         if tmp.exists():
             shutil.rmtree(tmp, ignore_errors=True)
+
+
+def check_output(path: str | os.PathLike, *, directory: bool = True,
+                 marker: str | None = None) -> Path:
+    """Raise :class:`OutputError` now, before any work, if ``path`` cannot be written.
+
+    Outputs are written through a temporary beside ``path`` (:func:`atomic_path`,
+    :func:`atomic_dir`), so the nearest existing ancestor of ``path`` must be a writable
+    directory. With ``marker``, an existing non-empty directory at ``path`` is only replaced if
+    it holds ``marker`` (the output of an earlier run): a misspelt ``-o`` must never wipe
+    unrelated files. (Permissions are checked with :func:`os.access`; the atomic writers still
+    report what the operating system refuses.)
+
+    Returns
+    -------
+    Path
+        ``path``.
+    """
+    path = Path(path)
+    if path.exists():
+        if directory and not path.is_dir():
+            raise OutputError(f"{path} exists and is not a directory; choose another output "
+                              "directory")
+        if not directory and path.is_dir():
+            raise OutputError(f"{path} is a directory; give the path of a file")
+        if marker is not None and any(path.iterdir()) and not (path / marker).exists():
+            raise OutputError(f"{path} exists and is not the output of an earlier run (no "
+                              f"{marker}); choose another output directory or remove it")
+    anc = path.parent if str(path.parent) else Path(".")
+    while not anc.exists() and anc != anc.parent:
+        anc = anc.parent
+    if not anc.is_dir():
+        raise OutputError(f"cannot write {path}: {anc} is a file, not a directory. Choose a "
+                          "writable output location.")
+    if not os.access(anc, os.W_OK | os.X_OK):
+        raise OutputError(f"cannot write {path}: {anc} is not writable (permission denied). "
+                          "Choose a writable output location.")
+    return path

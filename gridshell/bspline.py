@@ -36,6 +36,10 @@ VERSION = 1
 
 #: Parameters this far outside the knot domain are clipped onto it instead of rejected.
 DOMAIN_TOL = 1e-10
+#: Most control points per direction (the paper uses 9 to 12): more is a typo, not a design.
+MAX_CTRL = 1000
+#: Most samples of one tensor sampling (rows x cols): the paper's densest is 1200 x 1200.
+MAX_SAMPLES = 5_000_000
 
 __all__ = [
     "FORMAT",
@@ -73,6 +77,9 @@ def open_uniform_knots(n_ctrl: int, degree: int) -> np.ndarray:
     if n_ctrl < degree + 1:
         raise InputError(f"{n_ctrl} control points cannot carry degree {degree}; "
                          f"use at least degree + 1 = {degree + 1} control points or a lower degree")
+    if n_ctrl > MAX_CTRL:
+        raise InputError(f"{n_ctrl} control points per direction is more than the {MAX_CTRL} "
+                         "supported; use fewer (the paper uses 9 to 12)")
     interior = np.linspace(0.0, 1.0, n_ctrl - degree + 1)[1:-1]
     return np.concatenate([np.zeros(degree + 1), interior, np.ones(degree + 1)])
 
@@ -397,6 +404,7 @@ class BSplineSurface:
         rows, cols = int(rows), int(cols)
         if rows < 2 or cols < 2:
             raise InputError(f"sample needs at least 2 x 2 samples, got {rows} x {cols}")
+        _check_sample_count(rows, cols)
         (u0, u1), (v0, v1) = self.domain
         P = self.evaluate_grid(np.linspace(u0, u1, rows), np.linspace(v0, v1, cols))
         return QuadMesh(P.reshape(-1, 3), grid_quads(rows, cols))
@@ -624,6 +632,12 @@ def fit_points(P: np.ndarray, u: np.ndarray, v: np.ndarray, n_ctrl_u: int = 9,
     return _solve_fit(surf, surf.operator(u, v), P, smoothing)
 
 
+def _check_sample_count(a: int, b: int) -> None:
+    if a * b > MAX_SAMPLES:
+        raise InputError(f"{a} x {b} samples are more than the {MAX_SAMPLES} supported; use a "
+                         "coarser sampling (the paper's densest is 1200 x 1200)")
+
+
 def uniform_params(surf: BSplineSurface, samples: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
     """Uniform sample parameters ``u (a,)``, ``v (b,)`` over the surface domain, ends included."""
     try:
@@ -632,5 +646,6 @@ def uniform_params(surf: BSplineSurface, samples: tuple[int, int]) -> tuple[np.n
         raise InputError(f"samples must be a pair of integers, got {samples!r}") from None
     if a < 2 or b < 2:
         raise InputError(f"sampling needs at least 2 x 2 samples, got {a} x {b}")
+    _check_sample_count(a, b)
     (u0, u1), (v0, v1) = surf.domain
     return np.linspace(u0, u1, a), np.linspace(v0, v1, b)

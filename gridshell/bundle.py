@@ -162,12 +162,52 @@ def read_design_json(path: str | Path) -> dict:
         d = json.loads(f.read_text(encoding="utf-8"))
     except (json.JSONDecodeError, UnicodeDecodeError) as exc:
         raise InputError(f"{f} is not valid JSON ({exc}); re-run the design command") from exc
-    if d.get("format") != FORMAT:
-        raise InputError(f"{f} is not a gridshell design file (format {d.get('format')!r})")
+    except OSError as exc:
+        raise InputError(f"{f}: cannot read the file ({exc.strerror or exc})") from exc
+    if not isinstance(d, dict) or d.get("format") != FORMAT:
+        fmt = d.get("format") if isinstance(d, dict) else type(d).__name__
+        raise InputError(f"{f} is not a gridshell design file (format {fmt!r}); give the "
+                         "output directory of 'gridshell gg' or 'gridshell ncp'")
     for key in ("kind", "lamellae"):
         if key not in d:
             raise InputError(f"{f} lacks '{key}'; re-run the design command")
+    if d["kind"] not in KINDS:
+        raise InputError(f"{f}: unknown design kind {d['kind']!r} (expected one of "
+                         f"{', '.join(KINDS)}); re-run the design command")
+    if not isinstance(d["lamellae"], list) or not all(isinstance(r, dict) for r in d["lamellae"]):
+        raise InputError(f"{f}: 'lamellae' must be a list of lamella records; re-run the design "
+                         "command")
     return d
+
+
+def read_net_mesh(path: str | Path):
+    """The joints and loops of a bundle's ``net.obj`` as a QuadMesh.
+
+    Loops may touch at a corner only (where a loop of the net is missing), so vertices whose
+    loops form several fans are accepted; every other check of ``read_mesh`` applies.
+    """
+    from .quadmesh import read_mesh
+
+    return read_mesh(path, kind="quad", manifold_vertices=False)
+
+
+def lamellae_from_design(d: dict, axes: list[np.ndarray], where: str | Path) -> list[Lamella]:
+    """The lamellae of design.json ``d`` with their ``axes`` (from axes.obj, same order).
+
+    Raises :class:`InputError` naming the first malformed record."""
+    if len(axes) != len(d["lamellae"]):
+        raise InputError(f"{where}: axes.obj has {len(axes)} polylines but design.json "
+                         f"{len(d['lamellae'])} lamellae; re-run the design command")
+    out = []
+    for k, (r, ax) in enumerate(zip(d["lamellae"], axes)):
+        try:
+            out.append(Lamella(id=int(r["id"]), family=int(r["family"]), joints=r["joints"],
+                               joint_s=r["joint_s"], axis=ax))
+        except (KeyError, TypeError, ValueError) as exc:
+            what = f"lacks {exc}" if isinstance(exc, KeyError) else f"is malformed ({exc})"
+            raise InputError(f"{where}: lamella record {k} of design.json {what}; re-run the "
+                             "design command") from None
+    return out
 
 
 def read_bundle(path: str | Path) -> DesignBundle:
@@ -179,27 +219,27 @@ def read_bundle(path: str | Path) -> DesignBundle:
     for name in ("net.obj", "aligned.obj", "axes.obj", "surface.obj"):
         if not (path / name).is_file():
             raise InputError(f"design bundle {path} lacks {name}; re-run the design command")
-    net_mesh = read_mesh(path / "net.obj", kind="quad")
+    net_mesh = read_net_mesh(path / "net.obj")
     # collapsed loops are degenerate by design: only the vertices, unchecked
     aligned = read_configuration(path / "aligned.obj")[0]
     if aligned.shape != net_mesh.V.shape:
         raise InputError(f"{path}: aligned.obj has {len(aligned)} vertices but net.obj "
                          f"{len(net_mesh.V)}; re-run the design command")
     axes = read_polylines(path / "axes.obj")
-    if len(axes) != len(d["lamellae"]):
-        raise InputError(f"{path}: axes.obj has {len(axes)} polylines but design.json "
-                         f"{len(d['lamellae'])} lamellae")
-    lamellae = [Lamella(id=int(r["id"]), family=int(r["family"]), joints=r["joints"],
-                        joint_s=r["joint_s"], axis=ax) for r, ax in zip(d["lamellae"], axes)]
+    lamellae = lamellae_from_design(d, axes, path)
     net = Net(joints=net_mesh.V, loops=net_mesh.F, lamellae=lamellae)
     surf = read_mesh(path / "surface.obj", kind="any")
     rev_V = rev_F = None
     if (path / "revolution.obj").is_file():
         rev = read_mesh(path / "revolution.obj", kind="any")
         rev_V, rev_F = rev.V, rev.F
-    collapse_s = {int(r["id"]): np.asarray(r["collapse_s"], float)
-                  for r in d["lamellae"] if "collapse_s" in r} or None
-    collapse = CollapseCurve.from_json(d["collapse"]) if "collapse" in d else None
+    try:
+        collapse_s = {int(r["id"]): np.asarray(r["collapse_s"], float)
+                      for r in d["lamellae"] if "collapse_s" in r} or None
+        collapse = CollapseCurve.from_json(d["collapse"]) if "collapse" in d else None
+    except (KeyError, TypeError, ValueError) as exc:
+        raise InputError(f"{path}: the collapse curve in design.json is malformed ({exc!r}); "
+                         "re-run the design command") from None
     return DesignBundle(kind=d["kind"], net=net, aligned=aligned, surface_V=surf.V,
                         surface_F=surf.F, metrics=d.get("metrics", {}),
                         params=d.get("params", {}), collapse=collapse, collapse_s=collapse_s,

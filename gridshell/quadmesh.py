@@ -39,6 +39,10 @@ MESH_FORMATS = (".obj", ".ply", ".off")
 MAX_ELEMENTS = 5_000_000
 #: A face is degenerate if its area is below ``DEGENERATE_AREA * bbox_diagonal**2``.
 DEGENERATE_AREA = 1e-12
+#: Bounding-box diagonals (metres) a mesh file may have: coordinates are read as metres, and a
+#: gridshell (or its model) spans millimetres to kilometres. Outside this range the file is in
+#: other units or corrupt, and the optimizers' tolerances lose their meaning.
+EXTENT_RANGE = (1e-6, 1e6)
 
 _FLOAT_FMT = "%.17g"  # shortest format that round-trips every float64
 
@@ -163,7 +167,8 @@ def boundary_vertices_of(F: np.ndarray, n_vertices: int) -> np.ndarray:
 # --------------------------------------------------------------------------------------------
 
 def validate_mesh(V: np.ndarray, F: np.ndarray | Sequence[Sequence[int]],
-                  require_quads: bool = False, name: str = "mesh") -> None:
+                  require_quads: bool = False, name: str = "mesh",
+                  manifold_vertices: bool = True) -> None:
     """Raise :class:`MeshError` if ``(V, F)`` is unusable; the message names the problem and the fix.
 
     Parameters
@@ -176,6 +181,10 @@ def validate_mesh(V: np.ndarray, F: np.ndarray | Sequence[Sequence[int]],
         Every face must have exactly 4 vertices.
     name : str
         Name of the mesh (e.g. its file name) used in messages.
+    manifold_vertices : bool
+        Reject vertices whose faces form several fans (a bow-tie). ``False`` accepts them, as
+        in a net whose loops touch at a corner where a loop is missing; edges must still be
+        manifold and consistently oriented.
 
     Raises
     ------
@@ -227,23 +236,23 @@ def validate_mesh(V: np.ndarray, F: np.ndarray | Sequence[Sequence[int]],
         raise MeshError(f"{name}: {int(rep.sum())} faces are degenerate, repeating a vertex "
                         f"(the first is face {f}: {P[f, valid[f]].tolist()}); "
                         "remove them or merge the mesh properly")
-    problem = _topology_problem(P, n)
+    problem = _topology_problem(P, n, vertices=manifold_vertices)
     if problem is not None:
         raise MeshError(f"{name}: {problem}")
     A = np.linalg.norm(polygon_vector_areas(V, P), axis=1)
-    tiny = A < DEGENERATE_AREA * bbox_diagonal(V) ** 2
+    tiny = (A < DEGENERATE_AREA * bbox_diagonal(V) ** 2) | (A == 0)
     if tiny.any():
         f = int(np.flatnonzero(tiny)[0])
         raise MeshError(f"{name}: {int(tiny.sum())} faces are degenerate, with (near) zero area "
                         f"(the first is face {f}); remove or repair them")
 
 
-def _topology_problem(P: np.ndarray, n: int) -> str | None:
+def _topology_problem(P: np.ndarray, n: int, vertices: bool = True) -> str | None:
     """First topological problem of padded faces ``P`` as a message, or None if manifold.
 
     Checks non-manifold edges (more than two faces), inconsistent orientation (an edge run
-    the same way by two faces) and non-manifold vertices (faces around a vertex forming more
-    than one fan), all vectorized.
+    the same way by two faces) and, if ``vertices``, non-manifold vertices (faces around a
+    vertex forming more than one fan), all vectorized.
     """
     src, dst, face = _face_edges(P)
     E, inv = _unique_edges(src, dst, n)
@@ -261,6 +270,8 @@ def _topology_problem(P: np.ndarray, n: int) -> str | None:
         return (f"{len(d)} edges are run in the same direction by both of their faces, so the "
                 f"faces are inconsistently oriented (the first joins vertices {d[0] // n} and "
                 f"{d[0] % n}); reorient the faces consistently (or the surface is non-orientable)")
+    if not vertices:
+        return None
     # vertex fans: connect the corners of a vertex across shared edges
     h = np.arange(len(src))
     # the corner at dst of edge h is the src corner of the next edge in the same face
@@ -786,7 +797,8 @@ def read_configuration(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray,
     return V, P, sizes
 
 
-def read_mesh(path: str | os.PathLike, kind: str = "any") -> QuadMesh | TriMesh:
+def read_mesh(path: str | os.PathLike, kind: str = "any",
+              manifold_vertices: bool = True) -> QuadMesh | TriMesh:
     """Read an OBJ, PLY (ASCII or binary) or OFF mesh, keeping vertex and face order.
 
     Parameters
@@ -798,6 +810,8 @@ def read_mesh(path: str | os.PathLike, kind: str = "any") -> QuadMesh | TriMesh:
         :class:`TriMesh`, quads split along their shorter diagonal (other polygons fanned).
         ``"any"``: a :class:`QuadMesh` if all faces are quads, a :class:`TriMesh` otherwise
         (mixed faces triangulated).
+    manifold_vertices : bool
+        ``False`` accepts vertices whose faces form several fans (see :func:`validate_mesh`).
 
     Returns
     -------
@@ -807,19 +821,31 @@ def read_mesh(path: str | os.PathLike, kind: str = "any") -> QuadMesh | TriMesh:
     Raises
     ------
     MeshError
-        Missing, unreadable, empty, truncated or garbage file, unknown extension, or a mesh
-        that fails :func:`validate_mesh`.
+        Missing, unreadable, empty, truncated or garbage file, unknown extension, a mesh
+        that fails :func:`validate_mesh`, or one whose size is outside :data:`EXTENT_RANGE`.
     """
     if kind not in ("any", "quad", "tri"):
         raise ValueError(f"kind must be 'any', 'quad' or 'tri', got {kind!r}")
     path = Path(path)
     V, P, sizes = _read_raw(path)
-    validate_mesh(V, P, require_quads=kind == "quad", name=path.name)
+    validate_mesh(V, P, require_quads=kind == "quad", name=path.name,
+                  manifold_vertices=manifold_vertices)
+    _check_extent(V, path.name)
     if kind != "tri" and np.all(sizes == 4):
         return QuadMesh(V, P[:, :4], check=False)
     if np.all(sizes == 3):
         return TriMesh(V, P[:, :3], check=False)
     return TriMesh(V, _triangulate_padded(V, P, sizes), check=False)
+
+
+def _check_extent(V: np.ndarray, name: str) -> None:
+    """:class:`MeshError` unless the bounding-box diagonal of ``V`` lies in :data:`EXTENT_RANGE`."""
+    d = bbox_diagonal(V)
+    lo, hi = EXTENT_RANGE
+    if not lo <= d <= hi:
+        raise MeshError(f"{name}: the mesh spans {d:.3g} m (bounding-box diagonal), outside the "
+                        f"{lo:g} .. {hi:g} m a gridshell can have; coordinates are read as "
+                        "metres - rescale the mesh (or export it in metres)")
 
 
 def _obj_vertex_text(V: np.ndarray) -> str:

@@ -8,8 +8,12 @@ from gridshell.grid import grid_quads
 from gridshell.quadmesh import write_mesh
 
 
-def _torus_obj(path, a=12, b=12):
-    th, ph = np.meshgrid(np.linspace(-0.8, 0.8, a), np.linspace(0, 1.2, b), indexing="ij")
+def _torus_obj(path, a=12, b=12, inner=False):
+    """A torus zone: the outer side (K > 0), or the inner side (K < 0, where mode aa has
+    asymptotic directions)."""
+    th0 = np.pi if inner else 0.0
+    th, ph = np.meshgrid(np.linspace(th0 - 0.8, th0 + 0.8, a), np.linspace(0, 1.2, b),
+                         indexing="ij")
     rho = 2.0 + np.cos(th)
     P = np.stack([rho * np.cos(ph), rho * np.sin(ph), np.sin(th)], -1)
     write_mesh(path, P.reshape(-1, 3), grid_quads(a, b))
@@ -39,8 +43,8 @@ def test_cli_writes_every_output_and_a_json_summary(tmp_path, capsys):
 
 
 def test_cli_progress_on_stderr_and_modes(tmp_path, capsys):
-    ref = _torus_obj(tmp_path / "torus.obj")
     for mode in ("phlw", "aa"):
+        ref = _torus_obj(tmp_path / f"torus_{mode}.obj", inner=mode == "aa")
         assert main(["phlw", str(ref), "-o", str(tmp_path / mode), "--mode", mode, *SMALL]) == 0
         cap = capsys.readouterr()
         assert "round 1/1" in cap.err and "PHLW surface design" in cap.out

@@ -11,7 +11,9 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
 from gridshell.bspline import basis_matrix
-from gridshell.metrics import alignability_error
+from gridshell.grid import grid_quads
+from gridshell.igl_adapter import closest_points
+from gridshell.metrics import alignability_error, deviation
 from gridshell.net import polyline_arclength, polyline_length
 from gridshell.render.ribbons import ribbon_polygons
 from gridshell.solver.layout import Layout
@@ -143,3 +145,58 @@ def test_ribbon_has_the_width_and_contains_the_axis(P, width, tangent):
     np.testing.assert_allclose(np.linalg.norm(Q[:, 3] - Q[:, 0], axis=1), width, rtol=1e-9)
     np.testing.assert_allclose(0.5 * (Q[:, 0] + Q[:, 3]), P[:-1],
                                atol=1e-9 * (1 + np.abs(P).max()))
+
+
+@SETTINGS
+@given(knot_vectors(), st.integers(0, 100), st.floats(0.01, 0.49), st.floats(0.51, 0.99))
+def test_bspline_derivatives_integrate_to_the_differences(dk, span_pick, fa, fb):
+    # inside one knot span B is a polynomial of degree p, so Gauss-Legendre with p + 1 nodes
+    # integrates B' and B'' exactly: B(b) - B(a) = int_a^b B', and likewise B' from B''
+    degree, knots = dk
+    spans = np.flatnonzero(np.diff(knots) > 0)
+    k = spans[span_pick % len(spans)]
+    a = knots[k] + fa * (knots[k + 1] - knots[k])
+    b = knots[k] + fb * (knots[k + 1] - knots[k])
+    x, w = np.polynomial.legendre.leggauss(degree + 1)
+    nodes, weights = 0.5 * (b - a) * x + 0.5 * (a + b), 0.5 * (b - a) * w
+    for d in (0, 1):
+        ends = basis_matrix(knots, degree, np.array([a, b]), deriv=d).toarray()
+        D = basis_matrix(knots, degree, nodes, deriv=d + 1).toarray()
+        integral = weights @ D
+        scale = 1 + np.abs(D).max() * (b - a)
+        np.testing.assert_allclose(ends[1] - ends[0], integral, atol=1e-9 * scale)
+
+
+@SETTINGS
+@given(points(2, 30), st.integers(0, 1000))
+def test_arclength_is_additive_over_a_split(P, pick):
+    k = pick % len(P)  # split at vertex k: the vertex belongs to both pieces
+    whole = polyline_arclength(P)
+    head, tail = polyline_arclength(P[:k + 1]), polyline_arclength(P[k:])
+    tol = 1e-12 * (1 + whole[-1])
+    np.testing.assert_allclose(whole[:k + 1], head, atol=tol)
+    np.testing.assert_allclose(whole[k:], head[-1] + tail, atol=tol)
+    assert polyline_length(P) == pytest.approx(polyline_length(P[:k + 1])
+                                               + polyline_length(P[k:]), rel=1e-12, abs=1e-12)
+
+
+heights = arrays(np.float64, (4, 4), elements=st.floats(-1, 1, allow_nan=False))
+
+
+@SETTINGS
+@given(heights, points(1, 20))
+def test_closest_point_distance_is_nonnegative_and_no_more_than_to_a_vertex(Z, P):
+    i, j = np.meshgrid(np.arange(4.0), np.arange(4.0), indexing="ij")
+    V = np.stack([i.ravel(), j.ravel(), Z.ravel()], axis=1)
+    F = grid_quads(4, 4)
+    sq, face, C = closest_points(P, V, F)
+    assert np.all(sq >= 0) and np.all((face >= 0) & (face < len(F)))
+    scale = 1 + np.abs(P).max()
+    # the reported squared distance is the one to the reported point ...
+    np.testing.assert_allclose(np.sum((P - C) ** 2, axis=1), sq, atol=1e-9 * scale ** 2)
+    # ... and the closest point is at least as close as the nearest vertex
+    to_vertex = np.min(np.sum((P[:, None] - V[None]) ** 2, axis=2), axis=1)
+    assert np.all(sq <= to_vertex + 1e-9 * scale ** 2)
+    dev = deviation(P, V, F)
+    assert 0 <= dev["mean"] <= dev["max"] * (1 + 1e-12)
+    assert deviation(V, V, F)["max"] == pytest.approx(0.0, abs=1e-9)

@@ -52,6 +52,8 @@ def add_args(p: argparse.ArgumentParser) -> None:
 def run(args: Any) -> int:
     from fabrication import FabParams, fabricate
 
+    from ..atomic import check_output
+    from ..bundle import read_design_json
     from .common import Progress, print_summary
 
     progress = Progress(args)
@@ -60,7 +62,9 @@ def run(args: Any) -> int:
                        axis=args.axis, scale=args.scale, sheet=args.sheet, gap=args.gap,
                        overlap=args.overlap, kerf=args.kerf, dxf_version=args.dxf_version,
                        segments=args.segments, labels=not args.no_labels)
+    read_design_json(args.bundle)  # a bad bundle is named before its output location
     out = Path(args.out) if args.out else Path(args.bundle) / "fabrication"
+    check_output(out)
     rep = fabricate(args.bundle, out, params, progress=progress.callback, plan=not args.no_plan)
     summary = {
         "output": str(out),

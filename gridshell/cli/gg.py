@@ -40,9 +40,11 @@ def add_args(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: Any) -> int:
+    from ..atomic import check_output
     from ..gg.pipeline import design_gg, write_gg
     from .common import Progress, print_summary
 
+    check_output(args.output, marker="design.json")
     progress = Progress(args)
     n = args.lamellae if args.lamellae is not None or args.spacing is not None else 10
     bundle, report = design_gg(args.target, meridians=args.meridians,

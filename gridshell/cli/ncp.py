@@ -46,12 +46,25 @@ def add_args(p: argparse.ArgumentParser) -> None:
                    help="mesh input: PHLW outer rounds (default 4)")
     p.add_argument("--phlw-max-iter", type=int, default=40,
                    help="mesh input: PHLW iterations per round (default 40)")
+    p.add_argument("--strict", action="store_true",
+                   help="exit with code 4, writing nothing, as soon as an optimizer (PHLW step, "
+                        "level-set fit, post-optimization) misses its tolerances (default: "
+                        "continue, and the summary says which did not converge)")
+
+
+def _unconverged(bundle: Any, report: dict) -> list[str]:
+    """Names of the optimizers of an NCP design that stopped without meeting their tolerances."""
+    out = ["PHLW step"] if bundle.params.get("phlw_converged") is False else []
+    out += [f"level-set fit {f}" for f, r in report["levelset"].items() if not r["converged"]]
+    return out + ([] if report["postopt"]["converged"] else ["post-optimization"])
 
 
 def run(args: Any) -> int:
+    from ..atomic import check_output
     from ..ncp.pipeline import design_ncp, write_ncp
     from .common import Progress, print_summary
 
+    check_output(args.output, marker="design.json")
     progress = Progress(args)
     progress(f"reading {args.reference}")
     phlw = {"ctrl": tuple(args.phlw_ctrl), "samples": tuple(args.phlw_samples),
@@ -62,7 +75,11 @@ def run(args: Any) -> int:
                                 levelset_ctrl=tuple(args.levelset_ctrl), omega_f=args.omega_f,
                                 collapse_samples=tuple(args.collapse_samples),
                                 postopt_rounds=args.rounds, frames=args.frames,
-                                phlw_options=phlw, progress=progress.callback)
+                                phlw_options=phlw, strict=args.strict,
+                                progress=progress.callback)
+    failed = _unconverged(bundle, report)
+    for name in failed:
+        progress(f"warning: the {name} did not converge (--strict makes this an error)")
     progress(f"writing {args.output}")
     out = write_ncp(args.output, bundle, report, render=not args.no_render,
                     progress=progress.callback)
@@ -70,6 +87,8 @@ def run(args: Any) -> int:
     summary = {
         "bundle": str(out),
         "kind": bundle.kind,
+        "converged": not failed,
+        "not converged": ", ".join(failed) or "none",
         "joints / loops / lamellae": f"{m['n_joints']} / {m['n_loops']} / "
                                      f"{m['n_lamellae']['C1']} + {m['n_lamellae']['C3']}",
         "Delta_a before [%]": m["delta_a_before"],

@@ -31,6 +31,9 @@ def add_args(p: argparse.ArgumentParser) -> None:
                    help="outer rounds (closest points refreshed) (default 4)")
     p.add_argument("--max-iter", type=int, default=60,
                    help="Levenberg-Marquardt iterations per round (default 60)")
+    p.add_argument("--strict", action="store_true",
+                   help="exit with code 4, writing nothing, if the optimization misses its "
+                        "tolerances (default: write it; the summary says 'converged: False')")
     for key, default in (("closeness", None), ("gliding", None), ("target", None), ("beta", None),
                          ("constraints", None)):
         p.add_argument(f"--w-{key}", type=float, default=default, metavar="W",
@@ -55,10 +58,13 @@ def _load_reference(path: str, args: Any) -> tuple[Any, Any, Any]:
 
 
 def run(args: Any) -> int:
+    from ..atomic import check_output
     from ..bspline import uniform_params
+    from ..errors import ConvergenceError
     from ..ncp.phlw import optimize_phlw, row_relation_residual, write_phlw
     from .common import Progress, print_summary
 
+    check_output(args.output, marker="report.json")
     progress = Progress(args)
     progress(f"reading {args.reference}")
     init, V, F = _load_reference(args.reference, args)
@@ -73,6 +79,14 @@ def run(args: Any) -> int:
                         check_samples=tuple(args.check_samples), progress=progress.callback)
     for line in res.diagnostics:
         progress(f"note: {line}")
+    if not res.converged:
+        last = res.history[-1]
+        msg = (f"the PHLW optimization did not converge ({last['message']} after "
+               f"{args.outer} round(s) of at most {args.max_iter} iterations)")
+        if args.strict:
+            raise ConvergenceError(f"{msg}; raise --outer / --max-iter, or drop --strict to "
+                                   "write the unconverged surface")
+        progress(f"warning: {msg}")
     u, v = uniform_params(res.surface, tuple(args.check_samples))
     dense = row_relation_residual(res.surface, u, v, mode=args.mode)
     progress(f"writing {args.output}")

@@ -35,6 +35,7 @@ def _sequence_is_current(bundle: Path, gif: Path) -> bool:
 
 
 def run(args: Any) -> int:
+    from ..atomic import check_output
     from ..bundle import read_design_json
     from ..errors import InputError
     from ..render.ribbons import render_bundle
@@ -44,10 +45,13 @@ def run(args: Any) -> int:
     progress = Progress(args)
     bundle = Path(args.bundle)
     design = read_design_json(bundle)
+    check_output(bundle / "render.png", directory=False)
+    if args.rhino:
+        check_output(args.rhino, directory=False)
     if args.width is not None and not args.width > 0:
         raise InputError(f"--width must be positive (mm), got {args.width}")
-    if min(args.size) < 64:
-        raise InputError(f"--size must be at least 64 x 64 pixels, got {args.size}")
+    if min(args.size) < 64 or max(args.size) > 10000:
+        raise InputError(f"--size must be 64 to 10000 pixels each way, got {args.size}")
     written: list[str] = []
 
     progress("rendering render.png")

@@ -20,12 +20,12 @@ def add_args(p: argparse.ArgumentParser) -> None:
 def verify_bundle(path: str | Path) -> dict[str, Any]:
     """Metrics of the bundle at ``path`` recomputed from design.json, net.obj, axes.obj,
     surface.obj (and aligned.obj, axes_r.npy, aligned_r.npy when present)."""
-    from ..bundle import read_design_json
+    from ..bundle import lamellae_from_design, read_design_json, read_net_mesh
     from ..errors import InputError, MeshError
     from ..metrics import (alignability_error, alignability_error_arc,
                            crossing_normal_curvature_on_mesh, delta_l, delta_n,
                            deviation, geodesic_turning, summary)
-    from ..net import Lamella, Net
+    from ..net import Net
     from ..quadmesh import read_configuration, read_mesh, read_polylines
 
     path = Path(path)
@@ -33,13 +33,9 @@ def verify_bundle(path: str | Path) -> dict[str, Any]:
     for name in ("net.obj", "axes.obj", "surface.obj"):
         if not (path / name).is_file():
             raise InputError(f"design bundle {path} lacks {name}; re-run the design command")
-    net_mesh = read_mesh(path / "net.obj", kind="quad")
+    net_mesh = read_net_mesh(path / "net.obj")
     axes = read_polylines(path / "axes.obj")
-    if len(axes) != len(d["lamellae"]):
-        raise InputError(f"{path}: axes.obj has {len(axes)} polylines but design.json "
-                         f"{len(d['lamellae'])} lamellae")
-    lams = [Lamella(id=int(r["id"]), family=int(r["family"]), joints=r["joints"],
-                    joint_s=r["joint_s"], axis=ax) for r, ax in zip(d["lamellae"], axes)]
+    lams = lamellae_from_design(d, axes, path)
     net = Net(joints=net_mesh.V, loops=net_mesh.F, lamellae=lams)
     surf = read_mesh(path / "surface.obj", kind="any")
     da = alignability_error(net.joints, net.loops)

@@ -355,6 +355,11 @@ def geodesic_net(rev: Revolution, *, n_lamellae: int | None = None, spacing: flo
             if dstep > Phi:
                 raise InputError(f"spacing {spacing} m is wider than the reference parallel "
                                  f"({r_star * Phi:.4g} m); choose a smaller spacing")
+        if dstep * r_star < step:
+            n_max = int(r_star * Phi / step) + 1
+            raise InputError(f"the curves would be {dstep * r_star:.3g} m apart on the reference "
+                             f"parallel, closer than the {step:.3g} m they are sampled at; use at "
+                             f"most {n_max} lamellae or a spacing of at least {step:.3g} m")
     bs, bphi, bsig, bds, bdphi = trace_geodesic(
         rev, s_star, 0.0, xi, s_range=(s_lo, s_hi), phi_range=(-Phi, Phi), both=True,
         step=step, max_length=None, derivatives=True)

@@ -46,9 +46,15 @@ def _check_disk(mesh: Any) -> None:
 
 
 def _check_size(R: int, C: int, what: str) -> None:
+    from ..quadmesh import MAX_ELEMENTS
+
     if R < _MIN or C < _MIN:
         raise InputError(f"{what} is too coarse ({R} x {C} vertices); the GG design needs at "
                          f"least {_MIN} x {_MIN} - refine it or ask for a larger grid=(R, C)")
+    if R * C > MAX_ELEMENTS:
+        raise InputError(f"{what} is too fine ({R} x {C} vertices, limit {MAX_ELEMENTS}); a GG "
+                         "mesh of 10 to 100 vertices per side is plenty - ask for a smaller "
+                         "grid=(R, C)")
 
 
 def _resample(P: np.ndarray, R: int, C: int) -> np.ndarray:

@@ -96,7 +96,8 @@ def row_normal_curvature(K: np.ndarray, H: np.ndarray, mode: Mode = "phlw",
 
 
 def net_angle(kI: np.ndarray, kII: np.ndarray, n: np.ndarray,
-              umbilic_tol: float = 1e-6) -> tuple[np.ndarray, np.ndarray]:
+              umbilic_tol: float = 1e-6, scale: float | None = None
+              ) -> tuple[np.ndarray, np.ndarray]:
     """Net angle ``beta`` to ``e5`` from ``sin^2 beta = (n - kI) / (kII - kI)`` (eq. 4.10).
 
     Parameters
@@ -107,6 +108,10 @@ def net_angle(kI: np.ndarray, kII: np.ndarray, n: np.ndarray,
         Net normal curvature (broadcast against ``kI``).
     umbilic_tol : float
         ``|kII - kI|`` below this times the curvature scale counts as umbilic.
+    scale : float, optional
+        The curvature scale, 1/m (default: the largest ``|kI|``, ``|kII|``). Pass at least
+        one over the surface's size, so that a flat surface (curvatures at rounding level)
+        counts as umbilic.
 
     Returns
     -------
@@ -118,7 +123,8 @@ def net_angle(kI: np.ndarray, kII: np.ndarray, n: np.ndarray,
     """
     kI, kII = np.asarray(kI, float), np.asarray(kII, float)
     gap = kII - kI
-    scale = float(np.nanmax(np.maximum(np.abs(kI), np.abs(kII)))) if kI.size else 1.0
+    if scale is None:
+        scale = float(np.nanmax(np.maximum(np.abs(kI), np.abs(kII)))) if kI.size else 1.0
     umb = ~(np.abs(gap) > umbilic_tol * max(scale, 1e-300))
     with np.errstate(divide="ignore", invalid="ignore"):
         s2 = (np.asarray(n, float) - kI) / gap
@@ -164,6 +170,35 @@ class NetDirections:
         raise InputError(f"family must be 1 or 3, got {family}")
 
 
+def _raise_no_net(g: dict[str, np.ndarray], n_rows: np.ndarray, u: np.ndarray, v: np.ndarray,
+                  valid: np.ndarray, mode: str, scale: float) -> None:
+    """:class:`NoNetError` saying why the net has no direction at the ``~valid`` samples."""
+    gap = np.abs(g["kII"] - g["kI"])
+    bad = ~valid
+    if np.all(gap <= 1e-6 * scale):
+        raise NoNetError(
+            f"the surface is umbilic at all {valid.size} samples (kappa_I = kappa_II, as on a "
+            "plane or a sphere): its principal directions, and with them the directions of a "
+            "normal-curvature-preserving net, are undefined; give a surface with distinct "
+            "principal curvatures (e.g. a saddle or a torus patch), or design a geodesic "
+            "gridshell (gridshell gg)")
+    if mode == "aa" and np.all(g["K"][bad] > 0):
+        raise NoNetError(
+            f"the surface has K > 0 at {int(bad.sum())} of {valid.size} samples (it bends like a "
+            "dome there), and asymptotic directions exist only where K <= 0, so the AA net "
+            "(n = 0) has no direction there; use mode 'phlw' or 'cnc', or a surface with K < 0 "
+            "(e.g. a pseudosphere or a saddle)")
+    i, j = np.argwhere(bad)[0]
+    near = (f"; |kappa_II - kappa_I| is only {100 * gap[i, j] / scale:.2g} % of the curvature "
+            "there, the surface is nearly umbilic (like a sphere)"
+            if gap[i, j] < 0.05 * scale else "")
+    raise NoNetError(
+        f"the net of normal curvature n has no real direction at {int(bad.sum())} of "
+        f"{valid.size} samples (first at u={u[i]:.3f}, v={v[j]:.3f}: n={n_rows[i]:.4g} outside "
+        f"[kappa_I, kappa_II] = [{g['kI'][i, j]:.4g}, {g['kII'][i, j]:.4g}] or umbilic, eq. "
+        f"4.10{near}); re-run the PHLW optimization (gridshell phlw) or trim the surface")
+
+
 def net_directions(surf: BSplineSurface, u: np.ndarray, v: np.ndarray, *, mode: Mode = "phlw",
                    n: float | np.ndarray | None = None, require: bool = True) -> NetDirections:
     """Principal frame, net angle and net directions on the grid ``u x v`` (paper 4.2.2).
@@ -185,16 +220,13 @@ def net_directions(surf: BSplineSurface, u: np.ndarray, v: np.ndarray, *, mode: 
         n_rows = row_normal_curvature(g["K"], g["H"], mode)
     else:
         n_rows = np.broadcast_to(np.asarray(n, float).reshape(-1), (len(np.atleast_1d(u)),)).copy()
-    beta, valid = net_angle(g["kI"], g["kII"], n_rows[:, None])
+    S = g["S"].reshape(-1, 3)
+    size = float(np.linalg.norm(S.max(axis=0) - S.min(axis=0))) if len(S) else 0.0
+    kmax = float(np.nanmax(np.maximum(np.abs(g["kI"]), np.abs(g["kII"]))))
+    scale = max(kmax, 1.0 / size) if size > 0 else kmax
+    beta, valid = net_angle(g["kI"], g["kII"], n_rows[:, None], scale=scale)
     if require and not valid.all():
-        bad = np.argwhere(~valid)
-        i, j = bad[0]
-        raise NoNetError(
-            f"the net of normal curvature n has no real direction at {len(bad)} of {valid.size} "
-            f"samples (first at u={np.atleast_1d(u)[i]:.3f}, v={np.atleast_1d(v)[j]:.3f}: "
-            f"n={n_rows[i]:.4g} outside [kappa_I, kappa_II] = [{g['kI'][i, j]:.4g}, "
-            f"{g['kII'][i, j]:.4g}] or umbilic, eq. 4.10); re-run the PHLW optimization "
-            "(gridshell phlw) or trim the surface")
+        _raise_no_net(g, n_rows, np.atleast_1d(u), np.atleast_1d(v), valid, mode, scale)
     nu = np.sqrt(g["E"])
     nv = np.sqrt(g["G"])
     e5 = g["Su"] / nu[..., None]

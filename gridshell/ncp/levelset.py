@@ -120,6 +120,8 @@ def fit_level_function(surf: BSplineSurface, dirs: NetDirections, family: int, *
     if family not in (1, 3):
         raise InputError(f"family must be 1 or 3, got {family}")
     nu, nv = (int(k) for k in n_ctrl)
+    for k, d in zip((nu, nv), degree):
+        open_uniform_knots(k, int(d))  # checks the counts before anything is allocated
     F0 = level_function(surf, np.zeros(nu * nv), (nu, nv), tuple(int(d) for d in degree))
     uu, vv = np.meshgrid(dirs.u, dirs.v, indexing="ij")
     ok = dirs.valid.reshape(-1)
@@ -152,25 +154,35 @@ def fit_level_function(surf: BSplineSurface, dirs: NetDirections, family: int, *
 # ============================================================================ tracing
 
 def level_values(zmin: float, zmax: float, count: int | None = None,
-                 spacing: float | None = None) -> np.ndarray:
+                 spacing: float | None = None, max_count: int | None = None) -> np.ndarray:
     """Uniformly subdivided levels strictly inside ``(zmin, zmax)``: ``count`` values at
     ``zmin + k (zmax - zmin) / (count + 1)``, or values ``spacing`` apart centred on the
-    middle of the range (``xi`` is in metres across the curves, eq. 4.13)."""
+    middle of the range (``xi`` is in metres across the curves, eq. 4.13); at most
+    ``max_count`` of them."""
     if (count is None) == (spacing is None):
         raise InputError("give either the number of curves or their spacing, not both")
     if count is not None:
         if int(count) < 1:
             raise InputError(f"the number of curves must be >= 1, got {count}")
+        _check_count(int(count), max_count)
         return np.linspace(zmin, zmax, int(count) + 2)[1:-1]
     if not (spacing > 0 and np.isfinite(spacing)):
         raise InputError(f"the curve spacing must be a positive number of metres, got {spacing}")
     mid = 0.5 * (zmin + zmax)
     k = int(np.floor((zmax - mid) / spacing))
+    _check_count(2 * k + 1, max_count, spacing)
     vals = mid + spacing * np.arange(-k, k + 1)
     vals = vals[(vals > zmin) & (vals < zmax)]
     if len(vals) == 0:
         raise InputError(f"spacing {spacing} m is larger than the surface; choose a smaller one")
     return vals
+
+
+def _check_count(count: int, max_count: int | None, spacing: float | None = None) -> None:
+    if max_count is not None and count > max_count:
+        what = f"spacing {spacing} m gives {count}" if spacing is not None else f"{count}"
+        raise InputError(f"{what} curves per family, more than the {max_count} the tracing grid "
+                         "resolves; ask for fewer curves or a larger spacing")
 
 
 def _grad_xi(F: BSplineSurface, uv: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -356,7 +368,8 @@ def trace_net(surf: BSplineSurface, fits: dict[int, LevelFit], *, curves: int | 
     levels, polys = {}, {}
     for f, cnt in zip((1, 3), counts):
         Z = fits[f].F.evaluate_grid(ug, vg)[..., 2]
-        levels[f] = level_values(float(Z.min()), float(Z.max()), cnt, spacing)
+        levels[f] = level_values(float(Z.min()), float(Z.max()), cnt, spacing,
+                                 max_count=min(grid) // 2)
         polys[f] = trace_levels(fits[f].F, levels[f], grid)
     F1, F3 = fits[1].F, fits[3].F
     rng = max(float(np.ptp(levels[1])), float(np.ptp(levels[3])), 1.0)
@@ -423,6 +436,11 @@ def trace_net(surf: BSplineSurface, fits: dict[int, LevelFit], *, curves: int | 
                                     joints=[index[k] for k in mine], joint_s=s[jidx], axis=X))
             axis_uv.append(Q)
             axis_jidx.append(jidx)
+    if not lamellae:
+        raise NoNetError(f"the traced curves cross at {len(keys)} joints, but no curve crosses "
+                         "the other family twice, so no lamella has two joints (the net "
+                         "directions are nearly parallel, or the curves too few); ask for more "
+                         "curves (--curves) or a smaller spacing, or use another mode")
     # net-loops (i, j), (i+1, j), (i+1, j+1), (i, j+1), A = corner of least u
     loops = []
     for (i, j) in keys:

@@ -43,7 +43,7 @@ import scipy.sparse as sp
 
 from ..bspline import BSplineSurface, uniform_params
 from ..diffgeo import curvatures, fundamental_forms, principal_directions
-from ..errors import InputError
+from ..errors import InputError, NoNetError
 from ..solver import Layout, Problem, TermResult, result, solve, term
 from ..solver import terms as T
 
@@ -67,6 +67,14 @@ DEFAULT_WEIGHTS: dict[str, float] = {
     "closeness": 1e-2,     # omega_c
     "gliding": 10.0,       # omega_g
 }
+
+#: The reference is (nearly) umbilic at a sample if ``|kappa_2 - kappa_1|`` is at most this
+#: fraction of ``max(|kappa_1|, |kappa_2|, FLAT_CURVATURE)`` (unit-diagonal units). A
+#: reference umbilic at every sample (a plane, a sphere patch: up to 2.7 % measured on a 5 x 5
+#: control-point fit of a sphere) has no principal directions to start the PHLW net from.
+NEAR_UMBILIC = 0.05
+#: Curvatures below this, on unit-diagonal geometry (radius above 1000 diagonals), are flat.
+FLAT_CURVATURE = 1e-3
 
 _OPS = {"S": (0, 0), "Su": (1, 0), "Sv": (0, 1), "Suu": (2, 0), "Suv": (1, 1), "Svv": (0, 2)}
 _SCALARS = ("E", "F", "G", "delta", "w", "L", "M", "N", "K", "H")
@@ -621,6 +629,28 @@ def net_direction_check(surf: BSplineSurface, n_rows: np.ndarray | None,
 
 # ============================================================================ optimization
 
+def check_reference_net(K: np.ndarray, H: np.ndarray, mode: str) -> None:
+    """Raise :class:`NoNetError` if a surface with curvatures ``K, H`` at its samples (unit
+    bounding-box diagonal) admits no net of ``mode`` anywhere: umbilic at every sample (no
+    principal directions), or, in mode ``aa``, ``K > 0`` at every sample (no asymptotic
+    directions)."""
+    K, H = np.asarray(K, float), np.asarray(H, float)
+    d = np.sqrt(np.maximum(H * H - K, 0.0))
+    scale = np.maximum(np.abs(H) + d, FLAT_CURVATURE)
+    if np.all(2 * d <= NEAR_UMBILIC * scale):
+        raise NoNetError(
+            f"the reference is umbilic at all {K.size} samples (kappa_I = kappa_II within "
+            f"{100 * NEAR_UMBILIC:g} %, as on a plane or a sphere): it has no principal "
+            "directions, so no PHLW / CNC / PK net can start from it; give a reference with "
+            "distinct principal curvatures (e.g. a saddle or a torus patch), or design a "
+            "geodesic gridshell (gridshell gg)")
+    if mode == "aa" and np.all(K > 0):
+        raise NoNetError(
+            f"the reference has K > 0 at all {K.size} samples (it bends like a dome), and "
+            "asymptotic directions exist only where K <= 0, so no AA net (n = 0) exists near "
+            "it; use mode 'phlw' or 'cnc', or a reference with K < 0 (e.g. a saddle)")
+
+
 @dataclass
 class PHLWResult:
     """Outcome of :func:`optimize_phlw` (metres, 1/m, 1/m^2).
@@ -757,6 +787,7 @@ def optimize_phlw(surf: BSplineSurface, reference: Any, *, mode: Mode = "phlw",
     if not np.all(aux["delta"] > 0):
         raise InputError("the initial surface has a singular parametrization (S_u x S_v = 0) at "
                          f"{int(np.sum(~(aux['delta'] > 0)))} samples; refit the reference")
+    check_reference_net(aux["K"], aux["H"], mode)
     fit = fit_rows(aux["K"].reshape(R, -1), aux["H"].reshape(R, -1), mode)
     diagnostics: list[str] = []
     if len(fit.clamped):
@@ -825,6 +856,12 @@ def optimize_phlw(surf: BSplineSurface, reference: Any, *, mode: Mode = "phlw",
                                 (n_rows[:1] if mode == "cnc" else None),
                                 u_rows=u, u_samples=u, v_samples=v)
     diagnostics += check.messages
+    if np.all(check.umbilic | check.out_of_range):
+        raise NoNetError(
+            f"after the optimization the net has no real direction at any of the "
+            f"{check.umbilic.size} samples ({check.messages[0]}); the reference is too far from "
+            f"a {mode.upper()} surface: give the optimizer more rounds / iterations, a smaller "
+            "closeness or gliding weight, or another mode")
     dev = deviation_percent(out_surf, V, Fr, check_samples)
     return PHLWResult(surface=out_surf, mode=mode, u_rows=u, v_samples=v, n_rows=n_rows,
                       t_rows=t_rows, abc=abc, history=history, report_before=before,

@@ -18,7 +18,7 @@ import numpy as np
 
 from ..bspline import BSplineSurface
 from ..bundle import CollapseCurve, DesignBundle, write_bundle
-from ..errors import InputError
+from ..errors import ConvergenceError, InputError
 from ..metrics import alignability_error, delta_l, delta_n, deviation, summary
 from .collapse import (CollapseResult, closest_on_polyline, collapse_curve, fit_circle,
                        line_deviation)
@@ -131,6 +131,7 @@ def design_ncp(source: Any, *, mode: str = "phlw", curves: int | tuple[int, int]
                postopt_weights: dict[str, float] | None = None, postopt_rounds: int = 3,
                frames: int = 12, sim_weights: dict[str, float] | None = None,
                surface_samples: tuple[int, int] = (100, 100), phlw_options: dict | None = None,
+               strict: bool = False,
                progress: Callable[[str], None] | None = None) -> tuple[DesignBundle, dict]:
     """Design a normal-curvature-preserving alignable gridshell (paper 4.2.2-4.2.4, 5.1).
 
@@ -151,6 +152,10 @@ def design_ncp(source: Any, *, mode: str = "phlw", curves: int | tuple[int, int]
     surface_samples : the PHLW sample mesh of the bundle (surface.obj)
     phlw_options : options of the PHLW step for a mesh source (``ctrl``, ``degree``,
         ``transpose``, and any keyword of :func:`gridshell.ncp.phlw.optimize_phlw`)
+    strict : raise :class:`~gridshell.errors.ConvergenceError` as soon as an optimizer (the
+        PHLW step, a level-set fit, the post-optimization) stops without meeting its
+        tolerances; otherwise the report records it (``phlw_converged`` in the params,
+        ``converged`` of ``levelset`` and ``postopt``)
     progress : called with one line per stage
 
     Returns
@@ -161,6 +166,8 @@ def design_ncp(source: Any, *, mode: str = "phlw", curves: int | tuple[int, int]
     """
     if mode not in KIND:
         raise InputError(f"unknown mode {mode!r}; use 'phlw', 'cnc' or 'aa'")
+    if n is not None and not np.isfinite(n):
+        raise InputError(f"the net normal curvature n must be a finite number (1/m), got {n}")
     say = progress or (lambda _m: None)
     timings: dict[str, float] = {}
     t_all = time.perf_counter()
@@ -169,6 +176,11 @@ def design_ncp(source: Any, *, mode: str = "phlw", curves: int | tuple[int, int]
     surf, n_src, info = load_surface(source, mode=mode, phlw_options=phlw_options,
                                      progress=progress)
     timings["surface"] = time.perf_counter() - t0
+    if strict and info.get("phlw_converged") is False:
+        raise ConvergenceError(
+            "the PHLW step did not converge within its iteration limits (phlw_options outer x "
+            "max_iter; --phlw-outer, --phlw-max-iter); raise them, or run without strict to "
+            "continue from the unconverged surface")
     if n is None:
         n = n_src
 
@@ -189,6 +201,12 @@ def design_ncp(source: Any, *, mode: str = "phlw", curves: int | tuple[int, int]
     say(f"traced {len(net.lamellae)} lamellae, {len(net.joints)} joints, {len(net.loops)} loops")
     for note in traced.dropped:
         say(f"note: {note}")
+    failed = [f for f, fit in traced.fits.items() if not fit.converged]
+    if strict and failed:
+        raise ConvergenceError(
+            f"the level-set fit of family {failed[0]} did not converge; use fewer level-set "
+            "control points (--levelset-ctrl) or a larger fairness weight (--omega-f), or run "
+            "without strict")
 
     t0 = time.perf_counter()
     col = collapse_curve(surf, mode=mode, n=n, samples=collapse_samples)
@@ -200,6 +218,11 @@ def design_ncp(source: Any, *, mode: str = "phlw", curves: int | tuple[int, int]
     post = post_optimize(surf, net, traced.joint_uv, col, weights=postopt_weights,
                          rounds=postopt_rounds, progress=progress)
     timings["postopt"] = time.perf_counter() - t0
+    if strict and not post.converged:
+        last = post.history[-1]["message"] if post.history else "no round run"
+        raise ConvergenceError(
+            f"the post-optimization did not converge in {postopt_rounds} round(s) ({last}); "
+            "give it more rounds (--rounds), or run without strict")
 
     t0 = time.perf_counter()
     E = net.edges()

@@ -234,6 +234,8 @@ def post_optimize(surf: BSplineSurface, net: Net, joint_uv: np.ndarray, collapse
             raise InputError(f"unknown post-optimization weight {key!r}; weights are "
                              f"{', '.join(w)}")
         w[key] = float(val)
+    if int(rounds) < 0:
+        raise InputError(f"post-optimization rounds must be >= 0, got {rounds}")
     V0, r0, Vt0, rt0 = initial_configuration(surf, joint_uv, collapse)
     n = len(V0)
     E = net.edges()

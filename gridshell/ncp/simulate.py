@@ -38,6 +38,9 @@ from .postopt import (AxisPairs, EdgeLength, UnitNorm, edge_length_eq, interior_
 __all__ = ["SIM_WEIGHTS", "collapse_direction", "AlignmentSequence", "simulate_alignment",
            "plane_frame", "embed_aligned"]
 
+#: Most frames of an alignment sequence (each frame is one optimization).
+MAX_FRAMES = 1000
+
 #: constraint weights as in the post-optimization (Table 2); collapse and proximity are blended
 #: (scaled units, unit diagonal; measured on a pseudosphere patch: these keep Delta_l < 1.1 % in
 #: every intermediate frame while the distance to the plane decreases monotonically)
@@ -148,6 +151,9 @@ def simulate_alignment(V_star: np.ndarray, r_star: np.ndarray, edges: np.ndarray
         w[key] = float(val)
     if int(frames) < 1:
         raise InputError(f"frames must be >= 1, got {frames}")
+    if int(frames) > MAX_FRAMES:
+        raise InputError(f"{frames} frames are more than the {MAX_FRAMES} supported (each is an "
+                         "optimization); ask for fewer, e.g. 12")
     Vs = np.asarray(V_star, float)
     rs = np.asarray(r_star, float)
     n = len(Vs)

@@ -1,0 +1,428 @@
+"""Benchmark of the sparse least-squares solver (``gridshell.solver``): seconds per iteration
+and peak memory at ~1e3, 1e4 and 1e5 unknowns, the side-by-side run against
+``scipy.optimize.least_squares`` and the choice of the linear solver.
+
+The problem has mesh-like sparsity and is built from the project's own terms: an ``n x n``
+quad grid on the elliptic dome ``z = -(x^2/2 + y^2/2.2)`` perturbed by Gaussian noise of 0.1
+edge lengths, pulled back towards the dome (``closeness``, weight 1) while being made a GG mesh
+(``geodesic_meridians``: angle sums, radians; ``equal_lengths`` on parallels and meridians
+with the auxiliary lengths ``l, h``), with second-difference fairness (``linear``, 1e-3).
+Length-like residuals are divided by the mean edge length, as in ``design_gg_surface``. The
+dome is not a GG surface, so the minimum has a non-zero energy. Unknowns ``3 n^2 + 2 n - 1``:
+n = 18, 57, 182 give 1 007, 9 860 and 99 735.
+
+Sections (units: seconds, MB = 2^20 bytes, peak resident memory above the start of the run,
+see ``_measure.py``):
+
+1. ``iterations``: Levenberg-Marquardt (``solve(method="lm")``) from the noisy grid; seconds
+   per iteration, peak memory, and one iteration's cost split into assembly
+   (``Problem.assemble``), normal equations (column selection + ``J^T J``), factorization
+   (``factorized``) and back-substitution.
+2. ``least_squares``: on two problems - section 1's, and round 1 of the GG surface design
+   (``design_gg_surface``'s terms and default weights on the dome, from the grid itself) -
+   the same residual and sparse Jacobian (both from ``Problem.assemble``, cached per ``x``)
+   are given to ``scipy.optimize.least_squares(method="trf", tr_solver="lsmr")`` with the
+   default ``x_scale`` and with ``x_scale="jac"`` (not at 1e5). The target is the energy our
+   solver converges to (``tol_rel=1e-10``) times ``1 + 1e-6``; each run is timed until its
+   energy first falls below it (least_squares through its ``callback``). Ours also runs with
+   ``damping=1e-6`` instead of the default 1e-3. Ratio = least_squares' best time over ours
+   (> 1: ours is faster; the issue's goal is >= 5 at 1e4+ unknowns).
+3. ``linear``: the damped normal equations ``J^T J + 1e-3 mean(diag) I`` at the start point
+   solved by SuperLU with our options (MMD on ``A^T + A``, ``SymmetricMode``,
+   ``diag_pivot_thresh=0``), SuperLU's default (COLAMD, partial pivoting), MMD with default
+   pivoting, COLAMD with diagonal pivots, ``qdldl`` (AMD + LDL^T, only if installed; it is
+   not a dependency) and, for reference, Jacobi-preconditioned CG to a relative residual of
+   1e-8 (inexact, iterative). Figures: factor + solve seconds, fill ``nnz(L) + nnz(U)``
+   (``2 nnz(L) + n`` for LDL^T), relative residual, peak MB. Each runs in its own process
+   with a time limit.
+
+    .venv/bin/python benchmarks/solver.py [--sizes 1e3 1e4 1e5] [--lsq-sizes 1e3 1e4 1e5]
+        [--lsq-problems dome gg_round] [--lsq-1e5-problems dome gg_round]
+        [--linear-sizes 1e3 1e4] [--iter-1e5 3]
+        [--section iterations least_squares linear] [--json FILE]
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+from typing import Any, Callable
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from _measure import measure, run_worker  # noqa: E402
+
+from gridshell.gg.design import (GridShape, edge_groups, equal_lengths,  # noqa: E402
+                                 fairness_matrix, geodesic_meridians, init_group_lengths)
+from gridshell.solver import Layout, Problem, solve  # noqa: E402
+from gridshell.solver import terms as T  # noqa: E402
+from gridshell.solver.solve import factorized  # noqa: E402
+
+#: grid side per size label: 3 n^2 + 2 n - 1 unknowns
+SIZES = {"1e3": 18, "1e4": 57, "1e5": 182}
+SECTIONS = ("iterations", "least_squares", "linear")
+DAMPING = 1e-3  # relative to mean diag(J^T J), as solve()'s default
+TARGET_REL = 1e-6
+SCRIPT = Path(__file__).resolve()
+
+
+def grid_problem(n: int, noise: float = 0.1, seed: int = 0, closeness: float = 1.0,
+                 fairness: float = 1e-3) -> tuple[Problem, np.ndarray]:
+    """The benchmark problem on an ``n x n`` grid and its start point ``x0``."""
+    x, y = np.meshgrid(np.linspace(-1, 1, n), np.linspace(-0.8, 0.8, n), indexing="ij")
+    P = np.stack([x, y, -(x ** 2 / 2.0 + y ** 2 / 2.2)], axis=-1).reshape(-1, 3)
+    L = 2.0 / (n - 1)
+    P0 = P + noise * L * np.random.default_rng(seed).standard_normal(P.shape)
+    lay = Layout({"P": (n * n, 3), "l": n, "h": n - 1})
+    par, mer = edge_groups((n, n), "parallel"), edge_groups((n, n), "meridian")
+    x0 = lay.pack({"P": P0, "l": init_group_lengths(P0, par), "h": init_group_lengths(P0, mer)})
+    s2 = 1.0 / L ** 2
+    D = fairness_matrix((n, n))
+    prob = (Problem(lay)
+            .add("geodesic", 1.0, geodesic_meridians, GridShape((n, n)))
+            .add("parallel_lengths", s2, equal_lengths, par)
+            .add("meridian_lengths", s2, equal_lengths, mer)
+            .add("closeness", closeness * s2, T.closeness, T.Closeness("P", P))
+            .add("fairness", fairness * s2, T.linear, T.Linear("P", D)))
+    return prob, x0
+
+
+def normal_equations(prob: Problem, x: np.ndarray) -> tuple[sp.csc_matrix, np.ndarray]:
+    """``A = J^T J + DAMPING mean(diag) I`` (CSC) and ``b = -J^T r`` at ``x``, as in solve()."""
+    a = prob.assemble(x)
+    J = a.J.tocsc()
+    JTJ = (J.T @ J).tocsc()
+    A = (JTJ + sp.identity(JTJ.shape[0], format="csc") * (DAMPING * JTJ.diagonal().mean())).tocsc()
+    return A, -(J.T @ a.r)
+
+
+# ============================================================================ 1. iterations
+
+def _timed(fn: Callable[[], Any]) -> tuple[float, Any]:
+    t0 = time.perf_counter()
+    out = fn()
+    return time.perf_counter() - t0, out
+
+
+def iteration_split(prob: Problem, x: np.ndarray) -> dict[str, float]:
+    """Seconds of one iteration's parts at ``x`` (the steps of solve())."""
+    free = np.arange(len(x))
+    t_asm, a = _timed(lambda: prob.assemble(x))
+    t_ne, (J, JTJ) = _timed(lambda: _ne(a.J, free))
+    A = JTJ + sp.identity(len(free), format="csc") * (DAMPING * JTJ.diagonal().mean())
+    g = J.T @ a.r
+    t_fac, solver = _timed(lambda: factorized(A))
+    t_sol, _ = _timed(lambda: solver(g))
+    return {"assemble": t_asm, "normal_eq": t_ne, "factor": t_fac, "backsolve": t_sol}
+
+
+def _ne(J: sp.csr_matrix, free: np.ndarray) -> tuple[sp.csc_matrix, sp.csc_matrix]:
+    Jf = J[:, free].tocsc()
+    return Jf, (Jf.T @ Jf).tocsc()
+
+
+def work_iterations(size: str, max_iter: int) -> dict:
+    prob, x0 = grid_problem(SIZES[size])
+    split = iteration_split(prob, x0)
+    m = measure(lambda: solve(prob, x0, method="lm", max_iter=max_iter, tol_rel=1e-10))
+    res = m.value
+    its = max(res.iterations, 1)
+    A, _ = normal_equations(prob, x0)
+    return {"size": size, "unknowns": int(len(x0)), "rows": int(len(prob.residuals(x0))),
+            "nnz_J": int(prob.assemble(x0).J.nnz), "nnz_A": int(A.nnz),
+            "seconds": m.seconds, "iterations": res.iterations, "s_per_it": m.seconds / its,
+            "peak_mb": m.peak_mb, "rss_peak_mb": m.rss_peak_mb, "energy0": res.energy0,
+            "energy": res.energy, "message": res.message, "split": split}
+
+
+# ============================================================================ 2. least_squares
+
+def gg_round_problem(n: int) -> tuple[Problem, np.ndarray]:
+    """Round 1 of ``design_gg_surface`` on the dome grid of ``gg_design.py``: the same terms
+    and default weights (geodesic, lengths, gliding on the target's tangent planes, fairness
+    1e-4, elastic 3, proximity 1e-2; boundary gliding left out), from the grid itself."""
+    from gridshell.grid import grid_quads
+    from gridshell.igl_adapter import closest_points_with_normals, triangulate
+
+    x, y = np.meshgrid(np.linspace(-1, 1, n), np.linspace(-0.8, 0.8, n), indexing="ij")
+    P0 = np.stack([x, y, -(x ** 2 / 2.0 + y ** 2 / 2.2)], axis=-1)
+    X = P0.reshape(-1, 3)
+    V, Ft, _ = triangulate(X, grid_quads(n, n))
+    foot, normal = closest_points_with_normals(X, V, Ft)
+    L = float(np.mean(np.concatenate([np.linalg.norm(np.diff(P0, axis=a), axis=2).ravel()
+                                      for a in (0, 1)])))
+    s2 = 1.0 / L ** 2
+    lay = Layout({"P": (n * n, 3), "l": n, "h": n - 1})
+    par, mer = edge_groups((n, n), "parallel"), edge_groups((n, n), "meridian")
+    x0 = lay.pack({"P": X, "l": init_group_lengths(X, par), "h": init_group_lengths(X, mer)})
+    D = fairness_matrix((n, n))
+    prob = (Problem(lay)
+            .add("geodesic", 1.0, geodesic_meridians, GridShape((n, n)))
+            .add("parallel_lengths", s2, equal_lengths, par)
+            .add("meridian_lengths", s2, equal_lengths, mer)
+            .add("closeness", 0.1 * s2, T.gliding, T.Gliding("P", foot, normal))
+            .add("fairness", 1e-4 * s2, T.linear, T.Linear("P", D))
+            .add("elastic", 3.0 * s2, T.linear, T.Linear("P", D, D @ X))
+            .add("proximity", 1e-2 * s2, T.closeness, T.Closeness("P", X.copy())))
+    return prob, x0
+
+
+#: problems of the least_squares section: name -> (builder, note)
+PROBLEMS: dict[str, tuple[Callable[[int], tuple[Problem, np.ndarray]], str]] = {
+    "dome": (grid_problem, "noisy dome grid (section 1's problem)"),
+    "gg_round": (gg_round_problem, "GG design round 1 on the dome (design_gg_surface's terms "
+                                   "and weights)"),
+}
+
+
+def _time_to_target(res: Any, target: float, total: float) -> dict[str, Any]:
+    reach = [h for h in res.history if h["accepted"] and h["energy"] <= target]
+    return {"reached": bool(reach), "seconds": reach[0]["time"] if reach else total,
+            "iterations": reach[0]["it"] if reach else res.iterations, "energy": res.energy,
+            "seconds_total": total, "iterations_total": res.iterations}
+
+
+def work_least_squares(problem: str, size: str, x_scales: list[str], cap: float) -> dict:
+    from scipy.optimize import least_squares
+
+    prob, x0 = PROBLEMS[problem][0](SIZES[size])
+    t_ours, res = _timed(lambda: solve(prob, x0, method="lm", max_iter=100, tol_rel=1e-10))
+    target = res.energy * (1.0 + TARGET_REL)
+    out: dict[str, Any] = {"problem": problem, "size": size, "unknowns": int(len(x0)),
+                           "target": target, "energy0": res.energy0,
+                           "ours": _time_to_target(res, target, t_ours), "least_squares": {}}
+    # the same solver with a lower initial damping (the default is 1e-3 of mean diag(J^T J))
+    t_low, low = _timed(lambda: solve(prob, x0, method="lm", max_iter=100, tol_rel=1e-10,
+                                      damping=1e-6))
+    out["ours_damping_1e-6"] = _time_to_target(low, target, t_low)
+    for xs in x_scales:
+        cache: dict[str, Any] = {}
+
+        def assembled(x: np.ndarray) -> Any:
+            if "x" not in cache or not np.array_equal(cache["x"], x):
+                cache["x"], cache["a"] = x.copy(), prob.assemble(x)
+            return cache["a"]
+
+        state: dict[str, Any] = {"nit": 0}
+        t0 = time.perf_counter()
+
+        def callback(intermediate_result: Any) -> None:  # the name selects the result form
+            state["nit"] += 1
+            if 2.0 * float(intermediate_result.cost) <= target:
+                state["seconds"] = time.perf_counter() - t0
+                raise StopIteration
+            if time.perf_counter() - t0 > cap:
+                raise StopIteration
+
+        r = least_squares(lambda x: assembled(x).r, x0, jac=lambda x: assembled(x).J,
+                          method="trf", tr_solver="lsmr", x_scale=None if xs == "default" else xs,
+                          ftol=1e-12, xtol=1e-12, gtol=1e-12, max_nfev=500, callback=callback)
+        total = time.perf_counter() - t0
+        out["least_squares"][xs] = {
+            "reached": "seconds" in state, "seconds": state.get("seconds", total),
+            "iterations": state["nit"], "nfev": int(r.nfev), "energy": 2.0 * float(r.cost),
+            "message": str(r.message), "capped": total > cap and "seconds" not in state}
+    return out
+
+
+# ============================================================================ 3. linear solvers
+
+def _superlu(**kw: Any) -> Callable[[sp.csc_matrix, np.ndarray], tuple[np.ndarray, int]]:
+    def run(A: sp.csc_matrix, b: np.ndarray) -> tuple[np.ndarray, int]:
+        lu = spla.splu(A, **kw)
+        return lu.solve(b), int(lu.L.nnz + lu.U.nnz)
+    return run
+
+
+def _qdldl(A: sp.csc_matrix, b: np.ndarray) -> tuple[np.ndarray, int]:
+    import qdldl
+
+    s = qdldl.Solver(sp.triu(A, format="csc"), upper=True)
+    L, d, _ = s.factors()
+    return s.solve(b), int(2 * L.nnz + len(d))
+
+
+def _cg(A: sp.csc_matrix, b: np.ndarray) -> tuple[np.ndarray, int]:
+    x, info = spla.cg(A, b, rtol=1e-8, maxiter=20000, M=sp.diags(1.0 / A.diagonal()))
+    return x, 0
+
+
+LINEAR: dict[str, tuple[str, Callable[[sp.csc_matrix, np.ndarray], tuple[np.ndarray, int]]]] = {
+    "ours": ("SuperLU MMD(A^T+A), SymmetricMode, diag_pivot_thresh=0 (factorized)",
+             _superlu(permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                      options={"SymmetricMode": True})),
+    "colamd": ("SuperLU COLAMD, partial pivoting (scipy default)", _superlu()),
+    "mmd_pivot": ("SuperLU MMD(A^T+A), partial pivoting", _superlu(permc_spec="MMD_AT_PLUS_A")),
+    "colamd_sym": ("SuperLU COLAMD, SymmetricMode, diag_pivot_thresh=0",
+                   _superlu(permc_spec="COLAMD", diag_pivot_thresh=0.0,
+                            options={"SymmetricMode": True})),
+    "qdldl": ("qdldl AMD + LDL^T (optional package)", _qdldl),
+    "cg": ("CG + Jacobi to rel. residual 1e-8 (iterative, inexact)", _cg),
+}
+
+
+def qdldl_available() -> bool:
+    try:
+        import qdldl  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+def work_linear(size: str, method: str) -> dict:
+    prob, x0 = grid_problem(SIZES[size])
+    A, b = normal_equations(prob, x0)
+    fn = LINEAR[method][1]
+    m = measure(lambda: fn(A, b))
+    x, fill = m.value
+    rel = float(np.linalg.norm(A @ x - b) / np.linalg.norm(b))
+    return {"size": size, "method": method, "n": int(A.shape[0]), "nnz_A": int(A.nnz),
+            "seconds": m.seconds, "fill": fill, "residual": rel, "peak_mb": m.peak_mb}
+
+
+# ============================================================================ printing
+
+def section_iterations(sizes: list[str], iter_big: int, timeout: float) -> list[dict]:
+    print("1. Levenberg-Marquardt iterations (solve(method='lm')), GG-dome grid problem")
+    print(f"  {'size':>4} {'unknowns':>9} {'nnz(J)':>9} {'nnz(JTJ)':>9} {'its':>4} {'s/it':>7} "
+          f"{'total s':>8} {'peak MB':>8}   one iteration: assemble / J^T J / factor / solve [s]")
+    rows = []
+    for s in sizes:
+        max_iter = 100 if SIZES[s] < 100 else iter_big
+        d = run_worker(SCRIPT, ["iterations", s, str(max_iter)], timeout)
+        if d is None or "error" in d:
+            print(f"  {s:>4}  {'timed out' if d is None else d['error']} (limit {timeout:.0f} s)")
+            continue
+        sp_ = d["split"]
+        print(f"  {s:>4} {d['unknowns']:>9} {d['nnz_J']:>9} {d['nnz_A']:>9} {d['iterations']:>4} "
+              f"{d['s_per_it']:>7.3f} {d['seconds']:>8.2f} {d['peak_mb']:>8.0f}   "
+              f"{sp_['assemble']:.3f} / {sp_['normal_eq']:.3f} / {sp_['factor']:.3f} / "
+              f"{sp_['backsolve']:.3f}"
+              + (f"  (capped at {max_iter} iterations)" if max_iter < 100 else ""))
+        rows.append(d)
+    return rows
+
+
+def section_least_squares(problems: list[str], sizes: list[str], timeout: float,
+                          cap: float, big_problems: list[str] | None = None) -> list[dict]:
+    print("2. ours (LM, SuperLU) vs scipy.optimize.least_squares(trf, lsmr), same r and J; "
+          f"seconds (iterations) to energy <= E_ours * (1 + {TARGET_REL:g}); ratio = best "
+          "least_squares / ours (> 1: ours faster)")
+    print(f"  {'problem':<9} {'size':>4} {'unknowns':>9} {'target E':>10} {'ours':>12} "
+          f"{'ours damp 1e-6':>15} {'lsq default':>14} {'lsq x_scale=jac':>16} {'ratio':>8} "
+          f"{'ratio 1e-6':>10}")
+    rows = []
+    for prob in problems:
+        for s in sizes:
+            if SIZES[s] >= 100 and big_problems is not None and prob not in big_problems:
+                continue
+            xs = ["default", "jac"] if SIZES[s] < 100 else ["default"]
+            d = run_worker(SCRIPT, ["least_squares", prob, s, ",".join(xs), str(cap)], timeout)
+            if d is None or "error" in d:
+                print(f"  {prob:<9} {s:>4}  {'timed out' if d is None else d['error']} "
+                      f"(limit {timeout:.0f} s)")
+                continue
+
+            def cell(v: dict | None) -> str:
+                if v is None:
+                    return "-"
+                mark = "" if v["reached"] else ("!" if not v.get("capped") else " capped")
+                return f"{v['seconds']:.2f} ({v['iterations']}){mark}"
+
+            ls = d["least_squares"]
+            best = min(ls.values(), key=lambda v: v["seconds"])
+            lower = not best["reached"]
+            d["ratio"] = best["seconds"] / d["ours"]["seconds"]
+            d["ratio_damping_1e-6"] = best["seconds"] / d["ours_damping_1e-6"]["seconds"]
+            d["ratio_lower_bound"] = lower
+            pre = ">=" if lower else ""
+            print(f"  {prob:<9} {s:>4} {d['unknowns']:>9} {d['target']:>10.6g} "
+                  f"{cell(d['ours']):>12} {cell(d['ours_damping_1e-6']):>15} "
+                  f"{cell(ls.get('default')):>14} {cell(ls.get('jac')):>16} "
+                  f"{pre + format(d['ratio'], '.2f') + 'x':>8} "
+                  f"{pre + format(d['ratio_damping_1e-6'], '.2f') + 'x':>10}")
+            rows.append(d)
+    print("  (!: stopped before the target; the time is then its whole run)")
+    return rows
+
+
+def section_linear(sizes: list[str], timeout: float) -> list[dict]:
+    print(f"3. linear solver of the damped normal equations (each in its own process, limit "
+          f"{timeout:.0f} s)")
+    methods = [m for m in LINEAR if m != "qdldl" or qdldl_available()]
+    if not qdldl_available():
+        print("  (qdldl not installed: skipped; pip install qdldl to include it)")
+    print(f"  {'size':>4} {'n':>7} {'nnz(A)':>9}  {'method':<68} {'s':>7} {'fill':>10} "
+          f"{'residual':>9} {'peak MB':>8}")
+    rows = []
+    for s in sizes:
+        for meth in methods:
+            d = run_worker(SCRIPT, ["linear", s, meth], timeout)
+            label = LINEAR[meth][0]
+            if d is None or "error" in d:
+                why = f"> {timeout:.0f} s (stopped)" if d is None else d["error"]
+                print(f"  {s:>4} {'':>7} {'':>9}  {label:<68} {why}")
+                rows.append({"size": s, "method": meth, "seconds": None})
+                continue
+            fill = f"{d['fill']:>10}" if d["fill"] else f"{'-':>10}"
+            print(f"  {s:>4} {d['n']:>7} {d['nnz_A']:>9}  {label:<68} {d['seconds']:>7.3f} "
+                  f"{fill} {d['residual']:>9.1e} {d['peak_mb']:>8.0f}")
+            rows.append(d)
+    return rows
+
+
+def main(argv: list[str] | None = None) -> dict[str, list[dict]]:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--sizes", nargs="+", default=list(SIZES), choices=list(SIZES),
+                    help="sizes of the iteration section")
+    ap.add_argument("--lsq-sizes", nargs="+", default=["1e3", "1e4", "1e5"], choices=list(SIZES))
+    ap.add_argument("--lsq-problems", nargs="+", default=list(PROBLEMS), choices=list(PROBLEMS))
+    ap.add_argument("--lsq-1e5-problems", nargs="+", default=list(PROBLEMS),
+                    choices=list(PROBLEMS), help="problems also compared at 1e5 (~2 min each)")
+    ap.add_argument("--linear-sizes", nargs="+", default=["1e3", "1e4"], choices=list(SIZES))
+    ap.add_argument("--iter-1e5", type=int, default=3,
+                    help="iteration cap of the 1e5 run of section 1 (about 12 s each)")
+    ap.add_argument("--lsq-cap", type=float, default=120.0,
+                    help="seconds after which least_squares is stopped (reported as capped)")
+    ap.add_argument("--linear-timeout", type=float, default=30.0)
+    ap.add_argument("--section", nargs="+", default=list(SECTIONS), choices=SECTIONS)
+    ap.add_argument("--json", help="also write the figures to this JSON file")
+    a = ap.parse_args(argv)
+    out: dict[str, list[dict]] = {}
+    if "iterations" in a.section:
+        out["iterations"] = section_iterations(a.sizes, a.iter_1e5, timeout=600)
+    if "least_squares" in a.section:
+        out["least_squares"] = section_least_squares(a.lsq_problems, a.lsq_sizes, timeout=900,
+                                                     cap=a.lsq_cap,
+                                                     big_problems=a.lsq_1e5_problems)
+    if "linear" in a.section:
+        out["linear"] = section_linear(a.linear_sizes, a.linear_timeout)
+    if a.json:
+        Path(a.json).write_text(json.dumps(out, indent=1, default=float))
+    return out
+
+
+def worker(args: list[str]) -> None:
+    kind, size = args[0], args[1]
+    if kind == "iterations":
+        d = work_iterations(size, int(args[2]))
+    elif kind == "least_squares":
+        d = work_least_squares(args[1], args[2], args[3].split(","), float(args[4]))
+    elif kind == "linear":
+        d = work_linear(size, args[2])
+    else:
+        raise SystemExit(f"unknown worker {kind!r}")
+    print(json.dumps(d, default=float))
+
+
+if __name__ == "__main__":
+    if len(sys.argv) > 1 and sys.argv[1] == "--worker":
+        worker(sys.argv[2:])
+    else:
+        main()
