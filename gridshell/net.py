@@ -105,3 +105,57 @@ class Net:
             return np.zeros((0, 2), dtype=np.int64)
         e = np.sort(np.concatenate(pairs), axis=1)
         return np.unique(e, axis=0)
+
+
+def move_joints(net: Net, joints: np.ndarray) -> Net:
+    """The net with its joints moved to ``joints (n,3)`` (metres) and every lamella axis
+    carried along.
+
+    Each axis is displaced by the joint displacements interpolated in arc length by a natural
+    cubic spline (continued linearly beyond the end joints), so the axis stays smooth, and the
+    joints are inserted as axis vertices, so the moved axis passes exactly through the moved
+    joints; ``joint_s`` is remeasured along it. Loops and topology are unchanged.
+    """
+    J = np.asarray(joints, dtype=float).reshape(-1, 3)
+    if J.shape != net.joints.shape:
+        raise InputError(f"move_joints: {len(J)} joint positions for a net of "
+                         f"{len(net.joints)} joints")
+    if not np.all(np.isfinite(J)):
+        raise InputError("move_joints: joint positions must be finite")
+    out = [_carry_axis(lam, J) for lam in net.lamellae]
+    return Net(joints=J, loops=net.loops.copy(), lamellae=out)
+
+
+def _carry_axis(lam: Lamella, J: np.ndarray) -> Lamella:
+    from scipy.interpolate import CubicSpline
+
+    X, js = lam.axis, lam.joint_s
+    if len(X) < 2 or len(js) == 0:
+        return Lamella(id=lam.id, family=lam.family, joints=lam.joints.copy(),
+                       joint_s=js.copy(), axis=X + (J[lam.joints[0]] - X[0] if len(js) else 0))
+    X = X[np.concatenate([[True], np.linalg.norm(np.diff(X, axis=0), axis=1) > 0])]
+    s = polyline_arclength(X)
+    js = np.clip(js, 0.0, s[-1])
+    # the axis with its joints as vertices, placed on the smooth curve through the axis
+    # vertices (not on a chord); vertices within a fifth of a segment of a joint give way
+    seg = np.diff(s)
+    near = 0.2 * np.interp(s, 0.5 * (s[:-1] + s[1:]), seg) if len(seg) else s
+    keep = np.min(np.abs(s[:, None] - js[None, :]), axis=1) > near
+    smooth = CubicSpline(s, X, axis=0) if len(s) > 2 else None
+    at = smooth(js) if smooth is not None else \
+        np.stack([np.interp(js, s, X[:, c]) for c in range(3)], axis=1)
+    order = np.argsort(np.concatenate([s[keep], js]), kind="stable")
+    s_all = np.concatenate([s[keep], js])[order]
+    X = np.concatenate([X[keep], at])[order]
+    D = J[lam.joints] - at
+    if len(js) == 1 or js[-1] - js[0] <= 1e-12 * s[-1]:
+        disp = np.broadcast_to(D.mean(axis=0), X.shape)
+    else:
+        cs = CubicSpline(js, D, axis=0, bc_type="natural" if len(js) > 2 else "not-a-knot")
+        t = np.clip(s_all, js[0], js[-1])
+        disp = cs(t) + (s_all - t)[:, None] * np.where((s_all < js[0])[:, None], cs(js[0], 1),
+                                                        cs(js[-1], 1))
+    X = X + disp
+    s_new = polyline_arclength(X)
+    return Lamella(id=lam.id, family=lam.family, joints=lam.joints.copy(),
+                   joint_s=np.interp(js, s_all, s_new), axis=X)

@@ -20,6 +20,7 @@ from ..bspline import BSplineSurface
 from ..bundle import CollapseCurve, DesignBundle, write_bundle
 from ..errors import ConvergenceError, InputError
 from ..metrics import alignability_error, delta_l, delta_n, deviation, summary
+from ..net import move_joints
 from .collapse import (CollapseResult, closest_on_polyline, collapse_curve, fit_circle,
                        line_deviation)
 from ..bspline import uniform_params
@@ -278,9 +279,9 @@ def design_ncp(source: Any, *, mode: str = "phlw", curves: int | tuple[int, int]
                            "omega_f": omega_f},
               "collapse_samples": list(collapse_samples), "frames": frames,
               "collapse_direction": d.tolist(), "postopt_weights": post.weights, **info}
-    from ..net import Net
-
-    out_net = Net(joints=post.V, loops=net.loops, lamellae=net.lamellae)
+    # the lamellae carried onto the post-optimized joints: axes.obj and joint_s (the cut
+    # files' joint positions) describe the gridshell that aligns, not the traced net
+    out_net = move_joints(net, post.V)
     bundle = DesignBundle(kind=KIND[mode], net=out_net, aligned=seq.aligned, surface_V=mesh.V,
                           surface_F=mesh.F, metrics=metrics, params=params, collapse=curve,
                           collapse_s=_collapse_s(traced, col, A2))
