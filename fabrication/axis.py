@@ -206,16 +206,17 @@ class DenseCurve:
         return float(np.interp(tau, self.tau, self.C))
 
     def piece(self, c0: float, c1: float) -> np.ndarray:
-        """Points ``(m,2)`` of the curve between arc lengths ``c0 < c1``, sampled at about
-        ``step``; beyond the ends the curve continues along its end tangents."""
-        n = max(int(np.ceil((c1 - c0) / self.step)), 2) + 1
-        c = np.linspace(c0, c1, n)
-        out = np.stack([np.interp(c, self.C, self.D[:, j]) for j in range(2)], axis=1)
-        for end, sel in ((0, c < 0), (-1, c > self.C[-1])):
+        """Points ``(m,2)`` of the curve between arc lengths ``c0 < c1``: the dense samples
+        in between (so a piece's points do not depend on where it starts) and both ends;
+        beyond the curve's ends it continues along its end tangents (straight)."""
+        C = self.C
+        inner = C[(C > c0) & (C < c1)]
+        c = np.unique(np.concatenate([[c0], inner, [c1]]))
+        out = np.stack([np.interp(c, C, self.D[:, j]) for j in range(2)], axis=1)
+        for end, sel in ((0, c < 0), (-1, c > C[-1])):
             if sel.any():
                 i, j = (0, 1) if end == 0 else (-2, -1)
                 T = self.D[j] - self.D[i]
                 T /= np.linalg.norm(T)
-                ref = self.D[end]
-                out[sel] = ref + (c[sel] - self.C[end])[:, None] * T
+                out[sel] = self.D[end] + (c[sel] - C[end])[:, None] * T
         return out

@@ -71,6 +71,7 @@ class FabParams:
     axis : str
         ``"centre"``: axis on the centre line; ``"edge"``: axis on one edge (orthogonal
         lamellae standing on the surface), the strip on the side of the flattened normal.
+        Tangent (GG) lamellae take ``"centre"`` only (:meth:`check_orientation`).
     scale : float
         Model / design length ratio (``1:10`` -> 0.1); design metres -> mm is ``1000 * scale``.
     sheet : (float, float)
@@ -180,6 +181,23 @@ class FabParams:
                 raise InputError(f"--overlap {self.overlap:g} mm must be at least twice the end "
                                  f"margin ({2 * self.margin:g} mm) so that both pieces keep the "
                                  "splice joint with a full margin; omit it for the default")
+
+    def check_orientation(self, orientation: str, kind: str = "") -> None:
+        """Raise :class:`InputError` if the joint style or axis place means nothing for
+        lamellae of this ``orientation`` (``"tangent"``: GG, width in the surface;
+        ``"orthogonal"``: AA, CNC, NCP, standing on the surface). ``kind`` names the design
+        in the message."""
+        if orientation == "orthogonal":
+            return
+        design = f"{kind} " if kind else ""
+        if self.joints == "slots":
+            raise InputError(f"--joints slots needs orthogonal lamellae (AA, CNC, NCP designs); "
+                             f"{design}lamellae lie in the surface: use --joints hole or marks")
+        if self.axis == "edge":
+            raise InputError(f"--axis edge puts the axis on the edge a lamella stands on, which "
+                             f"only orthogonal lamellae (AA, CNC, NCP designs) have; {design}"
+                             "lamellae are tangent to the surface with the axis on the centre "
+                             "line: use --axis centre")
 
 
 def scale_text(scale: float) -> str:

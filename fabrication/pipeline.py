@@ -4,6 +4,7 @@ Everything that can go wrong with the parameters or the design is checked before
 file is written; the output directory then appears at once (``gridshell.atomic.atomic_dir``)::
 
     sheet_01.dxf, sheet_01.svg, ...   one DXF and one SVG per sheet
+    sheet_01.png, ...                  a preview of each sheet (headless matplotlib)
     cutlist.csv                        one row per piece
     plan.png, plan.svg                 the net with every lamella's id at its place
     fabrication.json                   this report
@@ -23,9 +24,10 @@ from gridshell.errors import InputError
 from .cutlist import cutlist_rows, write_cutlist
 from .dxf import write_sheet_dxf
 from .nesting import Layout, check_layout, nest
-from .params import FabParams
+from .params import FabParams, scale_text
 from .part import Part, build_part
 from .plan import write_plan
+from .preview import write_sheet_png
 from .splice import split_strip
 from .strips import strips_from_bundle
 from .svg import write_sheet_svg
@@ -97,8 +99,9 @@ def fabricate(bundle: str | Path | DesignBundle, out_dir: str | Path,
     -------
     dict
         The report also written to ``fabrication.json``: parameters, counts, utilisation,
-        split lamellae, files, and each piece's sheet and placement (the rigid motion from
-        strip coordinates, see :mod:`fabrication.axis`, to the sheet).
+        split lamellae, files (``previews``: the sheet PNGs), and each piece's sheet and
+        placement (the rigid motion from strip coordinates, see :mod:`fabrication.axis`, to
+        the sheet; mm and degrees).
     """
     say = progress or (lambda msg: None)
     if params is None:
@@ -118,7 +121,8 @@ def fabricate(bundle: str | Path | DesignBundle, out_dir: str | Path,
     util = area / (layout.n_sheets * W * H)
     per_sheet = [sum(p.area for p in layout.on_sheet(k)) / (W * H) for k in range(layout.n_sheets)]
     names = [f"sheet_{k + 1:02d}" for k in range(layout.n_sheets)]
-    files = [f"{n}{ext}" for n in names for ext in (".dxf", ".svg")]
+    previews = [f"{n}.png" for n in names]
+    files = [f"{n}{ext}" for n in names for ext in (".dxf", ".svg", ".png")]
     files += ["cutlist.csv"] + (["plan.png", "plan.svg"] if plan else []) + [REPORT]
     mm = params.mm_per_m
     axis_lengths = {int(lam.id): lam.length * mm for lam in bundle.net.lamellae}
@@ -136,8 +140,9 @@ def fabricate(bundle: str | Path | DesignBundle, out_dir: str | Path,
         "pieces_split": info["split"],
         "labels_dropped": int(sum(p.labels_dropped for p in parts)),
         "radius_mm": info["strips"][0].axis.radius,
-        "sheet_files": "one DXF and one SVG per sheet",
+        "sheet_files": "one DXF and one SVG per sheet, and a PNG preview of each",
         "files": files,
+        "previews": previews,
         "pieces": [{"lamella": p.strip.lamella, "piece": p.strip.piece,
                     "n_pieces": p.strip.n_pieces, "sheet": s + 1,
                     "flat_length_mm": p.strip.length, "s0": p.strip.s0,
@@ -151,6 +156,8 @@ def fabricate(bundle: str | Path | DesignBundle, out_dir: str | Path,
             write_sheet_dxf(tmp / f"{name}.dxf", sp, (W, H), params)
             write_sheet_svg(tmp / f"{name}.svg", sp, (W, H), params,
                             title=f"{name}: {len(sp)} parts")
+            write_sheet_png(tmp / f"{name}.png", sp, (W, H), params,
+                            title=sheet_title(name, len(sp), params))
         write_cutlist(tmp / "cutlist.csv", cutlist_rows(layout, axis_lengths))
         if plan:
             say("drawing the assembly plan")
@@ -160,6 +167,13 @@ def fabricate(bundle: str | Path | DesignBundle, out_dir: str | Path,
                                   encoding="utf-8")
     report["out"] = str(out)
     return report
+
+
+def sheet_title(name: str, n_parts: int, params: FabParams) -> str:
+    """Title of a sheet preview: name, sheet size (mm), part count, scale and material."""
+    W, H = params.sheet
+    return (f"{name}: {W:g} x {H:g} mm sheet, {n_parts} part{'s' if n_parts != 1 else ''} "
+            f"(model {scale_text(params.scale)}, {params.thickness:g} mm thick)")
 
 
 def _json_default(o: Any) -> Any:

@@ -79,9 +79,7 @@ def neighbours_by_joint(bundle: DesignBundle) -> dict[int, list[int]]:
 
 def strips_from_bundle(bundle: DesignBundle, params: FabParams) -> list[Strip]:
     """One :class:`Strip` per lamella (not yet split to fit a sheet), in design order."""
-    if params.joints == "slots" and ORIENTATION[bundle.kind] != "orthogonal":
-        raise InputError("--joints slots needs orthogonal lamellae (AA, CNC, NCP designs); "
-                         "GG lamellae lie in the surface: use --joints hole or marks")
+    params.check_orientation(ORIENTATION[bundle.kind], bundle.kind)
     shape = axis_shape(bundle)
     mm = params.mm_per_m
     w = params.width

@@ -12,6 +12,7 @@ from gridshell.cli.main import main
 from gridshell.errors import ConvergenceError
 
 GG_FILES = ("design.json", "net.obj", "aligned.obj", "render.png", "preview.png", "states.png",
+            "alignment.gif", "sequence/frame_000.obj", "sequence/frame_000.png",
             "report.html", "gg.3dm", "fabrication/sheet_01.dxf", "fabrication/sheet_01.svg",
             "fabrication/cutlist.csv", "fabrication/plan.png")
 NCP_FILES = ("design.json", "surface.json", "axes_r.npy", "aligned_r.npy", "render.png",
@@ -41,7 +42,30 @@ def test_quick_demo_writes_everything(quick_demo):
     assert (out / "gg" / "fabrication" / "sheet_01.dxf").read_text().startswith("  0\nSECTION")
     html = (out / "ncp" / "report.html").read_text()
     assert "data:image/gif;base64," in html and "<svg" in html   # GIF and cut sheets inline
+    assert "data:image/gif;base64," in (out / "gg" / "report.html").read_text()
     assert not [p for p in out.parent.iterdir() if p.name.startswith(".")]  # no temporaries
+
+
+def test_quick_demo_gg_alignment_sequence(quick_demo):
+    # deployed net -> collapsed net (aligned.obj), lamella edges kept within 1 % in every state
+    import numpy as np
+
+    from gridshell.bundle import read_bundle
+    from gridshell.render.sequence import read_sequence
+
+    _, out, s = quick_demo
+    b = read_bundle(out / "gg")
+    frames, loops = read_sequence(out / "gg")
+    assert len(frames) == 5 and "5 states" in s["GG alignment"]
+    np.testing.assert_array_equal(frames[0], b.net.joints)
+    np.testing.assert_array_equal(frames[-1], b.aligned)
+    E = b.net.edges()
+    ell0 = np.linalg.norm(b.net.joints[E[:, 1]] - b.net.joints[E[:, 0]], axis=1)
+    for V in frames:
+        ell = np.linalg.norm(V[E[:, 1]] - V[E[:, 0]], axis=1)
+        assert np.max(np.abs(ell - ell0) / ell0) < 0.01
+    saved = json.loads((out / "demo.json").read_text())["gg"]
+    assert saved["coverage"] > 95 and saved["frames"] == 5
 
 
 def test_quick_demo_figures_meet_the_paper_bounds(quick_demo):
@@ -74,9 +98,15 @@ def test_demo_prints_a_one_screen_summary(tmp_path, capsys):
 
 
 def test_demo_refuses_a_directory_it_did_not_write(tmp_path, capsys):
+    # as gg / phlw / ncp: an output problem (exit 5), found before any work
     (tmp_path / "keep.txt").write_text("mine")
-    assert main(["demo", "--quick", "-o", str(tmp_path)]) == 2
-    assert "not the output of 'gridshell demo'" in capsys.readouterr().err
+    assert main(["demo", "--quick", "-o", str(tmp_path)]) == 5
+    err = capsys.readouterr().err
+    assert "not the output of an earlier run (no demo.json)" in err
+    assert "GG: designing" not in err
+    assert [p.name for p in tmp_path.iterdir()] == ["keep.txt"]
+    assert main(["demo", "--quick", "-o", str(tmp_path / "keep.txt")]) == 5
+    assert "not a directory" in capsys.readouterr().err
     assert (tmp_path / "keep.txt").read_text() == "mine"
 
 

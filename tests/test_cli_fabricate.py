@@ -5,7 +5,7 @@ import csv
 import json
 
 import pytest
-from fab_cases import make_bundle, read_dxf_sheet
+from fab_cases import make_bundle, plan_labels, read_dxf_sheet
 
 from gridshell.bundle import write_bundle
 from gridshell.cli.main import main
@@ -42,6 +42,12 @@ def test_fabricate_from_the_cli(bundles, name, capsys):
     assert {"lamella", "family", "flat_length_mm", "joint_positions_mm", "sheet",
             "piece"} <= set(rows[0])
     assert (out / "plan.png").stat().st_size > 0 and (out / "plan.svg").is_file()
+    # every lamella id on the plan, one sheet preview per sheet, all listed in the report
+    ids = sorted(int(lam["id"]) for lam in json.loads((d / "design.json").read_text())["lamellae"])
+    assert sorted(plan_labels(out / "plan.svg")) == ids
+    previews = [f"sheet_{k + 1:02d}.png" for k in range(rep["n_sheets"])]
+    assert rep["previews"] == previews and set(previews) <= set(rep["files"])
+    assert all((out / f).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" for f in previews)
 
 
 def test_summary_in_text(bundles, tmp_path, capsys):
@@ -63,6 +69,7 @@ def test_summary_in_text(bundles, tmp_path, capsys):
     (["--scale", "1:0"], "scale"),
     (["--sheet", "big"], "sheet size"),
     (["--joints", "slots"], "orthogonal"),                     # slots on a GG design
+    (["--axis", "edge"], "--axis edge"),                       # no edge stands on a GG surface
 ])
 def test_nonsensical_parameters_fail_before_writing(bundles, tmp_path, capsys, args, message):
     out = tmp_path / "out"

@@ -102,3 +102,76 @@ def test_unconverged_design_is_an_error_unless_allowed(tmp_path, capsys):
     assert main([*args, "--allow-unconverged", "--no-preview"]) == 0
     assert "did NOT converge" in capsys.readouterr().out
     assert (out / "design.json").is_file()
+
+
+def test_gg_prints_progress_on_stderr_and_a_one_screen_summary(tmp_path, capsys):
+    target = _helicoid_target(tmp_path)
+    out = tmp_path / "design"
+    assert main(["gg", str(target), "-o", str(out), "--lamellae", "5", "--frames", "3"]) == 0
+    cap = capsys.readouterr()
+    err = cap.err.strip().splitlines()
+    # progress: one timed line per step, from the target to the written bundle
+    assert all(ln.startswith("[") and "s] " in ln for ln in err), err
+    text = "\n".join(err)
+    for step in ("target:", "designing the GG surface", "tracing geodesics", "alignment sequence",
+                 "rendering", f"writing {out}"):
+        assert step in text, step
+    # the summary: a title and one line per figure, fitting on a screen
+    lines = cap.out.strip().splitlines()
+    assert lines[0] == "GG design" and len(lines) <= 24
+    body = {ln.split("  ")[1].strip(): ln for ln in lines[1:]}
+    for key in ("Delta_a straight [%]", "geodesic turning [%]", "deviation [% diag]",
+                "deviation target->surface [% diag]", "coverage [% of target area]",
+                "alignment sequence"):
+        assert any(k.startswith(key) for k in body), key
+    assert "mean=" in next(ln for k, ln in body.items() if k.startswith("Delta_a straight"))
+    cov = float(next(ln for k, ln in body.items() if k.startswith("coverage")).split()[-1])
+    assert cov == pytest.approx(100.0, abs=1.0)       # the helicoid grid is its own design
+    assert (out / "alignment.gif").is_file() and len(list(out.glob("sequence/frame_*.obj"))) == 4
+
+
+def test_gg_non_uniform_offsets(tmp_path, capsys):
+    # helicoid (u cos v, u sin v, c v) with the rulings as meridians: the reference parallel
+    # (the middle one, u = 0) is the axis x = y = 0, and arc length along it from the first
+    # meridian (v = 0) is z = c v - so each lamella must cross the axis at z = its offset
+    target = _helicoid_target(tmp_path)
+    out = tmp_path / "design"
+    assert main(["gg", str(target), "-o", str(out), "--offsets", "0.15", "0.4", "0.85",
+                 "--offsets3", "0.3", "0.6", "--frames", "0", "--no-preview", "-q",
+                 "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["ok"]
+    b = read_bundle(out)
+    assert b.params["offsets"] == [[0.15, 0.4, 0.85], [0.3, 0.6]]
+    assert b.params["n_lamellae"] is None and b.params["spacing"] is None
+    for fam, offsets in ((1, [0.15, 0.4, 0.85]), (3, [0.3, 0.6])):
+        crossings = []
+        for lam in b.net.family(fam):
+            k = np.argmin(np.hypot(lam.axis[:, 0], lam.axis[:, 1]))
+            assert np.hypot(*lam.axis[k, :2]) < 1e-6
+            crossings.append(lam.axis[k, 2])
+        np.testing.assert_allclose(np.sort(crossings), offsets, rtol=3e-3)
+
+
+@pytest.mark.parametrize("extra, message", [
+    (["--offsets", "0.3"], "at least 2"),
+    (["--offsets", "0.3", "0.3", "0.5"], "given twice"),
+    (["--offsets", "nan", "0.2"], "finite"),
+    (["--offsets1", "0.1", "0.4"], "--offsets3 is missing"),
+    (["--spacing", "0.2", "--offsets3", "0.1", "0.4"], "replace --lamellae and --spacing"),
+])
+def test_gg_bad_offsets_are_named_and_write_nothing(tmp_path, capsys, extra, message):
+    target = _helicoid_target(tmp_path)
+    out = tmp_path / "design"
+    assert main(["gg", str(target), "-o", str(out), "-q", *extra]) == 2
+    err = capsys.readouterr().err
+    assert message in err and "Traceback" not in err
+    assert not out.exists()
+
+
+def test_gg_offsets_and_lamellae_are_exclusive(tmp_path, capsys):
+    target = _helicoid_target(tmp_path)
+    with pytest.raises(SystemExit) as exc:
+        main(["gg", str(target), "-o", str(tmp_path / "d"), "--lamellae", "5", "--offsets", "0.1",
+              "0.5"])
+    assert exc.value.code == 2
+    assert "not allowed with argument" in capsys.readouterr().err

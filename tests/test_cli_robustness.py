@@ -10,6 +10,8 @@ import json
 import os
 import shutil
 import struct
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -116,6 +118,25 @@ def _bow_tie():
     return V, [[0, 1, 2, 3], [0, 4, 5, 6]]
 
 
+def _repeated_vertex():
+    """A quad repeating a vertex (face 12 of the saddle becomes ``a b b d``)."""
+    V, F = _saddle()
+    F = F.tolist()
+    a, b, _, d = F[12]
+    F[12] = [a, b, b, d]
+    return V, F
+
+
+def _zero_area():
+    """A corner quad squashed onto its first edge (``c -> b``, ``d -> a``): zero area, four
+    distinct vertex indices, every other face intact."""
+    V, F = _saddle()
+    a, b, c, d = F[0]
+    V = V.copy()
+    V[c], V[d] = V[b], V[a]
+    return V, F
+
+
 def _bad_coordinate(value: str) -> str:
     lines = _obj(*_saddle()).splitlines(keepends=True)
     lines[7] = f"v 0.1 {value} 0.2\n"
@@ -148,6 +169,8 @@ BAD_FILES = {
     "mesh.stl": lambda: _obj(*_saddle()),
     "edge_of_three.obj": lambda: _obj(*_edge_of_three()),
     "bow_tie.obj": lambda: _obj(*_bow_tie()),
+    "degenerate_repeat.obj": lambda: _obj(*_repeated_vertex()),
+    "degenerate_area.obj": lambda: _obj(*_zero_area()),
     "nan.obj": lambda: _bad_coordinate("nan"),
     "inf.obj": lambda: _bad_coordinate("inf"),
     "huge.obj": lambda: _obj(*_saddle(1e12)),
@@ -225,6 +248,8 @@ FILE_CASES = [
     ("missing.obj", 2, ["missing.obj", "no such file"]),
     ("edge_of_three.obj", 2, ["non-manifold", "edge", "more than two faces"]),
     ("bow_tie.obj", 2, ["non-manifold", "vertices", "split the mesh"]),
+    ("degenerate_repeat.obj", 2, ["degenerate_repeat.obj", "degenerate", "repeating a vertex"]),
+    ("degenerate_area.obj", 2, ["degenerate_area.obj", "degenerate", "zero area"]),
     ("nan.obj", 2, ["nan.obj", "NaN or infinite"]),
     ("inf.obj", 2, ["inf.obj", "NaN or infinite"]),
     ("huge.obj", 2, ["huge.obj", "spans", "rescale"]),
@@ -395,6 +420,28 @@ def test_ncp_strict_fails_at_the_phlw_step(tmp_path, capsys):
                          ["PHLW step did not converge", "--phlw-max-iter"], [out])
 
 
+def test_ncp_strict_fails_at_the_level_set_fit(tmp_path, capsys, surfaces, monkeypatch):
+    """No CLI option makes the level-set fit miss its tolerances: it is a linear least-squares
+    problem that Levenberg-Marquardt solves well within its 20 iterations (measured on this
+    torus: converged for 4 x 4 to 60 x 60 control points, omega_f 1e-14 to 1e8, 6 x 6 to
+    12 x 12 samples), and its iteration limit is not a parameter of trace() or design_ncp().
+    Its default limit is lowered here to one iteration, which the fit cannot converge in."""
+    from gridshell.ncp.levelset import fit_level_function
+
+    monkeypatch.setitem(fit_level_function.__kwdefaults__, "max_iter", 1)
+    src, out = surfaces / "torus.json", tmp_path / "out"
+    opts = [*NCP, "--mode", "cnc"]
+    assert_clean_failure(capsys, ["ncp", str(src), "-o", str(out), *opts, "--strict"], 4,
+                         ["level-set fit of family 1 did not converge", "--levelset-ctrl",
+                          "--omega-f"], [out])
+    code, stdout, err = _run(capsys, ["ncp", str(src), "-o", str(out), *opts, "--json"])
+    assert code == 0, err
+    summary = json.loads(stdout)
+    assert summary["converged"] is False
+    assert "level-set fit 1" in summary["not converged"]
+    assert "level-set fit 3" in summary["not converged"]
+
+
 def test_ncp_reports_an_unconverged_post_optimization(tmp_path, capsys, surfaces):
     src, out = surfaces / "torus.json", tmp_path / "out"
     opts = _without(NCP, "--rounds") + ["--rounds", "0", "--mode", "cnc"]
@@ -420,20 +467,61 @@ def test_gg_unconverged_design_is_an_error_unless_allowed(tmp_path, capsys):
 
 # --------------------------------------------------------------------------- unwritable output
 
+def _make_read_only(d: Path) -> bool:
+    """Make directory ``d`` unwritable: mode 0o500, or, where root ignores the mode, the
+    immutable attribute (``chattr +i``). Returns whether ``d`` is now unwritable."""
+    d.chmod(0o500)
+    if not os.access(d, os.W_OK):
+        return True
+    if shutil.which("chattr"):
+        subprocess.run(["chattr", "+i", str(d)], capture_output=True, check=False)
+    return not os.access(d, os.W_OK)
+
+
+def _make_writable(d: Path) -> None:
+    """Undo :func:`_make_read_only` (so that pytest can remove ``d``)."""
+    if shutil.which("chattr"):
+        subprocess.run(["chattr", "-i", str(d)], capture_output=True, check=False)
+    d.chmod(0o700)
+
+
+@pytest.fixture
+def read_only_dir(tmp_path, monkeypatch):
+    """``make(path)``: make the directory ``path`` unwritable for the rest of the test. Where
+    neither the mode nor the immutable attribute has an effect (root on a file system without
+    ``chattr``), the permission check of ``gridshell.atomic`` is told what a non-root user's
+    would answer: not writable."""
+    made: list[Path] = []
+
+    def make(d: Path) -> Path:
+        made.append(d)
+        if not _make_read_only(d):
+            import gridshell.atomic as atomic
+
+            real = os.access
+            monkeypatch.setattr(atomic.os, "access", lambda p, mode, *a, **k: False
+                                if Path(p).resolve() == d.resolve() and mode & os.W_OK
+                                else real(p, mode, *a, **k))
+        return d
+
+    yield make
+    for d in reversed(made):
+        _make_writable(d)
+
+
 @pytest.fixture
 def unwritable(tmp_path):
-    """A directory that cannot be written: a read-only one (chmod 0o500), or, where that has no
-    effect (running as root), a regular file standing where the directory should be."""
+    """A directory that cannot be written (:func:`_make_read_only`), or, where that is not
+    possible, a regular file standing where the directory should be."""
     d = tmp_path / "readonly"
     d.mkdir()
-    d.chmod(0o500)
-    if os.access(d, os.W_OK):  # root ignores the mode
-        d.chmod(0o700)
+    if not _make_read_only(d):
+        _make_writable(d)
         d.rmdir()
         d.write_text("a regular file, not a directory\n")
     yield d
     if d.is_dir():
-        d.chmod(0o700)
+        _make_writable(d)
 
 
 def _output_location(kind: str, tmp_path: Path, unwritable_dir: Path) -> Path:
@@ -473,6 +561,28 @@ def test_render_unwritable_rhino_file(tmp_path, capsys, unwritable, bundle, wher
                                   "--size", "100", "100"], 5, ["cannot write", ".3dm"],
                          [target])
     assert sorted(p.name for p in bundle.iterdir()) == before  # nothing rendered either
+
+
+def test_render_read_only_bundle(tmp_path, capsys, bundle, read_only_dir):
+    """render writes into the bundle: a read-only bundle is named before any rendering."""
+    b = tmp_path / "bundle"
+    shutil.copytree(bundle, b)
+    before = sorted(p.name for p in b.iterdir())
+    read_only_dir(b)
+    assert_clean_failure(capsys, ["render", str(b), "--no-sequence", "--size", "100", "100"],
+                         5, ["cannot write", "render.png", "not writable",
+                             "writable output location"], [b / "render.png"])
+    assert sorted(p.name for p in b.iterdir()) == before
+
+
+@pytest.mark.parametrize("where", ["under a file", "read-only directory"])
+def test_demo_unwritable_output(tmp_path, capsys, unwritable, where):
+    """The demo fails at once (it would run for minutes otherwise) and writes nothing."""
+    out = _output_location(where, tmp_path, unwritable)
+    assert_clean_failure(capsys, ["demo", "-o", str(out), "--quick"], 5,
+                         ["cannot", str(out), "writable output location"], [out])
+    if unwritable.is_dir():
+        assert list(unwritable.iterdir()) == []
 
 
 @pytest.mark.parametrize("command", ["gg", "phlw", "ncp"])
@@ -602,3 +712,60 @@ def test_absurd_bundle_parameters(tmp_path, capsys, bundle, command, options, wo
     before = sorted(p.name for p in b.iterdir())
     assert_clean_failure(capsys, argv, 2, words, [out])
     assert sorted(p.name for p in b.iterdir()) == before
+
+
+# --------------------------------------------------------------------------- the parser itself
+
+def test_no_command_prints_help_on_stderr_and_exits_2(capsys):
+    code, out, err = _run(capsys, [])
+    assert code == 2
+    assert out == ""
+    assert err.startswith("usage: gridshell")
+    for name in ("gg", "phlw", "ncp", "verify", "fabricate", "render", "demo"):
+        assert name in err
+    assert "error: give a command" in err
+
+
+def _choices(command: str, option: str) -> tuple:
+    from gridshell.cli.main import build_parser
+
+    parser = build_parser([command])
+    sub = next(a for a in parser._actions if a.dest == "command").choices[command]
+    action = next(a for a in sub._actions if option in a.option_strings)
+    return tuple(action.choices), action.default, action.help
+
+
+def _registries():
+    from fabrication import params as fp
+
+    from gridshell.ncp import phlw, pipeline
+
+    return [("phlw", "--mode", phlw, "MODES"), ("ncp", "--mode", pipeline, "KIND"),
+            ("fabricate", "--joints", fp, "JOINT_STYLES"), ("fabricate", "--axis", fp,
+                                                            "AXIS_PLACES"),
+            ("fabricate", "--dxf-version", fp, "DXF_VERSIONS")]
+
+
+@pytest.mark.parametrize("i", range(5), ids=lambda i: " ".join(_registries()[i][:2]))
+def test_choices_are_the_registries(i, monkeypatch):
+    command, option, module, name = _registries()[i]
+    registry = getattr(module, name)
+    choices, default, text = _choices(command, option)
+    assert choices == tuple(registry)
+    assert default in choices
+    assert all(c in text for c in choices)
+    # a choice the registry gains is offered without touching the CLI
+    grown = {**registry, "zz": "ZZ"} if isinstance(registry, dict) else (*registry, "zz")
+    monkeypatch.setattr(module, name, grown)
+    choices, _, text = _choices(command, option)
+    assert "zz" in choices and "zz" in text
+
+
+def test_a_command_builds_only_its_own_options():
+    """``gridshell gg`` does not import the fabrication package for fabricate's choices."""
+    code = ("import sys; from gridshell.cli.main import main\n"
+            "try:\n    main(['gg', '--help'])\nexcept SystemExit:\n    pass\n"
+            "print('fabrication' in sys.modules, 'gridshell.ncp.phlw' in sys.modules)")
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True)
+    assert res.stdout.split()[-2:] == ["False", "False"]

@@ -66,20 +66,31 @@ def test_portrait_sheet():
 
 
 def test_congruent_arcs_nest_in_stacks():
+    """Arcs of one circle (lamellae of different lengths) stack along their symmetry axis,
+    longest first, each dropped onto those below until it is ``gap`` from them: consecutive
+    parts of a stack are at least width + gap apart (their middles are normal to the drop)
+    and far less than a part's height - they nest."""
     parts, layout, params = _layout("CNC", sheet="600x400", gap=5)
     _assert_valid(layout, 5)
     assert layout.n_sheets == 1
-    # congruent arcs nest: consecutive ones in a stack are much closer than their height
-    on = sorted(layout.on_sheet(0), key=lambda p: p.polygon().bounds[1])
-    steps = [(q.polygon().bounds[1] - p.polygon().bounds[1], p.strip)
-             for p, q in zip(on[:-1], on[1:]) if abs(p.strip.length - q.strip.length) < 1e-6]
-    assert len(steps) >= 6
-    for dy, s in steps:
-        # two copies of an arc strip of half angle phi, shifted along the symmetry axis,
-        # are width + gap apart (normal to the arcs) at their ends when dy = (w + g) / cos phi
-        phi = s.length / (2 * s.axis.radius)
-        h = np.ptp(np.asarray(s.axis.point(np.linspace(s.s0, s.s1, 50), 10.0))[:, 1]) + 20
-        assert 25 - 1e-6 <= dy <= 25 / np.cos(phi) + 0.5 < h
+    stacks = {}
+    for p in layout.on_sheet(0):
+        x0, _, x1, _ = p.polygon().bounds
+        stacks.setdefault(round(0.5 * (x0 + x1), 3), []).append(p)   # centred in a stack
+    steps = 0
+    for ps in stacks.values():
+        ps.sort(key=lambda p: p.polygon().bounds[1])
+        for i in range(1, len(ps)):
+            p, q = ps[i - 1], ps[i]
+            assert q.strip.length <= p.strip.length + 1e-6       # longest first
+            dy = q.polygon().bounds[1] - p.polygon().bounds[1]
+            h = q.polygon().bounds[3] - q.polygon().bounds[1]
+            assert 25 - 1e-6 <= dy < h
+            # dropped as far as the gap allows: it touches the stack below at ~gap
+            below = shapely.unary_union([r.polygon(0.001) for r in ps[:i]])
+            assert 5 - 0.02 <= q.polygon(0.001).distance(below) <= 5 + 0.5
+            steps += 1
+    assert steps >= 6
 
 
 def test_ncp_pieces_stack_on_several_sheets():

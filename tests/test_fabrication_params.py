@@ -54,3 +54,13 @@ def test_defaults_are_the_papers_prototype():
     p = FabParams()
     assert (p.width, p.thickness, p.hole, p.sheet, p.scale) == (20, 1, 3, (600, 400), 0.1)
     assert p.mm_per_m == pytest.approx(100.0) and p.slot_width == pytest.approx(1.2)
+
+
+@pytest.mark.parametrize("kw,match", [({"axis": "edge"}, "--axis edge .* use --axis centre"),
+                                      ({"joints": "slots"}, "--joints slots needs orthogonal")])
+def test_tangent_lamellae_refuse_edge_axis_and_slots(kw, match):
+    """GG lamellae are tangent to the surface: no edge stands on it, no notch crosses them."""
+    params = FabParams(**kw)
+    with pytest.raises(InputError, match=match):
+        params.check_orientation("tangent", "GG")
+    params.check_orientation("orthogonal", "CNC")      # standing lamellae take both

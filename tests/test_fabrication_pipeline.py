@@ -1,5 +1,9 @@
 """Acceptance of issue #6 on synthetic GG, CNC and NCP bundles: files re-read, joint spacing,
-counts, no overlaps, NCP congruence, CNC radius."""
+counts, no overlaps, NCP congruence, CNC radius, assembly plan and sheet previews.
+
+Parts read back from the DXF are matched to lamellae by id: the report's ``pieces`` give each
+piece's lamella, sheet and placement, and the cut list its joint positions, so a part that
+carried another lamella's joints (or collapse position) fails."""
 from __future__ import annotations
 
 import json
@@ -8,9 +12,11 @@ import numpy as np
 import pytest
 import shapely
 import shapely.affinity
-from fab_cases import fit_circle, make_bundle, parabola_at, read_dxf_sheet
+from fab_cases import (fit_circle, make_bundle, match_pieces, parabola_at, parabola_band,
+                       plan_labels, read_cutlist, read_dxf_sheet, similarity_fit)
 
 from fabrication import FabParams, fabricate
+from gridshell.net import polyline_arclength
 
 MM = 100.0      # mm per design metre at 1:10
 R_DESIGN = 1.0  # CNC collapse radius, m
@@ -41,34 +47,17 @@ def _fabricate(kind, tmp_path_factory):
     return kind, b, out, rep, sheets
 
 
-def _design_spacings(b):
-    return [np.diff(lam.joint_s) * MM for lam in b.net.lamellae]
-
-
-def _match_all(measured, design, tol=0.05):
-    """Every measured spacing vector matches a distinct design lamella within ``tol`` mm."""
-    left = list(range(len(design)))
-    worst = 0.0
-    for m in measured:
-        errs = [(np.max(np.abs(m - design[i])) if len(design[i]) == len(m) else np.inf, i)
-                for i in left]
-        e, i = min(errs)
-        assert e <= tol, f"spacing {m} matches no design lamella (best error {e} mm)"
-        worst = max(worst, e)
-        left.remove(i)
-    assert not left
-    return worst
-
-
-def _part_spacing(kind, part):
-    H = part["holes"]
-    if kind == "GG":
-        return np.linalg.norm(np.diff(H, axis=0), axis=1)
-    if kind == "CNC":
-        c, _ = fit_circle(H)
-        ang = np.unwrap(np.arctan2(H[:, 1] - c[1], H[:, 0] - c[0]))
-        return np.abs(np.diff(ang)) * R_DESIGN * MM
-    raise AssertionError
+def test_the_synthetic_lamellae_differ():
+    """The cases distinguish lamellae: no two share their joint spacings (rows and columns
+    of the twisted saddle), and NCP lamellae start at different collapse positions."""
+    for kind, shape in (("GG", dict(nr=4, nc=5)), ("NCP", dict(nr=4, nc=4))):
+        b = make_bundle(kind, **shape)
+        d = [np.diff(lam.joint_s) * MM for lam in b.net.lamellae]
+        for i in range(len(d)):
+            for j in range(i + 1, len(d)):
+                assert len(d[i]) != len(d[j]) or np.max(np.abs(d[i] - d[j])) > 1.0
+    starts = [cs[0] for cs in b.collapse_s.values()]
+    assert np.min(np.diff(np.sort(starts))) * MM > 5.0
 
 
 def test_counts_of_strips_and_joint_marks(made):
@@ -77,32 +66,61 @@ def test_counts_of_strips_and_joint_marks(made):
     assert len(parts) == len(b.net.lamellae) == rep["n_strips"] == rep["n_pieces"]
     assert sum(len(p["holes"]) for p in parts) == sum(len(l.joints) for l in b.net.lamellae)
     assert rep["n_joint_marks"] == rep["n_design_joints"]
+    # one piece per lamella id, each found on its sheet with its own joint count
+    found = match_pieces(b, rep, sheets)
+    assert sorted(found) == sorted((int(lam.id), 1) for lam in b.net.lamellae)
+    for lam in b.net.lamellae:
+        assert len(found[(int(lam.id), 1)][0]["holes"]) == len(lam.joints)
+
+
+def _measured_spacing(kind, b, lam, holes):
+    """Distances (mm) between consecutive holes along the strip axis, measured on the DXF."""
+    if kind == "GG":
+        return np.linalg.norm(np.diff(holes, axis=0), axis=1)
+    if kind == "CNC":
+        c, r = fit_circle(holes)
+        ang = np.unwrap(np.arctan2(holes[:, 1] - c[1], holes[:, 0] - c[0]))
+        return np.abs(np.diff(ang)) * r
+    # NCP: align the holes (rigidly) to the analytic parabola in mm at this lamella's
+    # collapse positions, then read their arc lengths along the parabola
+    x = np.linspace(-1.5, 1.5, 200001)
+    C = np.stack([x, 0.6 * x ** 2], 1) * MM
+    s_curve = np.concatenate([[0], np.cumsum(np.linalg.norm(np.diff(C, axis=0), axis=1))])
+    expect = parabola_at(b.collapse_s[lam.id]) * MM
+    R, t = _kabsch(holes, expect)
+    A = holes @ R.T + t
+    assert np.max(np.linalg.norm(A - expect, axis=1)) < 0.05
+    idx = [np.argmin(np.linalg.norm(C - a, axis=1)) for a in A]
+    return np.diff(s_curve[idx])
 
 
 def test_joint_spacing_equals_design_arc_length(made):
+    """Each lamella's part (found by id) has its own design spacings within 0.05 mm, and the
+    cut list row of that id says the same."""
     kind, b, out, rep, sheets = made
-    parts = [p for _, ps in sheets for p in ps]
-    design = _design_spacings(b)
-    if kind in ("GG", "CNC"):
-        worst = _match_all([_part_spacing(kind, p) for p in parts], design)
-    else:
-        # NCP: align each part's holes to the analytic parabola (mm) at the design's
-        # collapse positions, then read their arc lengths along the parabola
-        x = np.linspace(-1.5, 1.5, 200001)
-        C = np.stack([x, 0.6 * x ** 2], 1) * MM
-        s_curve = np.concatenate([[0], np.cumsum(np.linalg.norm(np.diff(C, axis=0), axis=1))])
-        lam = b.net.lamellae[0]
-        expect = parabola_at(b.collapse_s[lam.id]) * MM
-        measured = []
-        for p in parts:
-            H = p["holes"]
-            R, t = _kabsch(H, expect)
-            A = H @ R.T + t
-            assert np.max(np.linalg.norm(A - expect, axis=1)) < 0.05
-            idx = [np.argmin(np.linalg.norm(C - a, axis=1)) for a in A]
-            measured.append(np.diff(s_curve[idx]))
-        worst = _match_all(measured, design, tol=0.05)
+    found = match_pieces(b, rep, sheets)
+    rows = read_cutlist(out / "cutlist.csv")
+    worst = 0.0
+    for lam in b.net.lamellae:
+        part, _ = found[(int(lam.id), 1)]
+        design = np.diff(lam.joint_s) * MM
+        measured = _measured_spacing(kind, b, lam, part["holes"])
+        worst = max(worst, float(np.max(np.abs(measured - design))))
+        row = rows[(int(lam.id), 1)]
+        assert int(row["family"]) == lam.family and int(row["n_joints"]) == len(lam.joints)
+        assert np.diff(row["joint_positions_mm"]) == pytest.approx(design, abs=2e-3)
+        assert float(row["axis_length_mm"]) == pytest.approx(lam.length * MM, abs=2e-3)
     assert worst < 0.05
+
+
+def test_cutlist_sheet_and_piece_of_every_lamella(made):
+    kind, b, out, rep, sheets = made
+    rows = read_cutlist(out / "cutlist.csv")
+    assert sorted(rows) == sorted((int(lam.id), 1) for lam in b.net.lamellae)
+    for pc in rep["pieces"]:
+        row = rows[(pc["lamella"], pc["piece"])]
+        assert int(row["sheet"]) == pc["sheet"]
+        assert float(row["flat_length_mm"]) == pytest.approx(pc["flat_length_mm"], abs=2e-3)
 
 
 def _kabsch(P, Q):
@@ -159,15 +177,85 @@ def test_cnc_arcs_have_radius_one_over_n(tmp_path_factory):
 
 
 def test_ncp_strips_are_congruent(tmp_path_factory):
+    """Every NCP strip is the piece of one band around the collapse curve that its lamella's
+    collapse_s selects: the part found by id, moved rigidly onto its joints on the analytic
+    parabola, covers the analytic band between its ends (margins included)."""
     kind, b, out, rep, sheets = _made("NCP", tmp_path_factory)
-    parts = [p for _, ps in sheets for p in ps]
-    ref = parts[0]
-    for p in parts[1:]:
-        R, t = _kabsch(p["holes"], ref["holes"])
+    found = match_pieces(b, rep, sheets)
+    margin = rep["params"]["margin"] / MM
+    for lam in b.net.lamellae:
+        part, _ = found[(int(lam.id), 1)]
+        cs, js = b.collapse_s[lam.id], lam.joint_s
+        expect = parabola_at(cs) * MM
+        R, t = _kabsch(part["holes"], expect)
         ang = np.degrees(np.arctan2(R[1, 0], R[0, 0]))
-        moved = shapely.affinity.rotate(p["poly"], ang, origin=(0, 0))
+        assert np.linalg.det(R) > 0      # a rigid motion, no mirror image
+        moved = shapely.affinity.rotate(part["poly"], ang, origin=(0, 0))
         moved = shapely.affinity.translate(moved, *t)
-        assert moved.symmetric_difference(ref["poly"]).area < 0.02 * ref["poly"].length
+        u0 = cs[0] + min(0.0, js[0]) - js[0] - margin
+        u1 = cs[0] + max(lam.length, js[-1]) - js[0] + margin
+        ref = parabola_band(u0, u1, 10.0, MM)
+        assert moved.symmetric_difference(ref).area < 0.01 * ref.length
+
+
+def test_plan_shows_every_lamella_id_at_its_place(tmp_path_factory):
+    """plan.svg holds every lamella id once, at the projected midpoint of its axis: the label
+    anchors are a similar image (scale, rotation, reflection, shift) of the midpoints of the
+    axes projected onto the net's best-fitting plane, to a fraction of a point."""
+    kind, b, out, rep, sheets = _made("GG", tmp_path_factory)
+    labels = plan_labels(out / "plan.svg")
+    lams = b.net.lamellae
+    assert sorted(labels) == sorted(int(lam.id) for lam in lams)
+    X = np.concatenate([b.net.joints] + [lam.axis for lam in lams])
+    c = X.mean(axis=0)
+    E = np.linalg.svd(X - c)[2][:2]
+    mids = []
+    for lam in lams:
+        s = polyline_arclength(lam.axis)
+        mids.append([np.interp(s[-1] / 2, s, lam.axis[:, j]) for j in range(3)])
+    P = (np.array(mids) - c) @ E.T
+    Q = np.array([labels[int(lam.id)] for lam in lams])
+    _, res = similarity_fit(P, Q)
+    assert np.ptp(Q, axis=0).max() > 100          # spread over the plan (points)
+    assert res.max() < 0.05
+    # a swapped pair of ids would not fit
+    Q2 = Q.copy()
+    Q2[[0, -1]] = Q2[[-1, 0]]
+    assert similarity_fit(P, Q2)[1].max() > 10
+
+
+def test_sheet_previews(made):
+    """sheet_NN.png: listed in the report, the drawn sheet has the sheet's aspect ratio, the
+    CUT red lines cover where the DXF parts are, labels engraved in black, the title names the
+    sheet size and part count."""
+    from PIL import Image
+
+    from fabrication.preview import SHEET_FILL
+
+    kind, b, out, rep, sheets = made
+    W, H = rep["params"]["sheet"]
+    assert rep["previews"] == [f"sheet_{k + 1:02d}.png" for k in range(rep["n_sheets"])]
+    fill = np.array([int(SHEET_FILL[i:i + 2], 16) for i in (1, 3, 5)])
+    for name, (doc, parts) in zip(rep["previews"], sheets):
+        with Image.open(out / name) as im:
+            title = im.text["Title"]
+            img = np.asarray(im.convert("RGB")).astype(int)
+        assert f"{W:g} x {H:g} mm" in title and f"{len(parts)} parts" in title
+        rows, cols = np.nonzero(np.all(img == fill, axis=2))
+        r0, r1, c0, c1 = rows.min(), rows.max() + 1, cols.min(), cols.max() + 1
+        assert (c1 - c0) / (r1 - r0) == pytest.approx(W / H, rel=0.01)
+        assert c1 - c0 >= 800                                   # a readable size
+        red = (img[..., 0] > 200) & (img[..., 1] < 90) & (img[..., 2] < 90)
+        black = img.max(axis=2) < 90
+        assert red.sum() > 1000 and black[r0:r1, c0:c1].sum() > 100
+        # the red lines span the DXF parts' extent, mapped into the drawn sheet
+        x0, y0, x1, y1 = shapely.unary_union([p["poly"] for p in parts]).bounds
+        kx, ky = (c1 - c0) / W, (r1 - r0) / H
+        rr, cc = np.nonzero(red)
+        assert cc.min() == pytest.approx(c0 + x0 * kx, abs=3)
+        assert cc.max() == pytest.approx(c0 + x1 * kx, abs=3)
+        assert rr.min() == pytest.approx(r1 - y1 * ky, abs=3)
+        assert rr.max() == pytest.approx(r1 - y0 * ky, abs=3)
 
 
 def test_outputs_and_report(made):
@@ -176,6 +264,8 @@ def test_outputs_and_report(made):
     assert set(rep["files"]) == names
     assert {"cutlist.csv", "fabrication.json"} <= names
     assert ({"plan.png", "plan.svg"} <= names) == (kind == "GG")
+    assert {f"sheet_{k + 1:02d}{e}" for k in range(rep["n_sheets"])
+            for e in (".dxf", ".svg", ".png")} <= names
     stored = json.loads((out / "fabrication.json").read_text())
     assert stored["n_sheets"] == rep["n_sheets"] and 0 < stored["utilisation"] < 1
     assert not any(p.name.startswith(".") for p in out.parent.iterdir())

@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 from fab_cases import make_bundle, parabola_at
 
+from fabrication import fabricate
 from fabrication.axis import ArcAxis, CurveAxis, DenseCurve, LineAxis
 from fabrication.params import FabParams
 from fabrication.strips import strips_from_bundle
@@ -95,6 +96,22 @@ def test_ncp_curve_too_tight_for_the_width_is_an_input_error():
 def test_slots_need_orthogonal_lamellae():
     with pytest.raises(InputError, match="orthogonal"):
         strips_from_bundle(make_bundle("GG"), FabParams(joints="slots"))
+
+
+def test_edge_axis_needs_orthogonal_lamellae(tmp_path):
+    """--axis edge means the edge an orthogonal lamella stands on; GG strips refuse it (before
+    any file is written) and keep the axis on the centre line."""
+    b = make_bundle("GG")
+    with pytest.raises(InputError, match="tangent to the surface.*--axis centre"):
+        strips_from_bundle(b, FabParams(axis="edge"))
+    with pytest.raises(InputError, match="--axis edge"):
+        fabricate(b, tmp_path / "out", FabParams(axis="edge"), plan=False)
+    assert list(tmp_path.iterdir()) == []
+    s = strips_from_bundle(b, FabParams(axis="centre"))[0]
+    assert (s.t_lo, s.t_hi) == (-10.0, 10.0)
+    for kind in ("AA", "CNC", "NCP"):
+        s = strips_from_bundle(make_bundle(kind, nr=3, nc=3), FabParams(axis="edge"))[0]
+        assert 0.0 in (s.t_lo, s.t_hi) and s.t_hi - s.t_lo == 20.0
 
 
 def test_dense_curve_arclength_and_extension():

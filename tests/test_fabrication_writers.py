@@ -72,3 +72,77 @@ def test_svg_parses_and_measures_in_mm(cnc_bundle, tmp_path):
         pts = [shapely.Point(pt.x, 400 - pt.y)
                for pt in (p.point(t) for t in np.linspace(0, 1, 60))]
         assert min(max(pp["poly"].exterior.distance(q) for q in pts) for pp in parts) < 0.03
+
+
+@pytest.fixture(scope="module")
+def gg_bundle():
+    return make_bundle("GG")
+
+
+@pytest.mark.parametrize("joints", ["marks", "hole"])
+def test_gg_svg_round_trip_layers_colours_and_units(gg_bundle, tmp_path, joints):
+    """A GG (straight strips) sheet read back with svgelements: width/height in mm equal the
+    viewBox (1 unit = 1 mm), SCORE lines pure #0000FF, CUT #FF0000, ENGRAVE #000000, hairline
+    strokes, no fill; and the same outlines, holes, score lines and strokes as the DXF."""
+    import xml.etree.ElementTree as ET
+
+    from svgelements import SVG, Circle, Line, Move, Path, Polyline, Shape, SimpleLine
+
+    W, H = 500, 300
+    rep = fabricate(gg_bundle, tmp_path / "f", FabParams(joints=joints, sheet=f"{W}x{H}"),
+                    plan=False)
+    ns = "{http://www.w3.org/2000/svg}"
+    expect = {"CUT": "#FF0000", "SCORE": "#0000FF", "ENGRAVE": "#000000"}
+    tags = {"CUT": {"path", "circle"}, "SCORE": {"line"}, "ENGRAVE": {"polyline"}}
+    for k in range(rep["n_sheets"]):
+        f = tmp_path / "f" / f"sheet_{k + 1:02d}.svg"
+        root = ET.parse(f).getroot()
+        assert (root.get("width"), root.get("height")) == (f"{W}mm", f"{H}mm")
+        assert [float(v) for v in root.get("viewBox").split()] == [0, 0, W, H]
+        # each layer group holds only its own elements, each in the layer's pure colour
+        groups = {g.get("id"): g for g in root.iter(f"{ns}g")}
+        assert set(groups) == set(expect)
+        for name, g in groups.items():
+            for e in g:
+                assert e.tag[len(ns):] in tags[name]
+                assert e.get("stroke") == expect[name] and e.get("fill") == "none"
+                assert float(e.get("stroke-width")) <= 0.05            # a hairline, mm
+        svg = SVG.parse(str(f), ppi=25.4)                                # 1 px = 1 mm
+        assert svg.width == pytest.approx(W, rel=1e-5) and svg.height == pytest.approx(H, rel=1e-5)
+        assert (svg.viewbox.width, svg.viewbox.height) == (W, H)
+        shapes = [e for e in svg.elements() if isinstance(e, Shape)]
+        assert all(e.fill is None or e.fill.value is None for e in shapes)
+        assert all(e.stroke_width == pytest.approx(0.025, rel=1e-3) for e in shapes)
+        lines = [e for e in shapes if isinstance(e, SimpleLine)]
+        strokes = [e for e in shapes if isinstance(e, Polyline)]
+        circles = [e for e in shapes if isinstance(e, Circle)]
+        outlines = [e for e in shapes if isinstance(e, Path) and not isinstance(e, Polyline)]
+        assert {e.stroke.hexrgb.upper() for e in lines} == ({"#0000FF"} if joints == "marks"
+                                                            else set())
+        assert {e.stroke.hexrgb.upper() for e in circles + outlines} == {"#FF0000"}
+        assert {e.stroke.hexrgb.upper() for e in strokes} == {"#000000"}
+        # the same geometry as the DXF, y flipped
+        doc, parts = read_dxf_sheet(tmp_path / "f" / f"sheet_{k + 1:02d}.dxf")
+        assert len(outlines) == len(parts)
+        for e in outlines:
+            V = np.array([(s.end.x, H - s.end.y) for s in e if isinstance(s, (Move, Line))])
+            P = shapely.Polygon(V)
+            best = min(parts, key=lambda q: q["poly"].symmetric_difference(P).area)
+            assert best["poly"].symmetric_difference(P).area < 1e-3 * P.length
+            assert best["poly"].bounds == pytest.approx(P.bounds, abs=1e-3)
+        S = np.array([[[l.x1, H - l.y1], [l.x2, H - l.y2]] for l in lines]).reshape(-1, 2, 2)
+        D = np.array([L for q in parts for L in q["scores"]]).reshape(-1, 2, 2)
+        C = np.array([[c.cx, H - c.cy] for c in circles]).reshape(-1, 2)
+        Hd = np.concatenate([q["holes"] for q in parts])
+        assert len(strokes) == sum(len(q["engrave"]) for q in parts) > 0
+        if joints == "marks":
+            assert len(S) == len(D) == sum(len(lam.joints) for lam in gg_bundle.net.lamellae)
+            assert len(C) == 0
+            key = lambda A: A[np.lexsort((A[:, 1], A[:, 0]))]       # noqa: E731
+            assert key(S.mean(axis=1)) == pytest.approx(key(D.mean(axis=1)), abs=1e-3)
+            assert np.linalg.norm(S[:, 1] - S[:, 0], axis=1) == pytest.approx(
+                np.full(len(S), 20.0), abs=1e-3)
+        else:
+            assert len(S) == 0 and len(C) == len(Hd) > 0
+            assert np.sort(C, axis=0) == pytest.approx(np.sort(Hd, axis=0), abs=1e-3)
+            assert all(c.rx == pytest.approx(1.5) for c in circles)

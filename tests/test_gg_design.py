@@ -130,6 +130,62 @@ def test_initial_grid_from_triangles_follows_a_3d_direction():
     assert np.ptp(P0[..., 0]) > 1.6 and np.ptp(P0[..., 1]) > 1.2
 
 
+def test_initial_grid_from_triangles_spans_the_whole_target():
+    # a helicoid as triangles: its free-boundary LSCM domain is far from a rectangle (the
+    # largest rectangle inside it covered 65 % of the surface); the map onto a square with the
+    # four corners of the boundary at its corners covers all of it, and - being close to
+    # conformal - follows the helicoid's own conformal coordinates (asinh(u / c), v): its
+    # lines are the rulings and the helices
+    c = 0.5
+    V, Q = _quads(helicoid_grid(25, 25, c=c))
+    T = np.concatenate([Q[:, [0, 1, 2]], Q[:, [0, 2, 3]]])
+    P0 = initial_grid(V, T, grid=(20, 16), direction=0.0)
+    X = P0.reshape(-1, 3)
+    F = grid_quads(20, 16)
+    area = 0.5 * np.linalg.norm(np.cross(X[F[:, 2]] - X[F[:, 0]], X[F[:, 3]] - X[F[:, 1]]),
+                                axis=1).sum()
+    exact = 2.0 * (np.sqrt(1 + c * c) + c * c * np.arcsinh(1 / c))   # int int sqrt(u^2 + c^2)
+    assert area > 0.98 * exact
+    # corners on the target's corners, every meridian a ruling (z = c v constant on it)
+    np.testing.assert_allclose(np.sort(P0[[0, 0, -1, -1], [0, -1, 0, -1], 2]), [0, 0, 1, 1],
+                               atol=1e-9)
+    assert np.ptp(P0[..., 2], axis=0).max() < 0.005
+    # direction 90: the helices become the meridians
+    P90 = initial_grid(V, T, grid=(16, 20), direction=90.0)
+    assert np.ptp(P90[..., 2], axis=1).max() < 0.005
+
+
+def test_initial_grid_on_a_round_target_and_the_rectangle_fallback(monkeypatch):
+    # an elliptic disk (no corners): corners at the extremes of +-s +-t, the grid spans it
+    from scipy.spatial import Delaunay
+
+    import gridshell.gg.initial as initial
+
+    r, th = np.meshgrid(np.linspace(0, 1, 9), np.linspace(0, 2 * np.pi, 41)[:-1], indexing="ij")
+    xy = np.unique(np.round(np.stack([1.5 * r * np.cos(th), r * np.sin(th)], -1)
+                            .reshape(-1, 2), 12), axis=0)
+    T = Delaunay(xy).simplices.astype(np.int64)
+    V = np.column_stack([xy, 0.5 * (1 - (xy[:, 0] / 1.5) ** 2 - xy[:, 1] ** 2)])
+
+    def area(P):
+        X, F = _quads(P)
+        return 0.5 * np.linalg.norm(np.cross(X[F[:, 2]] - X[F[:, 0]], X[F[:, 3]] - X[F[:, 1]]),
+                                    axis=1).sum()
+
+    target = 0.5 * np.linalg.norm(np.cross(V[T[:, 1]] - V[T[:, 0]], V[T[:, 2]] - V[T[:, 0]]),
+                                  axis=1).sum()
+    P0 = initial_grid(V, T, grid=(12, 10), direction=0.0)
+    assert area(P0) > 0.95 * target
+    m = P0[-1, :] - P0[0, :]          # meridians along x, the long axis, as asked
+    assert np.all(np.abs(m[:, 0]) > 2 * np.abs(m[:, 1]))
+    # if the square map folds, the largest rectangle inside the LSCM domain is used: inside
+    # the ellipse, about 2 / pi of its area
+    monkeypatch.setattr(initial, "_quad_domain", lambda *a: None)
+    R0 = initial_grid(V, T, grid=(12, 10), direction=0.0)
+    assert np.all((R0[..., 0] / 1.5) ** 2 + R0[..., 1] ** 2 <= 1 + 1e-9)
+    assert 0.5 * target < area(R0) < 0.75 * target
+
+
 # ----------------------------------------------------------------------------- bad input
 
 def _cylinder(R=6, C=8):

@@ -67,10 +67,24 @@ def test_write_gg_bundle(tmp_path):
     aligned, _ = collapse_gg(st["net"])
     b = DesignBundle(kind="GG", net=st["net"], aligned=aligned, surface_V=V, surface_F=F,
                      metrics=gg_metrics(st["net"], V, F))
-    out = write_gg(tmp_path / "b", b)
+    out = write_gg(tmp_path / "b", b, frames=3)
     assert (out / "preview.png").stat().st_size > 1000
     d = read_design_json(out)
     assert d["kind"] == "GG" and len(d["lamellae"]) == len(st["net"].lamellae)
+    # the alignment sequence: net.obj first, aligned.obj last, pictures and a GIF
+    from gridshell.quadmesh import read_configuration
+    from gridshell.render.sequence import read_sequence
+    frames, loops = read_sequence(out)
+    assert len(frames) == 4
+    np.testing.assert_array_equal(loops, st["net"].loops)
+    np.testing.assert_array_equal(frames[0], read_configuration(out / "net.obj")[0])
+    np.testing.assert_array_equal(frames[-1], read_configuration(out / "aligned.obj")[0])
+    assert len(list((out / "sequence").glob("frame_*.png"))) == 4
+    assert (out / "alignment.gif").read_bytes()[:6] in (b"GIF89a", b"GIF87a")
+    from PIL import Image
+    with Image.open(out / "states.png") as im:
+        assert im.width > 2.5 * im.height          # deployed, two states, collapsed in a row
+    assert not (write_gg(tmp_path / "c", b, preview=False, frames=0) / "sequence").exists()
 
 
 # ----------------------------------------------------------------------------- whole pipeline
@@ -97,6 +111,32 @@ def test_design_gg_on_a_helicoid():
     assert m["deviation"]["max"] < 1.0
     assert m["alignability"]["mean"] < 1.0 and m["alignability"]["max"] < 3.0
     assert m["geodesic_turning"] < 2.0
+    # the initial grid spans the whole target (the rectangle inside the LSCM domain of the
+    # helicoid covered 65 % of it): the design reaches the target's boundary
+    assert m["coverage"] > 98.0 and m["deviation_target"]["max"] < 1.0
+
+
+def test_two_way_deviation_and_coverage_on_a_helicoid_grid():
+    # an exact GG target given as a structured grid (rulings = meridians): the design is the
+    # target itself, in both directions and in area (closed form of the helicoid's area)
+    c = 0.5
+    V, F = _mesh(helicoid_grid(25, 25, c=c))
+    bundle, _ = design_gg((V, F), n_lamellae=6, crossing_angle=80.0, frames=0)
+    m = bundle.metrics
+    assert m["deviation"]["max"] < 0.01 and m["deviation_target"]["max"] < 0.2
+    assert m["coverage"] == pytest.approx(100.0, abs=0.5)
+    area = 2.0 * (np.sqrt(1 + c * c) + c * c * np.arcsinh(1 / c))   # int int sqrt(u^2+c^2)
+    from gridshell.metrics import surface_area
+    assert surface_area(bundle.surface_V, bundle.surface_F) == pytest.approx(area, rel=2e-3)
+    # the same design measured against a wider target (u in [-1.5, 1.5]) covers less of it
+    # and is far from its outer rulings: 0.5 m along a ruling
+    W, G = _mesh(helicoid_grid(37, 25, c=c, u=(-1.5, 1.5)))
+    wide = gg_metrics(bundle.net, bundle.surface_V, bundle.surface_F, target=(W, G))
+    area_w = 2.0 * (1.5 * np.sqrt(2.25 + c * c) + c * c * np.arcsinh(1.5 / c))
+    assert wide["coverage"] == pytest.approx(100 * area / area_w, rel=3e-3)
+    diag = np.linalg.norm(W.max(0) - W.min(0))
+    assert wide["deviation_target"]["max"] == pytest.approx(100 * 0.5 / diag, rel=5e-3)
+    assert wide["deviation"]["max"] < 0.01     # the one-way figure cannot see it
 
 
 def test_design_gg_on_a_dome_triangle_mesh():

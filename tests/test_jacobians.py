@@ -11,6 +11,7 @@ from gridshell.solver import TERMS
 from gridshell.solver.fdcheck import jacobian_error
 
 import fd_cases
+from fd_cases import term_name
 
 
 def _import_all_gridshell_modules():
@@ -34,14 +35,21 @@ CASES = _all_cases()
 
 
 def test_every_registered_term_has_a_case():
-    missing = sorted(set(TERMS) - set(CASES))
+    missing = sorted(set(TERMS) - {term_name(c) for c in CASES})
     assert not missing, f"terms without a finite-difference case: {missing}"
 
 
-@pytest.mark.parametrize("name", sorted(CASES))
-def test_jacobian_matches_finite_differences(name):
-    assert name in TERMS, f"case {name} names no registered term"
-    rng = np.random.default_rng(zlib.crc32(name.encode()))
-    layout, x, data = CASES[name](rng)
+def test_case_keys_name_a_term_and_a_variant():
+    assert term_name("a.b.f[cnc]") == "a.b.f" and term_name("a.b.f") == "a.b.f"
+    bad = [c for c in CASES if "[" in c and (not c.endswith("]") or c.endswith("[]"))]
+    assert not bad, f"malformed case keys (use module.function[variant]): {bad}"
+
+
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_jacobian_matches_finite_differences(case):
+    name = term_name(case)
+    assert name in TERMS, f"case {case} names no registered term"
+    rng = np.random.default_rng(zlib.crc32(case.encode()))
+    layout, x, data = CASES[case](rng)
     err = jacobian_error(TERMS[name], x, layout, data)
-    assert err < 1e-6, f"{name}: relative Jacobian error {err:.2e}"
+    assert err < 1e-6, f"{case}: relative Jacobian error {err:.2e}"

@@ -10,8 +10,9 @@ from gridshell.gg.clairaut import geodesic_net
 from gridshell.gg.mapback import map_to_revolution
 from gridshell.gg.revolution import rebuild_revolution
 from gridshell.grid import grid_quads
-from gridshell.metrics import (alignability_error, alignability_error_arc, delta_l, delta_n,
-                               deviation, geodesic_turning)
+from gridshell.metrics import (alignability_error, alignability_error_arc, coverage, delta_l,
+                               delta_n, deviation, geodesic_turning, smooth_grid_normals,
+                               surface_area, target_deviation)
 from gridshell.net import Lamella, Net
 
 
@@ -109,3 +110,99 @@ def test_geodesic_turning_of_parallels_and_meridians_on_a_sphere():
                                np.cos(t + 0.2)], 1)
     assert geodesic_turning([parallel], V, F)["ratio"] == pytest.approx(np.cos(theta), abs=2e-3)
     assert geodesic_turning([meridian], V, F)["ratio"] < 2e-3
+
+
+# ----------------------------------------------------------------------------- GG figures
+
+
+def _helicoid_mesh(u, v, c=0.5):
+    U, W = np.meshgrid(u, v, indexing="ij")
+    P = np.stack([U * np.cos(W), U * np.sin(W), c * W], axis=-1)
+    return P.reshape(-1, 3), grid_quads(len(u), len(v))
+
+
+def _helicoid_area(u0, u1, v_len, c=0.5):
+    """Closed form: int int sqrt(u^2 + c^2) du dv."""
+    F = lambda u: 0.5 * (u * np.sqrt(u * u + c * c) + c * c * np.arcsinh(u / c))  # noqa: E731
+    return v_len * (F(u1) - F(u0))
+
+
+def test_coverage_and_target_deviation_of_a_shrunken_patch():
+    # target: helicoid u in [-1, 1]; design: its middle u in [-0.5, 0.5], same v range
+    v = np.linspace(0.0, 2.0, 81)
+    tV, tF = _helicoid_mesh(np.linspace(-1, 1, 41), v)
+    V, F = _helicoid_mesh(np.linspace(-0.5, 0.5, 21), v)
+    assert surface_area(tV, tF) == pytest.approx(_helicoid_area(-1, 1, 2.0), rel=1e-3)
+    expected = 100 * _helicoid_area(-0.5, 0.5, 2.0) / _helicoid_area(-1, 1, 2.0)
+    assert coverage(V, F, tV, tF) == pytest.approx(expected, rel=2e-3)
+    assert coverage(tV, tF, tV, tF) == pytest.approx(100.0)
+    diag = np.linalg.norm(tV.max(0) - tV.min(0))
+    # the one-way deviation sees nothing: the design lies on the target
+    assert deviation(V, tV, tF)["max"] < 1e-9
+    # the far rulings' ends are 0.5 m from the design's edge (straight rulings through the axis)
+    d = target_deviation(V, F, tV, tF)
+    assert d["diagonal"] == pytest.approx(diag)
+    assert d["max"] == pytest.approx(100 * 0.5 / diag, rel=1e-3)
+    # mean over the target's area: distance max(|u| - 0.5, 0) weighted by sqrt(u^2 + c^2)
+    u = np.linspace(-1, 1, 20001)
+    w = np.sqrt(u * u + 0.25)
+    mean = np.sum(np.maximum(np.abs(u) - 0.5, 0) * w) / np.sum(w)
+    assert d["mean"] == pytest.approx(100 * mean / diag, rel=2e-2)
+    assert target_deviation(tV, tF, tV, tF)["max"] < 1e-9
+
+
+def _catenoid_geodesics(n_phi=6):
+    """Exact geodesics of the catenoid r = cosh z (arc length s = sinh z), traced with
+    Clairaut's relation on the closed-form profile and mapped with the closed-form surface."""
+    from gg_cases import profile
+
+    from gridshell.gg.clairaut import trace_geodesic
+
+    r, _, z = catenoid(1.0)
+    axes = []
+    for phi0 in np.linspace(0.3, 1.7, n_phi):
+        for xi in (0.7, -0.7, 1.2):
+            s, phi, _ = trace_geodesic(profile(catenoid(1.0), -1.0, 1.0), 0.0, phi0, xi)
+            ok = (phi > 0) & (phi < 2)
+            axes.append(np.stack([r(s[ok]) * np.cos(phi[ok]), r(s[ok]) * np.sin(phi[ok]),
+                                  z(s[ok])], 1))
+    return axes
+
+
+def test_smooth_grid_normals_match_the_catenoid():
+    n = 13
+    P = revolution_grid(catenoid(1.0), np.linspace(-1.0, 1.0, n), np.linspace(0.0, 2.0, n))
+    V, F = P.reshape(-1, 3), grid_quads(n, n)
+    rng = np.random.default_rng(1)
+    s, phi = rng.uniform(-1, 1, 200), rng.uniform(0, 2, 200)
+    r, _, z = catenoid(1.0)
+    X = np.stack([r(s) * np.cos(phi), r(s) * np.sin(phi), z(s)], 1)
+    exact = np.stack([np.cos(phi), np.sin(phi), -s], 1) / np.sqrt(1 + s * s)[:, None]
+    N = smooth_grid_normals(X, V, F)
+    err = np.degrees(np.arccos(np.minimum(np.abs(np.einsum("ij,ij->i", N, exact)), 1.0)))
+    assert err.max() < 0.1                       # degrees, on a 13 x 13 grid
+    assert smooth_grid_normals(X, V, np.concatenate([F[:, :3], F[:, [0, 2, 3]]])) is None
+
+
+def test_geodesic_turning_of_exact_geodesics_with_smooth_normals():
+    # exact geodesics on a coarse catenoid grid: the interpolated mesh normals (first order)
+    # read about 1 %, the normals of the smooth surface through the grid < 0.2 %
+    axes = _catenoid_geodesics()
+    n = 13
+    P = revolution_grid(catenoid(1.0), np.linspace(-1.0, 1.0, n), np.linspace(0.0, 2.0, n))
+    V, F = P.reshape(-1, 3), grid_quads(n, n)
+    smooth = geodesic_turning(axes, V, F)
+    assert smooth["normals"] == "smooth" and smooth["ratio"] < 2e-3
+    mesh = geodesic_turning(axes, V, F, normals="mesh")
+    assert mesh["normals"] == "mesh" and mesh["ratio"] > 5 * smooth["ratio"]
+    # the other extreme: a helix u = 0.7 of the helicoid (u cos v, u sin v, c v) has the radial
+    # principal normal (-cos v, -sin v, 0), tangent to the surface (normal ~ (c sin v,
+    # -c cos v, u)): it bends in the surface only, ratio 1
+    Vh, Fh = _helicoid_mesh(np.linspace(-1, 1, 13), np.linspace(0, 2, 13))
+    t = np.linspace(0.05, 1.95, 300)
+    helix = np.stack([0.7 * np.cos(t), 0.7 * np.sin(t), 0.5 * t], 1)
+    assert geodesic_turning([helix], Vh, Fh)["ratio"] == pytest.approx(1.0, abs=2e-3)
+    with pytest.raises(InputError, match="structured quad grid"):
+        geodesic_turning(axes, V, np.concatenate([F[:, :3], F[:, [0, 2, 3]]]), normals="smooth")
+    with pytest.raises(InputError, match="normals must be"):
+        geodesic_turning(axes, V, F, normals="exact")

@@ -13,7 +13,8 @@ from hypothesis.extra.numpy import arrays
 from gridshell.bspline import basis_matrix
 from gridshell.grid import grid_quads
 from gridshell.igl_adapter import closest_points
-from gridshell.metrics import alignability_error, deviation
+from gridshell.metrics import alignability_error, delta_l, delta_n, deviation
+from gridshell.ncp.collapse import fit_circle, fit_plane, integrate_collapse, line_deviation
 from gridshell.net import polyline_arclength, polyline_length
 from gridshell.render.ribbons import ribbon_polygons
 from gridshell.solver.layout import Layout
@@ -200,3 +201,169 @@ def test_closest_point_distance_is_nonnegative_and_no_more_than_to_a_vertex(Z, P
     dev = deviation(P, V, F)
     assert 0 <= dev["mean"] <= dev["max"] * (1 + 1e-12)
     assert deviation(V, V, F)["max"] == pytest.approx(0.0, abs=1e-9)
+
+
+# --------------------------------------------------------------------------- Delta_l, Delta_n
+
+@st.composite
+def joint_meshes(draw):
+    """A joint mesh: ``n`` joints (a cycle plus random chords, every joint with neighbours),
+    unit rotation axes, and a length scale; positions from a seeded generator so that they
+    are in general position (no vanishing denominators of Delta_n)."""
+    n = draw(st.integers(4, 12))
+    rng = np.random.default_rng(draw(st.integers(0, 2**32 - 1)))
+    scale = draw(st.floats(0.01, 100))
+    V = scale * rng.normal(size=(n, 3))
+    cycle = np.stack([np.arange(n), (np.arange(n) + 1) % n], axis=1)
+    chords = rng.integers(0, n, size=(draw(st.integers(0, n)), 2))
+    E = np.vstack([cycle, chords[chords[:, 0] != chords[:, 1]]])
+    r = rng.normal(size=(n, 3))
+    r /= np.linalg.norm(r, axis=1)[:, None]
+    return V, r, E, scale
+
+
+def _neighbour_offset(V, r, E):
+    """``|<V_j - mean of the neighbours of j, r_j>|``: the denominator of Delta_n (paper 5.1)."""
+    n = len(V)
+    j, k = np.concatenate([E[:, 0], E[:, 1]]), np.concatenate([E[:, 1], E[:, 0]])
+    S = np.zeros_like(V)
+    np.add.at(S, j, V[k])
+    return np.abs(np.einsum("ij,ij->i", V - S / np.bincount(j, minlength=n)[:, None], r))
+
+
+@SETTINGS
+@given(joint_meshes(), st.integers(0, 2**32 - 1), st.integers(0, 2**32 - 1),
+       arrays(np.float64, 3, elements=coord), st.floats(0.01, 100))
+def test_delta_l_and_delta_n_vanish_on_equal_shapes_and_ignore_rigid_motions(mesh, s1, s2, t,
+                                                                           factor):
+    V, r, E, scale = mesh
+    assume(_neighbour_offset(V, r, E).min() > 1e-3 * scale)
+    t = t * scale                     # a translation of up to 100 times the mesh's size
+    # identical configurations: no change at all
+    assert np.all(delta_l(V, V, E) == 0)
+    assert np.all(delta_n(V, r, V, r, E) == 0)
+    # an aligned configuration that differs by a rigid motion (joints and axes turned alike)
+    Q = rotation(s1)
+    Va, ra = V @ Q.T + t, r @ Q.T
+    np.testing.assert_allclose(delta_l(V, Va, E), 0, atol=1e-9)
+    np.testing.assert_allclose(delta_n(V, r, Va, ra, E), 0, atol=1e-9)
+    # a genuine change: Delta_l and Delta_n are unchanged when either configuration moves
+    # rigidly and when both are scaled alike (they are relative changes)
+    W = V + 0.3 * scale * np.random.default_rng(s2).normal(size=V.shape)
+    w = np.random.default_rng(s2 + 1).normal(size=r.shape)
+    w /= np.linalg.norm(w, axis=1)[:, None]
+    dl, dn = delta_l(V, W, E), delta_n(V, r, W, w, E)
+    P = rotation(s2)
+    cases = [(V @ P.T - t, r @ P.T, W @ Q.T + t, w @ Q.T), (factor * V, r, factor * W, w)]
+    for Vs, rs, Wa, wa in cases:
+        np.testing.assert_allclose(delta_l(Vs, Wa, E), dl, rtol=1e-7, atol=1e-9)
+        np.testing.assert_allclose(delta_n(Vs, rs, Wa, wa, E), dn, rtol=1e-7, atol=1e-9)
+
+
+# --------------------------------------------------------------------------- circle and line fits
+
+def rotation_2d(angle: float) -> np.ndarray:
+    c, s = np.cos(angle), np.sin(angle)
+    return np.array([[c, -s], [s, c]])
+
+
+arc_fractions = st.lists(st.floats(0, 1), min_size=0, max_size=27)
+
+
+@SETTINGS
+@given(arrays(np.float64, 2, elements=coord), st.floats(0.01, 100), st.floats(0, 2 * np.pi),
+       st.floats(0.5, 2 * np.pi), arc_fractions)
+def test_fit_circle_recovers_a_circle(centre, radius, start, arc, fractions):
+    # the ends and the middle of an arc of at least 0.5 rad, and any points between
+    a = start + arc * np.array([0.0, 0.5, 1.0, *fractions])
+    P = centre + radius * np.stack([np.cos(a), np.sin(a)], axis=1)
+    c, R = fit_circle(P)
+    size = radius + np.abs(centre).max()
+    assert R == pytest.approx(radius, rel=1e-6, abs=1e-9 * size)
+    np.testing.assert_allclose(c, centre, atol=1e-6 * size)
+
+
+@SETTINGS
+@given(st.integers(0, 2**32 - 1), st.floats(0, 2 * np.pi),
+       arrays(np.float64, 2, elements=coord))
+def test_fit_circle_moves_with_the_points(seed, angle, t):
+    # noisy points on an arc: the fit is no longer exact, but a rigid motion moves it along
+    rng = np.random.default_rng(seed)
+    a = rng.uniform(0, rng.uniform(0.5, 2 * np.pi), size=rng.integers(3, 30))
+    P = np.stack([np.cos(a), np.sin(a)], axis=1) * (1 + 0.1 * rng.normal(size=(len(a), 1)))
+    P = 2.0 * P + rng.normal(size=2)
+    c, R = fit_circle(P)
+    Q = rotation_2d(angle)
+    c2, R2 = fit_circle(P @ Q.T + t)
+    assert R2 == pytest.approx(R, rel=1e-6)
+    np.testing.assert_allclose(c2, c @ Q.T + t, atol=1e-6 * (1 + np.abs(t).max() + R))
+
+
+@SETTINGS
+@given(st.integers(0, 2**32 - 1), st.integers(2, 3), st.floats(0.01, 100),
+       arrays(np.float64, 3, elements=coord), st.floats(0.01, 100))
+def test_line_deviation_of_a_line_is_zero_and_of_noise_is_invariant(seed, dim, span, t, factor):
+    rng = np.random.default_rng(seed)
+    d = rng.normal(size=dim)
+    d /= np.linalg.norm(d)
+    s = span * np.concatenate([[0.0, 1.0], rng.uniform(size=rng.integers(1, 20))])
+    o = t[:dim]
+    assert line_deviation(o + s[:, None] * d) < 1e-9
+    # noisy points: unchanged by a rigid motion and a uniform scaling
+    P = o + s[:, None] * d + 0.05 * span * rng.normal(size=(len(s), dim))
+    Q = rotation(seed)[:dim, :dim] if dim == 3 else rotation_2d(seed % 7)
+    ref = line_deviation(P)
+    assert line_deviation(factor * P @ Q.T + o) == pytest.approx(ref, rel=1e-6)
+
+
+@SETTINGS
+@given(points(3, 30), st.integers(0, 2**32 - 1), arrays(np.float64, 3, elements=coord))
+def test_fit_plane_holds_planar_points_and_moves_with_them(P, seed, t):
+    c, B, dist = fit_plane(P)
+    np.testing.assert_allclose(B @ B.T, np.eye(2), atol=1e-12)
+    # the plane's points: their coordinates in it and the distances give them back
+    X = c + ((P - c) @ B.T) @ B + dist[:, None] * np.cross(B[0], B[1])
+    size = 1 + np.abs(P).max()
+    np.testing.assert_allclose(X, P, atol=1e-9 * size)
+    # points put in a plane lie in their fitted plane
+    flat = P - np.outer((P - c) @ np.cross(B[0], B[1]), np.cross(B[0], B[1]))
+    assert np.abs(fit_plane(flat)[2]).max() < 1e-9 * size
+    # a rigid motion keeps the least sum of squared distances (the plane itself may be any
+    # of several when the points spread alike in two directions)
+    d2 = fit_plane(P @ rotation(seed).T + t)[2]
+    size = 1 + np.abs(P).max() + np.abs(t).max()
+    assert np.sum(d2 ** 2) == pytest.approx(np.sum(dist ** 2), abs=1e-9 * size ** 2)
+
+
+# --------------------------------------------------------------------------- collapse integration
+
+@SETTINGS
+@given(st.floats(0.001, 10).flatmap(lambda a: st.sampled_from([a, -a])),
+       st.lists(st.floats(0.01, 0.95), min_size=1, max_size=60))
+def test_constant_curvature_integrates_to_a_circle_of_radius_one_over_k(k, fractions):
+    # chords shorter than the diameter 2 / |k| (and than 10 m)
+    ell = np.minimum(np.asarray(fractions) * 2 / abs(k), 10 * np.asarray(fractions))
+    P, N = integrate_collapse(ell, np.full(len(ell) + 1, k))
+    # from the origin with tangent (1, 0), bending towards the normal (0, 1) where k > 0:
+    # the centre is (0, 1 / k)
+    C = np.array([0.0, 1 / k])
+    np.testing.assert_allclose(np.linalg.norm(P - C, axis=1), 1 / abs(k), rtol=1e-9)
+    np.testing.assert_allclose(N, k * (C - P), atol=1e-9)
+    np.testing.assert_allclose(np.linalg.norm(np.diff(P, axis=0), axis=1), ell,
+                               atol=1e-12 * ell.sum())
+
+
+@SETTINGS
+@given(st.lists(st.tuples(st.floats(0.001, 10), st.floats(-1, 1)), min_size=1, max_size=60),
+       st.floats(-1, 1))
+def test_collapse_integration_keeps_the_chord_lengths(steps, last):
+    # curvatures n with |n l / 2| <= 1 at both ends of every chord
+    ell = np.array([s[0] for s in steps])
+    lim = 2 / np.maximum(ell, np.concatenate([ell[1:], ell[-1:]]))
+    n = np.concatenate([[last * 2 / ell[0]], [s[1] for s in steps] * lim])
+    P, N = integrate_collapse(ell, n)
+    assert np.allclose(P[0], 0) and P.shape == (len(ell) + 1, 2)
+    # differences of a cumulative sum: rounding of the coordinates, not of the chords
+    np.testing.assert_allclose(np.linalg.norm(np.diff(P, axis=0), axis=1), ell,
+                               atol=1e-12 * ell.sum())
+    np.testing.assert_allclose(np.linalg.norm(N, axis=1), 1, atol=1e-12)

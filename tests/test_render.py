@@ -102,3 +102,60 @@ def test_sequence_missing(tmp_path):
     assert sequence_files(d) == []
     with pytest.raises(InputError, match="no sequence"):
         read_sequence(d)
+
+
+# ----------------------------------------------------------------------------- GG states
+
+
+def _states_case():
+    """A 4 x 4 joint grid of a dome shrinking onto a line: deployed, half-way, collapsed."""
+    from gridshell.grid import grid_quads
+
+    t = np.linspace(-1.0, 1.0, 4)
+    X, Y = np.meshgrid(t, t, indexing="ij")
+    V0 = np.stack([X, Y, 0.3 * (2 - X * X - Y * Y)], -1).reshape(-1, 3)
+    V2 = np.stack([X.ravel() + Y.ravel() + 3, np.zeros(16), np.zeros(16)], 1)
+    G = np.arange(16).reshape(4, 4)
+    E = np.concatenate([np.stack([G[:, :-1].ravel(), G[:, 1:].ravel()], 1),
+                        np.stack([G[:-1].ravel(), G[1:].ravel()], 1)])
+    fam = np.repeat([1, 3], len(E) // 2)
+    return [V0, 0.5 * (V0 + V2), V2], E, fam, grid_quads(4, 4)
+
+
+def test_state_images_share_one_crop_and_scale():
+    from gridshell.render.states import state_images
+
+    frames, E, fam, _ = _states_case()
+    imgs = state_images(frames, E, families=fam, dpi=60)
+    assert len({im.size for im in imgs}) == 1
+    a = [np.asarray(im, float) for im in imgs]
+    # cropped: content reaches close to every side of the common box in some state
+    ink = np.max([np.any(x < 200, axis=2) for x in a], axis=0)
+    rows, cols = np.flatnonzero(ink.any(1)), np.flatnonzero(ink.any(0))
+    assert rows[0] <= 12 and cols[0] <= 12
+    assert rows[-1] >= ink.shape[0] - 13 and cols[-1] >= ink.shape[1] - 13
+    # both family colours are drawn in the deployed state
+    assert _has_colour(a[0], FAMILY_COLOURS[1]) and _has_colour(a[0], FAMILY_COLOURS[3])
+
+
+def test_states_png_strip_and_sequence_pngs():
+    import io
+
+    from gridshell.render.states import sequence_pngs, state_images, states_png
+
+    frames, E, fam, _ = _states_case()
+    with Image.open(io.BytesIO(states_png(frames, E, labels=["deployed", "t = 0.5",
+                                                             "collapsed"], title="GG",
+                                          families=fam, dpi=60))) as im:
+        assert im.width > 2 * im.height
+        px = np.asarray(im.convert("L"), float)
+    ink = px < 200                         # not a white page with small pictures in it
+    rows, cols = np.flatnonzero(ink.any(1)), np.flatnonzero(ink.any(0))
+    assert (cols[-1] - cols[0]) > 0.9 * px.shape[1] and (rows[-1] - rows[0]) > 0.8 * px.shape[0]
+    pngs = sequence_pngs(frames, E, title="GG alignment", dpi=60)
+    sizes = {Image.open(io.BytesIO(b)).size for b in pngs}
+    assert len(pngs) == 3 and len(sizes) == 1
+    with pytest.raises(InputError, match="labels"):
+        states_png(frames, E, labels=["one"])
+    with pytest.raises(InputError, match="edge families"):
+        state_images(frames, E, families=fam[:3])

@@ -4,53 +4,40 @@ import pytest
 import scipy.optimize as so
 import scipy.sparse as sp
 
+from fd_cases.fixtures import circle_term, grid_quads, planarity_term, rosenbrock_term
+
 from gridshell.errors import ConvergenceError, InputError
-from gridshell.solver import Layout, Problem, result, solve
+from gridshell.solver import Layout, Problem, result, solve, term
 from gridshell.solver import terms as T
+from gridshell.solver.fdcheck import jacobian_error
 
 
-# -- test-only terms (not registered: they are fixtures, not project terms) -------------------
-def circle_term(x, layout, pts):
-    """r_i = |p_i - c| - R."""
-    c = layout.view(x, "c")
-    R = layout.view(x, "R")[0]
-    d = pts - c
-    nrm = np.linalg.norm(d, axis=1)
-    r = nrm - R
-    k = len(pts)
-    rows = np.repeat(np.arange(k), pts.shape[1] + 1)
-    d_ = pts.shape[1]
-    cols = np.concatenate([np.tile(layout.indices("c"), (k, 1)),
-                           np.full((k, 1), layout.indices("R")[0])], axis=1).ravel()
-    vals = np.concatenate([-d / nrm[:, None], -np.ones((k, 1))], axis=1).ravel()
-    return result(r, rows, cols, vals)
+def lm_solve(prob, x0, **kw):
+    """``solve`` with method "lm" (the default), checking what every LM run must satisfy: the
+    energy never increases, from ``energy0`` through every history record, and the per-term
+    energies of every accepted record sum to its energy."""
+    assert kw.get("method", "lm") == "lm"
+    res = solve(prob, x0, **kw)
+    E = [res.energy0] + [h["energy"] for h in res.history]
+    rises = [(k, a, b) for k, (a, b) in enumerate(zip(E, E[1:])) if b > a]
+    assert not rises, f"LM energy increased at (iteration, before, after) {rises}"
+    assert res.energy == pytest.approx(E[-1], rel=1e-14, abs=0)
+    assert_terms_sum_to_energy(res)
+    return res
 
 
-def planarity_term(x, layout, F):
-    """Per quad f with unit normal n_f: <V_b - V_a, n_f> = 0 on its 4 edges; |n_f|^2 = 1."""
-    V = layout.view(x, "V")
-    N = layout.view(x, "N")
-    Vi, Ni = layout.indices("V"), layout.indices("N")
-    a = F.ravel()
-    b = np.roll(F, -1, axis=1).ravel()
-    f = np.repeat(np.arange(len(F)), 4)
-    e = V[b] - V[a]
-    n = N[f]
-    r1 = np.einsum("ij,ij->i", e, n)
-    m = len(r1)
-    rows1 = np.repeat(np.arange(m), 9)
-    cols1 = np.concatenate([Vi[b], Vi[a], Ni[f]], axis=1).ravel()
-    vals1 = np.concatenate([n, -n, e], axis=1).ravel()
-    r2 = np.einsum("ij,ij->i", N, N) - 1.0
-    rows2 = m + np.repeat(np.arange(len(N)), 3)
-    return result(np.concatenate([r1, r2]), np.concatenate([rows1, rows2]),
-                  np.concatenate([cols1, Ni.ravel()]), np.concatenate([vals1, 2 * N.ravel()]))
+def assert_terms_sum_to_energy(res):
+    """The per-term energies of every accepted history record sum to its energy, and the
+    final report's to the final energy."""
+    for h in res.history:
+        if h["accepted"]:
+            assert sum(h["terms"].values()) == pytest.approx(h["energy"], rel=1e-12, abs=1e-300)
+    assert sum(r["energy"] for r in res.report.values()) == pytest.approx(res.energy, rel=1e-12,
+                                                                         abs=1e-300)
 
 
 def _grid(rows, cols):
-    i, j = np.meshgrid(np.arange(rows - 1), np.arange(cols - 1), indexing="ij")
-    v0 = (i * cols + j).ravel()
-    return np.stack([v0, v0 + 1, v0 + cols + 1, v0 + cols], axis=1)
+    return grid_quads(rows, cols)
 
 
 def test_layout_views_and_pack():
@@ -75,7 +62,7 @@ def test_circle_fit_reaches_zero_residual():
     lay = Layout({"c": 2, "R": 1})
     prob = Problem(lay).add("circle", 1.0, circle_term, pts)
     x0 = lay.pack({"c": [0.0, 0.0], "R": [1.0]})
-    res = solve(prob, x0, method="lm")
+    res = lm_solve(prob, x0, method="lm")
     assert res.converged, res.message
     assert res.energy < 1e-20
     assert np.allclose(lay.view(res.x, "c"), c, atol=1e-9)
@@ -94,17 +81,15 @@ def test_planarizes_a_perturbed_planar_quad_grid(method):
     lay = Layout({"V": V.shape, "N": N.shape})
     prob = Problem(lay).add("planarity", 1.0, planarity_term, F)
     corners = lay.indices("V")[[0, cols - 1, len(V) - cols, len(V) - 1]].ravel()
-    res = solve(prob, lay.pack({"V": V, "N": N}), fixed=corners, method=method, max_iter=100,
-                damping=1e-6)
+    run = lm_solve if method == "lm" else solve
+    res = run(prob, lay.pack({"V": V, "N": N}), fixed=corners, method=method, max_iter=100,
+              damping=1e-6)
+    assert_terms_sum_to_energy(res)
     assert res.converged, res.message
     rep = res.report
     assert rep["planarity"]["max"] < 1e-8
     # damped steps are small: the planar result stays near the perturbed input
     assert np.abs(lay.view(res.x, "V") - V).max() < 0.1
-    E = [h["energy"] for h in res.history if h["accepted"]]
-    if method == "lm":
-        assert all(b <= a * (1 + 1e-12) for a, b in zip([res.energy0] + E, E)), \
-            "LM energy increased"
 
 
 def test_fixed_variables_do_not_move():
@@ -114,7 +99,7 @@ def test_fixed_variables_do_not_move():
     prob = Problem(lay).add("close", 1.0, T.closeness, T.Closeness("V", target))
     x0 = np.zeros(lay.size)
     fixed = lay.indices("V")[:3].ravel()
-    res = solve(prob, x0, fixed=fixed)
+    res = lm_solve(prob, x0, fixed=fixed)
     X = lay.view(res.x, "V")
     assert np.all(X[:3] == 0)
     assert np.allclose(X[3:], target[3:], atol=1e-10)
@@ -128,16 +113,14 @@ def test_agrees_with_scipy_least_squares_on_noisy_circle():
     lay = Layout({"c": 2, "R": 1})
     prob = Problem(lay).add("circle", 1.0, circle_term, pts)
     x0 = lay.pack({"c": [1.5, 0.5], "R": [1.0]})
-    ours = solve(prob, x0, tol_rel=1e-14, max_iter=200)
-
-    def fun(x):
-        return prob.residuals(x)
-
-    def jac(x):
-        return prob.assemble(x).J
-
-    ref = so.least_squares(fun, x0, jac=jac, method="trf", xtol=1e-15, ftol=1e-15, gtol=1e-15)
-    assert np.allclose(ours.x, ref.x, atol=1e-7)
+    ours = lm_solve(prob, x0, tol_rel=1e-14, max_iter=200)
+    assert ours.converged, ours.message
+    # scipy differentiates the residual itself (2-point differences), so a wrong analytic
+    # Jacobian of ours cannot be shared by the reference
+    ref = so.least_squares(prob.residuals, x0, jac="2-point", method="trf", xtol=1e-15,
+                           ftol=1e-15, gtol=1e-15)
+    assert ref.success, ref.message
+    assert np.allclose(ours.x, ref.x, atol=1e-8)
     assert abs(ours.energy - 2 * ref.cost) < 1e-10
 
 
@@ -156,6 +139,7 @@ def test_linear_laplacian_term_smooths_to_a_plane():
     prob = Problem(lay).add("fair", 1.0, T.linear, T.Linear("V", L))
     fixed = lay.indices("V")[boundary].ravel()
     res = solve(prob, lay.pack({"V": V}), fixed=fixed, method="gn")
+    assert_terms_sum_to_energy(res)
     assert np.abs(lay.view(res.x, "V")[:, 2]).max() < 1e-9
 
 
@@ -163,7 +147,7 @@ def test_honest_non_convergence():
     pts = np.array([[np.cos(t), np.sin(t)] for t in np.linspace(0, 6, 40)])
     lay = Layout({"c": 2, "R": 1})
     prob = Problem(lay).add("circle", 1.0, circle_term, pts)
-    res = solve(prob, lay.pack({"c": [5.0, 5], "R": [0.1]}), max_iter=2)
+    res = lm_solve(prob, lay.pack({"c": [5.0, 5], "R": [0.1]}), max_iter=2)
     assert not res.converged
     assert "iteration limit" in res.message
     with pytest.raises(ConvergenceError, match="did not converge"):
@@ -195,3 +179,120 @@ def test_report_lists_every_term():
     a = prob.assemble(np.zeros(3))
     assert a.energies()["a"] == pytest.approx(6.0)
     assert sp.isspmatrix_csr(a.J)
+
+
+# -- the test-only terms' Jacobians, at the configurations the tests above solve from ---------
+
+def _noisy_circle_points():
+    rng = np.random.default_rng(3)
+    th = rng.uniform(0, np.pi, 25)
+    pts = np.stack([2 + 1.5 * np.cos(th), 1 + 1.5 * np.sin(th)], axis=1)
+    return pts + rng.normal(scale=0.05, size=pts.shape)
+
+
+def _perturbed_grid():
+    rng = np.random.default_rng(1)
+    rows, cols = 8, 9
+    u, v = np.meshgrid(np.linspace(0, 1, rows), np.linspace(0, 1, cols), indexing="ij")
+    V = np.stack([u.ravel(), v.ravel(), 0.2 * u.ravel() + 0.1 * v.ravel()], axis=1)
+    F = _grid(rows, cols)
+    N = rng.normal(size=(len(F), 3))
+    lay = Layout({"V": V.shape, "N": N.shape})
+    return lay, lay.pack({"V": V + rng.normal(scale=0.02, size=V.shape), "N": N}), F
+
+
+@pytest.mark.parametrize("case", ["circle", "planarity", "rosenbrock"])
+def test_test_terms_match_finite_differences(case):
+    if case == "circle":
+        lay = Layout({"c": 2, "R": 1})
+        fn, x, data = circle_term, lay.pack({"c": [1.5, 0.5], "R": [1.0]}), _noisy_circle_points()
+    elif case == "planarity":
+        fn, (lay, x, data) = planarity_term, _perturbed_grid()
+    else:
+        lay = Layout({"p": 2})
+        fn, x, data = rosenbrock_term, np.array([-1.2, 1.0]), None
+    err = jacobian_error(fn, x, lay, data)
+    assert err < 1e-6, f"{case}: relative Jacobian error {err:.2e}"
+
+
+def test_finite_difference_check_catches_a_wrong_jacobian():
+    lay = Layout({"c": 2, "R": 1})
+    x, pts = lay.pack({"c": [1.5, 0.5], "R": [1.0]}), _noisy_circle_points()
+
+    def wrong(x, layout, data):  # d/dR should be -1
+        res = circle_term(x, layout, data)
+        return res._replace(vals=np.where(res.cols == layout.indices("R")[0], 1.0, res.vals))
+
+    assert jacobian_error(wrong, x, lay, pts) > 0.1
+
+
+# -- registration --------------------------------------------------------------------------
+
+def unregistered_term(x, layout, data=None):
+    return result(x, np.arange(len(x)), np.arange(len(x)), np.ones(len(x)))
+
+
+def test_problem_takes_only_registered_terms():
+    prob = Problem(Layout({"c": 3}))
+    for fn, what in ((unregistered_term, "unregistered_term"), (lambda x, lay, d: None, "lambda"),
+                     (print, "print"), (42, "int")):
+        with pytest.raises(InputError, match=f"'bad'.*{what}.*not a registered solver term.*@"):
+            prob.add("bad", 1.0, fn)
+    assert prob.entries == []
+
+    # a function that merely shares the qualified name of a registered term is not it
+    def closeness(x, layout, data):
+        return T.closeness(x, layout, data)
+    closeness.__module__ = T.closeness.__module__
+    with pytest.raises(InputError, match="not a registered solver term"):
+        prob.add("impostor", 1.0, closeness)
+
+    # once registered (and given a case in tests/fd_cases), it is accepted
+    prob.add("ok", 1.0, T.closeness, T.Closeness("c", np.zeros((1, 3))))
+    assert [e.name for e in prob.entries] == ["ok"]
+
+
+
+# -- what x is, and why a solve stopped --------------------------------------------------------
+
+@pytest.mark.parametrize("method", ["gn", "guided"])
+def test_gn_and_guided_return_the_last_iterate_even_if_the_energy_rose(method):
+    """A full Gauss-Newton step on the Rosenbrock residual from (-1.2, 1) lands on (1, -3.84):
+    the energy rises from 24.2 to 2342; the next step reaches the minimum (1, 1)."""
+    lay = Layout({"p": 2})
+    prob = Problem(lay).add("rosenbrock", 1.0, rosenbrock_term)
+    x0 = np.array([-1.2, 1.0])
+    one = solve(prob, x0, method=method, max_iter=1, damping=1e-12)
+    assert one.energy0 == pytest.approx(24.2)
+    assert np.allclose(one.x, [1.0, -3.84], atol=1e-6)    # the last iterate, not the best (x0)
+    assert one.energy == pytest.approx(prob.energy(one.x)) and one.energy > 2000
+    assert one.history[-1]["accepted"] and not one.converged
+    assert_terms_sum_to_energy(one)
+    two = solve(prob, x0, method=method, max_iter=20, damping=1e-12)
+    assert two.converged and np.allclose(two.x, [1.0, 1.0], atol=1e-8)
+
+
+def test_lm_on_the_same_problem_never_rises():
+    lay = Layout({"p": 2})
+    prob = Problem(lay).add("rosenbrock", 1.0, rosenbrock_term)
+    res = lm_solve(prob, np.array([-1.2, 1.0]), max_iter=200)
+    assert res.converged, res.message
+    assert np.allclose(res.x, [1.0, 1.0], atol=1e-6)
+    assert all(h["energy"] <= 24.2 for h in res.history)
+
+
+@pytest.mark.parametrize("method", ["lm", "gn", "guided"])
+def test_a_singular_system_is_named_as_such(method):
+    """A point at the circle's centre: |p - c| is not differentiable there, its Jacobian row is
+    NaN and the damped system cannot be factored at any damping."""
+    pts = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [-1.0, 0.2]])
+    lay = Layout({"c": 2, "R": 1})
+    prob = Problem(lay).add("circle", 1.0, circle_term, pts)
+    x0 = lay.pack({"c": [0.0, 0.0], "R": [1.0]})
+    res = solve(prob, x0, method=method)
+    assert not res.converged
+    assert "singular at every damping" in res.message, res.message
+    assert "non-finite" not in res.message.split("(")[0]
+    assert np.array_equal(res.x, x0) and res.energy == res.energy0
+    with pytest.raises(ConvergenceError, match="singular"):
+        res.raise_if_failed("circle fit")

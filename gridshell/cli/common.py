@@ -4,7 +4,7 @@ from __future__ import annotations
 import json
 import sys
 import time
-from typing import Any, Callable
+from typing import Any, Callable, Iterable, Mapping
 
 
 class Progress:
@@ -27,6 +27,16 @@ class Progress:
     @property
     def callback(self) -> Callable[[str], None]:
         return self
+
+
+def choice_help(descriptions: Mapping[str, str], choices: Iterable[str], default: str,
+                describe: Callable[[str], str] | None = None) -> str:
+    """Help text of an option whose ``choices`` come from a registry: ``"a: what a does; b:
+    ...; default a"``, with ``describe(choice)`` or ``descriptions[choice]``. A choice the
+    registry gained but ``descriptions`` lacks is still listed, by name."""
+    describe = describe or (lambda c: descriptions.get(c, ""))
+    parts = [f"{c}: {describe(c)}" if describe(c) else str(c) for c in choices]
+    return "; ".join(parts) + f" (default {default})"
 
 
 def print_summary(args: Any, title: str, summary: dict[str, Any]) -> None:

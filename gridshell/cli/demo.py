@@ -1,15 +1,17 @@
 """``gridshell demo``: the whole product on the bundled meshes, in one output directory.
 
-1. **GG** on the freeform dome (``gridshell/data/dome.obj``): design, design bundle, verification
-   from the files, ribbons ``render.png``, the deployed and collapsed states, Rhino ``.3dm``,
-   DXF/SVG cut files, ``report.html``;
+1. **GG** on the freeform dome (``gridshell/data/dome.obj``): design, design bundle, alignment
+   sequence (``sequence/frame_*``, ``alignment.gif``, ``states.png``), verification from the
+   files, ribbons ``render.png``, Rhino ``.3dm``, DXF/SVG cut files, ``report.html``;
 2. **CNC** pavilion from the torus zone (``gridshell/data/torus_patch.obj``): PHLW step (mode
    ``cnc``, with its curvature diagram), net, collapse circle, post-optimization, alignment
    sequence (``sequence/frame_*``, ``alignment.gif``), colour maps, verification, render, Rhino
    ``.3dm``, cut files (arcs of one circle), ``report.html``.
 
 Everything is written into a temporary directory that replaces ``-o DIR`` only when all of it
-succeeded; ``DIR/demo.json`` holds the summary printed at the end.
+succeeded; ``DIR/demo.json`` holds the summary printed at the end. An existing non-empty ``DIR``
+without ``demo.json`` is refused before any work (:func:`gridshell.atomic.check_output`,
+exit code 5, as for the other commands).
 """
 from __future__ import annotations
 
@@ -26,11 +28,11 @@ MARKER = "demo.json"
 
 #: sizes of the full and the --quick demo
 SIZES: dict[str, dict[str, Any]] = {
-    "full": {"gg": {"grid": (16, 16), "n_lamellae": 8},
+    "full": {"gg": {"grid": (16, 16), "n_lamellae": 8, "frames": 12},
              "phlw": {"samples": (18, 18), "outer": 4, "max_iter": 40},
              "ncp": {"curves": 12, "samples": (48, 48), "collapse_samples": (1200, 1200),
                      "frames": 12, "postopt_rounds": 3}},
-    "quick": {"gg": {"grid": (12, 12), "n_lamellae": 6},
+    "quick": {"gg": {"grid": (12, 12), "n_lamellae": 6, "frames": 4},
               "phlw": {"samples": (10, 10), "outer": 1, "max_iter": 10},
               "ncp": {"curves": 8, "samples": (32, 32), "collapse_samples": (400, 400),
                       "frames": 4, "postopt_rounds": 2}},
@@ -51,49 +53,6 @@ def add_args(p: argparse.ArgumentParser) -> None:
                         "everything runs, in a fraction of the time)")
     p.add_argument("--only", choices=("gg", "ncp"),
                    help="run only the GG or only the NCP (CNC) part")
-
-
-def _check_output(out: Path) -> None:
-    from ..errors import InputError
-
-    if out.exists():
-        if not out.is_dir():
-            raise InputError(f"{out} exists and is not a directory; choose another -o")
-        if any(out.iterdir()) and not (out / MARKER).is_file():
-            raise InputError(f"{out} exists and is not the output of 'gridshell demo' (no "
-                             f"{MARKER}); choose another -o or remove it")
-
-
-def _states_png(V, aligned, F, title: str) -> bytes:
-    """One PNG of the deployed net (left) and its collapsed state (right), same axes."""
-    import io
-
-    from PIL import Image, ImageOps
-
-    from ..quadmesh import mesh_edges
-    from ..render import ncp_maps
-    from ..render.ribbons import view_angles
-
-    elev, azim = view_angles(V)
-    pngs = ncp_maps.sequence_frames([V, aligned], mesh_edges(F, len(V)), title=title,
-                                    dpi=110, elev=elev, azim=azim)
-    a, b = (Image.open(io.BytesIO(x)).convert("RGB") for x in pngs)
-    if a.size == b.size:  # crop the common white margin (same box: same scale in both)
-        boxes = [ImageOps.invert(im).getbbox() for im in (a, b)]
-        if all(boxes):
-            pad = 12
-            box = (max(min(bx[0] for bx in boxes) - pad, 0),
-                   max(min(bx[1] for bx in boxes) - pad, 0),
-                   min(max(bx[2] for bx in boxes) + pad, a.width),
-                   min(max(bx[3] for bx in boxes) + pad, a.height))
-            a, b = a.crop(box), b.crop(box)
-    gap = 24
-    img = Image.new("RGB", (a.width + gap + b.width, max(a.height, b.height)), "white")
-    img.paste(a, (0, 0))
-    img.paste(b, (a.width + gap, 0))
-    buf = io.BytesIO()
-    img.save(buf, format="PNG")
-    return buf.getvalue()
 
 
 def _agrees(v: dict, stored: dict, keys: tuple[tuple[str, str], ...]) -> bool:
@@ -140,7 +99,6 @@ def _finish(d: Path, label: str, name: str, fab_params: dict, progress) -> dict[
 
 def _gg(root: Path, sizes: dict, progress) -> dict[str, Any]:
     from .. import data
-    from ..atomic import write_bytes
     from ..gg.pipeline import design_gg, write_gg
     from .verify import verify_bundle
 
@@ -149,13 +107,10 @@ def _gg(root: Path, sizes: dict, progress) -> dict[str, Any]:
     progress(f"GG: designing a geodesic gridshell on {target.name} (grid "
              f"{sizes['grid'][0]} x {sizes['grid'][1]}, {sizes['n_lamellae']} lamellae)")
     bundle, report = design_gg(target, grid=sizes["grid"], n_lamellae=sizes["n_lamellae"],
-                               progress=progress.detail)
+                               frames=sizes["frames"], progress=progress.detail)
     d = root / "gg"
-    progress("GG: writing the design bundle and its pictures")
-    write_gg(d, bundle)
-    write_bytes(d / "states.png", _states_png(
-        bundle.net.joints, bundle.aligned, bundle.net.loops,
-        "GG deployed (0), collapsed (1):"))
+    progress("GG: writing the bundle, the alignment sequence, alignment.gif and states.png")
+    write_gg(d, bundle, sequence=report["sequence"], progress=progress.detail)
     progress("GG: verifying the bundle from its files")
     v = verify_bundle(d)
     fab = _finish(d, "GG", "gg", FABRICATION, progress)
@@ -166,6 +121,8 @@ def _gg(root: Path, sizes: dict, progress) -> dict[str, Any]:
         "joints": v["n_joints"], "loops": v["n_loops"],
         "delta_a": v["alignability"], "delta_a_arc": v["alignability_arc"],
         "geodesic_turning": v["geodesic_turning"], "deviation": v["deviation"],
+        "deviation_target": m["deviation_target"], "coverage": m["coverage"],
+        "frames": len(report["sequence"].V), "sequence_length_error": m["sequence_length_error"],
         "verified": _agrees(v, m, (("alignability", "alignability"),
                                    ("alignability_arc", "alignability_arc"))),
         "checks": _checks(m), "revolution": report["revolution"]["method"],
@@ -239,12 +196,17 @@ def _sheets(fab: dict) -> str:
 def _summary(out: Path, gg: dict | None, ncp: dict | None, total: float) -> dict[str, Any]:
     s: dict[str, Any] = {"output": str(out)}
     if gg is not None:
-        s["GG dome"] = f"{out / 'gg'}/ (report.html, render.png, states.png, gg.3dm, fabrication/)"
+        s["GG dome"] = (f"{out / 'gg'}/ (report.html, render.png, alignment.gif, states.png, "
+                        "gg.3dm, fabrication/)")
         s["GG lamellae / joints / loops"] = f"{gg['lamellae']} / {gg['joints']} / {gg['loops']}"
         s["GG Delta_a [%]"] = _mm(gg["delta_a"])
         s["GG Delta_a arc length [%]"] = _mm(gg["delta_a_arc"])
         s["GG geodesic turning [%]"] = gg["geodesic_turning"]
-        s["GG deviation from dome [% diag]"] = _mm(gg["deviation"])
+        s["GG deviation [% diag]"] = {"surface->dome max": gg["deviation"]["max"],
+                                      "dome->surface max": gg["deviation_target"]["max"],
+                                      "coverage %": gg["coverage"]}
+        s["GG alignment"] = (f"{gg['frames']} states, joint-to-joint lengths within "
+                             f"{gg['sequence_length_error']:.2g} % of the deployed net")
         s["GG paper thresholds"] = gg["checks"]
         s["GG cut files"] = _sheets(gg["fabrication"])
     if ncp is not None:
@@ -285,12 +247,11 @@ def _nested(summary: dict, gg: dict | None, ncp: dict | None) -> dict[str, Any]:
 
 
 def run(args: Any) -> int:
-    from ..atomic import atomic_dir, write_text
+    from ..atomic import atomic_dir, check_output, write_text
     from .common import Progress, print_summary
 
     progress = Progress(args)
-    out = Path(args.output)
-    _check_output(out)
+    out = check_output(args.output, marker=MARKER)
     sizes = SIZES["quick" if args.quick else "full"]
     t0 = time.perf_counter()
     gg = ncp = None

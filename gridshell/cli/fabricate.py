@@ -5,11 +5,25 @@ import argparse
 from pathlib import Path
 from typing import Any
 
+from .common import choice_help
+
 HELP = ("cut files of a design bundle: flat lamellae with joint holes, slots or marks and "
         "engraved ids, nested on sheets as DXF and SVG, with a cut list and an assembly plan")
 
 
+#: what each choice of the option sets of :mod:`fabrication.params` means (the choices and
+#: defaults come from there)
+AXIS_HELP = {"centre": "on the centre line",
+             "edge": "on one edge (orthogonal lamellae standing on the surface)"}
+JOINT_HELP = {"hole": "a hole on the axis",
+              "slots": "cross-halving notches (orthogonal lamellae)",
+              "marks": "score lines across the strip"}
+DXF_HELP = {"R2010": "AutoCAD 2010", "R12": "through ezdxf's R12 export"}
+
+
 def add_args(p: argparse.ArgumentParser) -> None:
+    from fabrication.params import AXIS_PLACES, DXF_VERSIONS, JOINT_STYLES, FabParams
+
     p.add_argument("bundle", metavar="DIR",
                    help="design bundle (output of 'gridshell gg' or 'ncp')")
     p.add_argument("-o", "--out", metavar="OUT",
@@ -19,15 +33,14 @@ def add_args(p: argparse.ArgumentParser) -> None:
     g.add_argument("--thickness", type=float, default=1.0, help="sheet thickness (default 1)")
     g.add_argument("--margin", type=float, default=15.0,
                    help="strip length beyond the end joints (default 15)")
-    g.add_argument("--axis", choices=("centre", "edge"), default="centre",
-                   help="lamella axis on the strip's centre line or on one edge (orthogonal "
-                        "lamellae standing on the surface); default centre")
+    g.add_argument("--axis", choices=AXIS_PLACES, default=FabParams.axis,
+                   help="place of the lamella axis on the strip: "
+                        + choice_help(AXIS_HELP, AXIS_PLACES, FabParams.axis))
     g.add_argument("--scale", default="1:10",
                    help="model scale, e.g. 1:10 (default), 1:1 or 0.1")
     g = p.add_argument_group("joints")
-    g.add_argument("--joints", choices=("hole", "slots", "marks"), default="hole",
-                   help="hole on the axis (default); slots: cross-halving notches (orthogonal "
-                        "lamellae); marks: score lines across the strip")
+    g.add_argument("--joints", choices=JOINT_STYLES, default=FabParams.joints,
+                   help=choice_help(JOINT_HELP, JOINT_STYLES, FabParams.joints))
     g.add_argument("--hole", type=float, default=3.0, help="hole diameter, mm (default 3)")
     g.add_argument("--clearance", type=float, default=0.2,
                    help="slot width = thickness + clearance, mm (default 0.2)")
@@ -41,8 +54,9 @@ def add_args(p: argparse.ArgumentParser) -> None:
                         "spacing plus two margins, so the pieces share two joints)")
     g.add_argument("--kerf", type=float, default=0.0,
                    help="laser kerf, mm: outlines move out and holes in by kerf/2 (default 0: off)")
-    g.add_argument("--dxf-version", choices=("R2010", "R12"), default="R2010",
-                   help="DXF version (default R2010; R12 through ezdxf's R12 export)")
+    g.add_argument("--dxf-version", choices=DXF_VERSIONS, default=FabParams.dxf_version,
+                   help="DXF version: " + choice_help(DXF_HELP, DXF_VERSIONS,
+                                                      FabParams.dxf_version))
     g.add_argument("--segments", action="store_true",
                    help="write arcs as short segments instead of bulges")
     g.add_argument("--no-labels", action="store_true", help="do not engrave ids")

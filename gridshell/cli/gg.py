@@ -24,6 +24,14 @@ def add_args(p: argparse.ArgumentParser) -> None:
                    help="lamellae per family crossing the reference parallel (default 10)")
     g.add_argument("--spacing", type=float, metavar="M",
                    help="spacing of the lamellae along the reference parallel, metres")
+    g.add_argument("--offsets", nargs="+", type=float, metavar="M",
+                   help="non-uniform spacing (paper Fig. 18): positions of the lamellae of both "
+                        "families on the reference parallel, metres of arc length from the "
+                        "first meridian, at least 2; --offsets1 / --offsets3 override one family")
+    p.add_argument("--offsets1", nargs="+", type=float, metavar="M",
+                   help="positions of the C1 lamellae only (metres, as --offsets)")
+    p.add_argument("--offsets3", nargs="+", type=float, metavar="M",
+                   help="positions of the C3 lamellae only (metres, as --offsets)")
     p.add_argument("--angle", type=float, default=90.0, metavar="DEG",
                    help="crossing angle of the two families on the reference parallel, "
                         "degrees (default 90)")
@@ -36,7 +44,32 @@ def add_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--allow-unconverged", action="store_true",
                    help="write the design even if the surface optimization misses its "
                         "tolerances (default: exit code 4, nothing written)")
-    p.add_argument("--no-preview", action="store_true", help="do not render preview.png")
+    p.add_argument("--frames", type=int, default=12, metavar="N",
+                   help="steps of the alignment sequence from the deployed to the collapsed net "
+                        "(sequence/frame_*.obj, with pictures alignment.gif and states.png); "
+                        "0: none (default 12)")
+    p.add_argument("--no-preview", action="store_true",
+                   help="do not render preview.png nor the pictures of the alignment sequence")
+
+
+def _offsets(args: Any) -> tuple[list[float], list[float]] | None:
+    """The (C1, C3) positions of ``--offsets`` / ``--offsets1`` / ``--offsets3``, validated."""
+    from ..errors import InputError
+    from ..gg.pipeline import check_offsets
+
+    o1 = args.offsets1 if args.offsets1 is not None else args.offsets
+    o3 = args.offsets3 if args.offsets3 is not None else args.offsets
+    if o1 is None and o3 is None:
+        return None
+    if args.lamellae is not None or args.spacing is not None:
+        raise InputError("--offsets1 / --offsets3 replace --lamellae and --spacing; give one way "
+                         "of placing the lamellae")
+    if o1 is None or o3 is None:
+        missing = "--offsets1" if o1 is None else "--offsets3"
+        raise InputError(f"{missing} is missing: give the positions of both families "
+                         "(--offsets for both, or --offsets1 and --offsets3)")
+    a1, a3 = check_offsets((o1, o3))
+    return a1.tolist(), a3.tolist()
 
 
 def run(args: Any) -> int:
@@ -44,19 +77,26 @@ def run(args: Any) -> int:
     from ..gg.pipeline import design_gg, write_gg
     from .common import Progress, print_summary
 
+    offsets = _offsets(args)
+    if not 0 <= args.frames <= 1000:
+        from ..errors import InputError
+        raise InputError(f"--frames must be in 0 .. 1000 (each state is an optimization), got "
+                         f"{args.frames}; e.g. 12")
     check_output(args.output, marker="design.json")
     progress = Progress(args)
     n = args.lamellae if args.lamellae is not None or args.spacing is not None else 10
     bundle, report = design_gg(args.target, meridians=args.meridians,
                                grid=tuple(args.grid) if args.grid else None,
                                direction=args.direction, n_lamellae=n, spacing=args.spacing,
-                               crossing_angle=args.angle, at_parallel=args.at,
+                               offsets=offsets, crossing_angle=args.angle, at_parallel=args.at,
                                rounds=args.rounds, polish_iter=args.polish,
                                allow_unconverged=args.allow_unconverged,
-                               progress=progress.callback)
+                               frames=args.frames, progress=progress.callback)
     progress(f"writing {args.output}")
-    out = write_gg(args.output, bundle, preview=not args.no_preview)
+    out = write_gg(args.output, bundle, preview=not args.no_preview,
+                   sequence=report["sequence"], frames=0, progress=progress.callback)
     m = bundle.metrics
+    seq = report["sequence"]
     summary = {
         "bundle": str(out),
         "surface optimization": "converged" if bundle.params["converged"]
@@ -67,8 +107,13 @@ def run(args: Any) -> int:
         "Delta_a arc [%]": m["alignability_arc"],
         "geodesic turning [%]": m["geodesic_turning"],
         "deviation [% diag]": m.get("deviation", {}),
+        "deviation target->surface [% diag]": m.get("deviation_target", {}),
+        "coverage [% of target area]": m.get("coverage", float("nan")),
         "surface of revolution": {"total_angle_deg": math.degrees(bundle.params["total_angle"]),
                                   "choice": report["revolution"]["method"]},
+        "alignment sequence": (f"{len(seq.V)} states, joint-to-joint lengths within "
+                               f"{m['sequence_length_error']:.2g} % of the deployed net"
+                               if seq is not None else "none (--frames 0)"),
     }
     print_summary(args, "GG design", summary)
     return 0

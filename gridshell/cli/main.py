@@ -5,7 +5,7 @@ import argparse
 import importlib
 import json
 import sys
-from typing import Sequence
+from typing import Iterable, Sequence
 
 from .. import __version__
 from ..errors import GridshellError
@@ -33,16 +33,24 @@ def _available() -> dict[str, object]:
     return mods
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The argument parser of every subcommand."""
+def build_parser(commands: Iterable[str] | None = None) -> argparse.ArgumentParser:
+    """The argument parser of the ``gridshell`` command.
+
+    ``commands``: the subcommands whose options are added (None: all). Every subcommand is
+    listed either way; :func:`main` adds the options of the one it runs only, because some
+    take their choices from registries whose modules are slow to import (``fabricate``).
+    """
     parser = argparse.ArgumentParser(
         prog="gridshell",
         description="Design alignable lamella gridshells: from a target surface to cut files.")
     parser.add_argument("--version", action="version", version=f"gridshell {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    wanted = None if commands is None else set(commands)
     for name, mod in _available().items():
         p = sub.add_parser(name, help=getattr(mod, "HELP", None),
                            description=getattr(mod, "HELP", None))
+        if wanted is not None and name not in wanted:
+            continue
         g = p.add_mutually_exclusive_group()
         g.add_argument("-v", "--verbose", action="count", default=0, help="more progress output")
         g.add_argument("-q", "--quiet", action="store_true", help="no progress output")
@@ -52,14 +60,24 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _requested(argv: Sequence[str]) -> list[str]:
+    """The subcommand named in ``argv`` (its first word that is not an option), if any."""
+    first = next((a for a in argv if not a.startswith("-")), None)
+    return [first] if first in SUBCOMMANDS else []
+
+
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run the CLI; returns the exit code (0 success, 2 bad input, 3 no net, 4 no convergence,
-    5 output not writable, 1 other tool error)."""
-    parser = build_parser()
+    """Run the CLI; returns the exit code (0 success, 2 bad input or no command, 3 no net,
+    4 no convergence, 5 output not writable, 1 other tool error; argparse exits with 2 on an
+    unknown option)."""
+    argv = sys.argv[1:] if argv is None else list(argv)
+    parser = build_parser(_requested(argv))
     args = parser.parse_args(argv)
     if not getattr(args, "command", None):
-        parser.print_help()
-        return 0
+        parser.print_help(sys.stderr)
+        print(f"\ngridshell: error: give a command, one of {', '.join(SUBCOMMANDS)} "
+              "(gridshell COMMAND --help describes its options)", file=sys.stderr)
+        return 2
     try:
         result = args._run(args)
     except GridshellError as exc:

@@ -4,19 +4,28 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
+from .common import choice_help
+
 HELP = ("trace a normal-curvature-preserving alignable net on a PHLW / CNC / PK surface, "
         "post-optimize it, simulate its alignment and write a design bundle (NCP, CNC or AA)")
 
+#: what each mode of :data:`gridshell.ncp.pipeline.KIND` designs (the choices come from KIND)
+MODE_HELP = {"phlw": "normal curvature per principal line",
+             "cnc": "one normal curvature, collapses into a circle",
+             "aa": "asymptotic net on a PK surface, collapses into a line"}
+
 
 def add_args(p: argparse.ArgumentParser) -> None:
+    from ..ncp.pipeline import KIND
+
     p.add_argument("reference", help="a surface.json written by 'gridshell phlw', or a reference "
                                      "mesh (OBJ, PLY, OFF): the PHLW step runs first")
     p.add_argument("-o", "--output", required=True, metavar="DIR",
                    help="output design bundle directory (replaced atomically)")
-    p.add_argument("--mode", choices=("phlw", "cnc", "aa"), default="phlw",
-                   help="phlw: normal curvature per principal line (kind NCP); cnc: one normal "
-                        "curvature, collapses into a circle (kind CNC); aa: asymptotic net on "
-                        "a PK surface, collapses into a line (kind AA); default phlw")
+    modes = tuple(KIND)
+    p.add_argument("--mode", choices=modes, default=modes[0],
+                   help=choice_help(MODE_HELP, modes, modes[0],
+                                    lambda m: f"{MODE_HELP.get(m, m)} (kind {KIND[m]})"))
     g = p.add_mutually_exclusive_group()
     g.add_argument("--curves", type=int, metavar="N",
                    help="curves per family, uniformly subdivided level values (default 10)")

@@ -4,19 +4,28 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
+from .common import choice_help
+
 HELP = ("optimize a B-spline towards a PHLW (phlw), constant-normal-curvature (cnc) or "
         "PK (aa) surface near a reference mesh; writes surface.json/.obj, rows.csv, "
         "report.json and the curvature diagram")
 
+#: what each mode of :data:`gridshell.ncp.phlw.MODES` optimizes towards (the choices come
+#: from MODES)
+MODE_HELP = {"phlw": "(n_u, t_u) per principal line",
+             "cnc": "one normal curvature n",
+             "aa": "n = 0, asymptotic net on a PK surface"}
+
 
 def add_args(p: argparse.ArgumentParser) -> None:
+    from ..ncp.phlw import MODES
+
     p.add_argument("reference", help="reference surface: a mesh (OBJ, PLY, OFF; a structured quad "
                                      "grid is fitted directly, rows -> u) or a B-spline .json")
     p.add_argument("-o", "--output", required=True, metavar="DIR",
                    help="output directory (replaced atomically)")
-    p.add_argument("--mode", choices=("phlw", "cnc", "aa"), default="phlw",
-                   help="phlw: (n_u, t_u) per principal line; cnc: one normal curvature n; "
-                        "aa: n = 0, asymptotic net on a PK surface (default phlw)")
+    p.add_argument("--mode", choices=MODES, default=MODES[0],
+                   help=choice_help(MODE_HELP, MODES, MODES[0]))
     p.add_argument("--degree", nargs=2, type=int, default=(4, 4), metavar=("DU", "DV"),
                    help="B-spline bi-degree (default 4 4)")
     p.add_argument("--ctrl", nargs=2, type=int, default=(9, 9), metavar=("NU", "NV"),

@@ -10,21 +10,33 @@ the meridian; meridians are ``P0[:, j]``, parallels ``P0[i, :]``.
   ``i*C + j``), ``"cols"`` gives back ``P``. A different ``grid=(R, C)`` resamples it
   bilinearly in the grid's index space.
 - A **triangle mesh** target is parameterized (:func:`gridshell.igl_adapter.parameterize_disk`,
-  LSCM); the parameter domain is turned so that the meridian ``direction`` runs along the first
-  axis, the largest axis-aligned rectangle inside the domain is sampled with ``R x C`` points,
-  and these are lifted to the surface by barycentric interpolation in their triangles.
+  LSCM) and the parameter domain turned so that the meridian ``direction`` runs along its first
+  axis ``s``. Four boundary corners are chosen (the target's own corners if its boundary has
+  four, else the extremes of ``+-s +-t``) and the target is mapped onto the unit square with
+  them at its corners, by two harmonic functions (cotangent weights; Dirichlet on two opposite
+  sides, free on the others): the side pair furthest apart along ``s`` bounds the meridians.
+  The map is close to conformal, so its grid lines follow the target (on a helicoid they are the
+  rulings and helices) and the grid spans the whole target. If that map folds, the largest
+  axis-aligned rectangle inside the LSCM domain is used instead (it can miss a third of a
+  target whose domain is far from a rectangle: 65 % coverage on a helicoid). ``R x C`` samples
+  of the square (or rectangle) are lifted to the surface by barycentric interpolation.
 """
 from __future__ import annotations
 
 from typing import Any
 
 import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.linalg import spsolve
 
 from ..errors import InputError, MeshError
 
 __all__ = ["initial_grid"]
 
 _MIN = 4
+
+#: boundary vertices with a smaller angle (degrees) between their boundary edges are corners
+_CORNER_ANGLE = 135.0
 
 
 def _mesh_arrays(target: Any, F: Any) -> tuple[np.ndarray, np.ndarray]:
@@ -114,8 +126,143 @@ def _direction_angle(direction: Any, V: np.ndarray, UV: np.ndarray) -> float:
     return float(np.arctan2(du[1], du[0]))
 
 
-def _from_triangles(V: np.ndarray, F: np.ndarray, grid: tuple[int, int] | None,
-                    direction: Any) -> np.ndarray:
+def _cotan_laplacian(V: np.ndarray, T: np.ndarray) -> sp.csr_matrix:
+    """Cotangent Laplacian ``L (n, n)`` of a triangle mesh (positive semi-definite:
+    ``x^T L x`` is twice the Dirichlet energy of the piecewise-linear ``x``)."""
+    n = len(V)
+    rows, cols, vals = [], [], []
+    for k in range(3):
+        i, j, o = T[:, (k + 1) % 3], T[:, (k + 2) % 3], T[:, k]  # edge (i, j) opposite o
+        a, b = V[i] - V[o], V[j] - V[o]
+        cross = np.linalg.norm(np.cross(a, b), axis=1)
+        w = 0.5 * np.einsum("ij,ij->i", a, b) / np.maximum(cross, 1e-300)
+        rows += [i, j, i, j]
+        cols += [j, i, i, j]
+        vals += [-w, -w, w, w]
+    return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                         shape=(n, n))
+
+
+def _harmonic(L: sp.csr_matrix, zero: np.ndarray, one: np.ndarray) -> np.ndarray:
+    """Harmonic function (``L x = 0`` inside) with ``x = 0`` on ``zero``, ``x = 1`` on ``one``
+    and a free (natural, zero-flux) boundary elsewhere."""
+    n = L.shape[0]
+    fixed = np.concatenate([zero, one])
+    val = np.concatenate([np.zeros(len(zero)), np.ones(len(one))])
+    free = np.setdiff1d(np.arange(n), fixed)
+    x = np.zeros(n)
+    x[fixed] = val
+    x[free] = spsolve(L[free][:, free].tocsc(), -(L[free][:, fixed] @ val))
+    return x
+
+
+def _corners(V: np.ndarray, loop: np.ndarray, ST: np.ndarray) -> np.ndarray:
+    """Four corners of a boundary loop (positions in ``loop``, increasing).
+
+    The four sharpest boundary vertices (3D angle between the two boundary edges below
+    :data:`_CORNER_ANGLE`, at least an eighth of the loop apart) if there are four; otherwise
+    (a smooth boundary) the extremes of ``+-s +-t`` in the parameter plane ``ST``.
+    """
+    nb = len(loop)
+    a = V[np.roll(loop, 1)] - V[loop]
+    b = V[np.roll(loop, -1)] - V[loop]
+    cos = np.einsum("ij,ij->i", a, b) / np.maximum(
+        np.linalg.norm(a, axis=1) * np.linalg.norm(b, axis=1), 1e-300)
+    ang = np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))
+    gap = max(1, nb // 8)
+    chosen: list[int] = []
+    for k in np.argsort(ang, kind="stable"):
+        if ang[k] >= _CORNER_ANGLE or len(chosen) == 4:
+            break
+        if all(min(abs(k - c), nb - abs(k - c)) >= gap for c in chosen):
+            chosen.append(int(k))
+    if len(chosen) < 4:
+        B = ST[loop]
+        chosen = [int(np.argmax(B @ np.array(w, float)))
+                  for w in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
+    return np.sort(np.array(chosen))
+
+
+def _quad_domain(V: np.ndarray, T: np.ndarray, loop: np.ndarray,
+                 ST: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """Map of the target onto the unit square with four boundary corners at its corners.
+
+    ``s`` and ``t`` are harmonic (cotangent weights) with ``s = 0`` / ``1`` on the two opposite
+    sides that lie furthest apart along the meridian direction (the first axis of ``ST``) and a
+    free boundary on the other two, ``t`` likewise across; together they approximate the
+    conformal map onto a rectangle, scaled to ``[0, 1]^2``, so the whole target is sampled
+    (the largest rectangle inside a free-boundary parameterization can miss a third of it).
+
+    Returns
+    -------
+    W : (n, 2) float or None
+        ``(s, t)`` of every vertex; None if the map folds (obtuse triangles can make cotangent
+        weights negative) or a side is degenerate.
+    lengths : (2,) float
+        Mean 3D length (metres) of the sides along ``s`` and along ``t``.
+    """
+    if len(loop) < 4:
+        return None
+    c = _corners(V, loop, ST)
+    if len(np.unique(c)) < 4:
+        return None
+    sides = [loop[c[k]:c[k + 1] + 1] if k < 3 else np.concatenate([loop[c[3]:], loop[:c[0] + 1]])
+             for k in range(4)]
+    centre = np.array([ST[sd].mean(axis=0) for sd in sides])
+    # the pair of opposite sides that are furthest apart along s are the ends of the meridians
+    k = int(np.argmax([abs(centre[2, 0] - centre[0, 0]), abs(centre[3, 0] - centre[1, 0])]))
+    s0, s1 = sides[k], sides[k + 2]
+    t0, t1 = sides[k + 1], sides[(k + 3) % 4]
+    if centre[k, 0] > centre[k + 2, 0]:
+        s0, s1 = s1, s0
+    if centre[k + 1, 1] > centre[(k + 3) % 4, 1]:
+        t0, t1 = t1, t0
+    L = _cotan_laplacian(V, T)
+    W = np.stack([_harmonic(L, s0, s1), _harmonic(L, t0, t1)], axis=1)
+    if not np.all(np.isfinite(W)):
+        return None
+    area = 0.5 * ((W[T[:, 1], 0] - W[T[:, 0], 0]) * (W[T[:, 2], 1] - W[T[:, 0], 1])
+                  - (W[T[:, 2], 0] - W[T[:, 0], 0]) * (W[T[:, 1], 1] - W[T[:, 0], 1]))
+    if not (np.all(area > 0) or np.all(area < 0)):
+        return None
+
+    def length(side: np.ndarray) -> float:
+        return float(np.linalg.norm(np.diff(V[side], axis=0), axis=1).sum())
+
+    lengths = np.array([0.5 * (length(t0) + length(t1)), 0.5 * (length(s0) + length(s1))])
+    return W, lengths
+
+
+def _lift(V: np.ndarray, T: np.ndarray, D: np.ndarray, Q: np.ndarray) -> np.ndarray:
+    """Points ``(k, 3)`` of the target at parameters ``Q (k, 2)`` of the parameterization
+    ``D (n, 2)``: barycentric interpolation in the closest parameter triangle (samples just
+    outside the domain are clamped onto its edge)."""
+    from ..igl_adapter import closest_points
+
+    D3 = np.concatenate([D, np.zeros((len(D), 1))], axis=1)
+    Q3 = np.concatenate([Q, np.zeros((len(Q), 1))], axis=1)
+    _, face, Cq = closest_points(Q3, D3, T)
+    tri = T[face]
+    A, B, C = D[tri[:, 0]], D[tri[:, 1]], D[tri[:, 2]]
+    e1, e2, p = B - A, C - A, Cq[:, :2] - A
+    det = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
+    det = np.where(np.abs(det) > 1e-300, det, 1e-300)
+    b1 = (p[:, 0] * e2[:, 1] - p[:, 1] * e2[:, 0]) / det
+    b2 = (e1[:, 0] * p[:, 1] - e1[:, 1] * p[:, 0]) / det
+    return ((1 - b1 - b2)[:, None] * V[tri[:, 0]] + b1[:, None] * V[tri[:, 1]]
+            + b2[:, None] * V[tri[:, 2]])
+
+
+def _default_size(ext: np.ndarray, n_vertices: int) -> tuple[int, int]:
+    """About ``sqrt(n_vertices)`` (8..40) grid vertices along the longer of the extents
+    ``(along the meridians, along the parallels)``, proportionally fewer along the other."""
+    N = int(np.clip(round(np.sqrt(n_vertices)), 8, 40))
+    R, C = (max(_MIN, int(round(N * e / ext.max()))) for e in ext)
+    return R, C
+
+
+def _from_triangles(V: np.ndarray, F: np.ndarray, loop: np.ndarray,
+                    grid: tuple[int, int] | None, direction: Any) -> np.ndarray:
     from ..igl_adapter import closest_points, closest_points_with_normals, parameterize_disk
 
     UV = parameterize_disk(V, F, method="lscm", normalize=False)
@@ -125,40 +272,36 @@ def _from_triangles(V: np.ndarray, F: np.ndarray, grid: tuple[int, int] | None,
     th = _direction_angle(direction, V, UV)
     d = np.array([np.cos(th), np.sin(th)])
     ST = np.stack([UV @ d, UV @ np.array([-d[1], d[0]])], axis=1)  # s along the meridians
-    UV3 = np.concatenate([ST, np.zeros((len(ST), 1))], axis=1)
-    # raster of the domain and the largest rectangle inside it
-    n = 96
-    lo, hi = ST.min(axis=0), ST.max(axis=0)
-    gs, gt = np.linspace(lo[0], hi[0], n), np.linspace(lo[1], hi[1], n)
-    S, Tt = np.meshgrid(gs, gt, indexing="ij")
-    Q = np.stack([S.ravel(), Tt.ravel(), np.zeros(S.size)], axis=1)
-    sq, _, _ = closest_points(Q, UV3, F)
-    # samples up to 2 % of the extent outside the domain are accepted (clamped onto its edge)
-    tol = (0.02 * max(hi - lo)) ** 2
-    r0, r1, c0, c1 = _largest_rectangle((sq <= tol).reshape(n, n))
-    s0, s1, t0, t1 = gs[r0], gs[r1], gt[c0], gt[c1]
-    if grid is None:
-        # about as many grid vertices along the longer side as sqrt(#vertices), 8..40
-        Lm = float(np.mean(np.linalg.norm(np.diff(V[F[:, [0, 1, 2, 0]]], axis=1), axis=2)))
-        Lp = float(np.mean(np.linalg.norm(np.diff(UV3[F[:, [0, 1, 2, 0]]], axis=1), axis=2)))
-        ext = np.array([s1 - s0, t1 - t0]) * Lm / Lp
-        N = int(np.clip(round(np.sqrt(len(V))), 8, 40))
-        R, C = (max(_MIN, int(round(N * e / ext.max()))) for e in ext)
+    quad = _quad_domain(V, F, loop, ST)
+    if quad is not None:
+        W, ext = quad
+        R, C = grid if grid is not None else _default_size(ext, len(V))
+        s, t = np.linspace(0.0, 1.0, R), np.linspace(0.0, 1.0, C)
+        D = W
     else:
-        R, C = grid
-    s, t = np.linspace(s0, s1, R), np.linspace(t0, t1, C)
+        # fallback: the largest axis-aligned rectangle inside a raster of the LSCM domain
+        UV3 = np.concatenate([ST, np.zeros((len(ST), 1))], axis=1)
+        n = 96
+        lo, hi = ST.min(axis=0), ST.max(axis=0)
+        gs, gt = np.linspace(lo[0], hi[0], n), np.linspace(lo[1], hi[1], n)
+        S, Tt = np.meshgrid(gs, gt, indexing="ij")
+        Q = np.stack([S.ravel(), Tt.ravel(), np.zeros(S.size)], axis=1)
+        sq, _, _ = closest_points(Q, UV3, F)
+        # samples up to 2 % of the extent outside the domain are accepted (clamped onto its edge)
+        tol = (0.02 * max(hi - lo)) ** 2
+        r0, r1, c0, c1 = _largest_rectangle((sq <= tol).reshape(n, n))
+        s0, s1, t0, t1 = gs[r0], gs[r1], gt[c0], gt[c1]
+        if grid is None:
+            Lm = float(np.mean(np.linalg.norm(np.diff(V[F[:, [0, 1, 2, 0]]], axis=1), axis=2)))
+            Lp = float(np.mean(np.linalg.norm(np.diff(UV3[F[:, [0, 1, 2, 0]]], axis=1),
+                                              axis=2)))
+            R, C = _default_size(np.array([s1 - s0, t1 - t0]) * Lm / Lp, len(V))
+        else:
+            R, C = grid
+        s, t = np.linspace(s0, s1, R), np.linspace(t0, t1, C)
+        D = ST
     Ss, Ts = np.meshgrid(s, t, indexing="ij")
-    Q = np.stack([Ss.ravel(), Ts.ravel(), np.zeros(Ss.size)], axis=1)
-    _, face, Cq = closest_points(Q, UV3, F)
-    tri = F[face]
-    A, B, D = ST[tri[:, 0]], ST[tri[:, 1]], ST[tri[:, 2]]
-    e1, e2, p = B - A, D - A, Cq[:, :2] - A
-    det = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
-    det = np.where(np.abs(det) > 1e-300, det, 1e-300)
-    b1 = (p[:, 0] * e2[:, 1] - p[:, 1] * e2[:, 0]) / det
-    b2 = (e1[:, 0] * p[:, 1] - e1[:, 1] * p[:, 0]) / det
-    P = ((1 - b1 - b2)[:, None] * V[tri[:, 0]] + b1[:, None] * V[tri[:, 1]]
-         + b2[:, None] * V[tri[:, 2]]).reshape(R, C, 3)
+    P = _lift(V, F, D, np.stack([Ss.ravel(), Ts.ravel()], axis=1)).reshape(R, C, 3)
     # orient the grid's quads (i,j),(i,j+1),(i+1,j+1),(i+1,j) like the target's faces
     nq = np.cross(P[:-1, 1:] - P[:-1, :-1], P[1:, :-1] - P[:-1, :-1]).reshape(-1, 3)
     _, N = closest_points_with_normals(P[:-1, :-1].reshape(-1, 3), V, F)
@@ -233,4 +376,4 @@ def initial_grid(target: Any, F: Any = None, *, meridians: str = "cols",
         return np.array(P, dtype=float)
     mesh = TriMesh(V, Fa)
     _check_disk(mesh)
-    return _from_triangles(mesh.V, mesh.F, grid, direction)
+    return _from_triangles(mesh.V, mesh.F, mesh.boundary_loops[0], grid, direction)

@@ -7,7 +7,8 @@ Stages (each usable alone):
    a mesh ``P (R, C, 3)`` isometric to a surface of revolution approximating the target (4.1.1);
 2. :func:`gg_net_from_mesh`: :func:`~gridshell.gg.revolution.rebuild_revolution`,
    :func:`~gridshell.gg.clairaut.geodesic_net`, :func:`~gridshell.gg.mapback.map_back` (4.1.2);
-3. :func:`collapse_gg`: the aligned (collapsed) configuration;
+3. :func:`collapse_gg`: the aligned (collapsed) configuration, and
+   :func:`gridshell.gg.simulate.gg_alignment_sequence`: the states between the two;
 4. :func:`gg_metrics`: paper 5.1 on the result.
 """
 from __future__ import annotations
@@ -23,14 +24,16 @@ from scipy.sparse.linalg import lsqr
 from ..bundle import DesignBundle, write_bundle
 from ..errors import ConvergenceError, InputError
 from ..grid import grid_quads
-from ..metrics import (alignability_error, alignability_error_arc, deviation, geodesic_turning,
-                       summary)
+from ..metrics import (alignability_error, alignability_error_arc, coverage, delta_l, deviation,
+                       geodesic_turning, summary, target_deviation)
 from ..net import Net
 from .clairaut import IntrinsicNet, geodesic_net
 from .mapback import map_back, map_to_revolution
 from .revolution import rebuild_revolution
+from .simulate import GGSequence, gg_alignment_sequence
 
-__all__ = ["collapse_gg", "design_gg", "gg_metrics", "gg_net_from_mesh", "write_gg"]
+__all__ = ["check_offsets", "collapse_gg", "design_gg", "gg_metrics", "gg_net_from_mesh",
+           "write_gg"]
 
 Progress = Callable[[str], None] | None
 
@@ -41,6 +44,49 @@ def _say(progress: Progress, msg: str) -> None:
 
 
 # ----------------------------------------------------------------------------- stages
+
+
+def check_offsets(offsets: Any) -> tuple[np.ndarray, np.ndarray]:
+    """Validate user-given lamella positions (non-uniform spacing, paper Fig. 18).
+
+    Parameters
+    ----------
+    offsets : (seq, seq)
+        Positions of the C1 and of the C3 curves on the reference parallel, metres of arc
+        length from the first meridian (values outside the parallel are allowed: an inclined
+        geodesic crossing the parallel's extension may still reach the surface).
+
+    Returns
+    -------
+    (o1, o3) : two sorted (k,) float arrays, metres
+
+    Raises
+    ------
+    InputError
+        Not a pair; a family with fewer than 2 positions; a value that is not a finite number;
+        two equal positions in one family.
+    """
+    if isinstance(offsets, (str, bytes)) or not hasattr(offsets, "__len__") or len(offsets) != 2:
+        raise InputError("offsets must be a pair (offsets of C1, offsets of C3) in metres")
+    out = []
+    for fam, o in zip((1, 3), offsets):
+        try:
+            a = np.asarray(o, dtype=float)
+        except (TypeError, ValueError):
+            raise InputError(f"offsets of C{fam} must be numbers (metres), got {o!r}") from None
+        if a.ndim != 1 or len(a) < 2:
+            raise InputError(f"offsets of C{fam}: give at least 2 positions (metres along the "
+                             f"reference parallel), got {a.size}")
+        if not np.all(np.isfinite(a)):
+            raise InputError(f"offsets of C{fam} must be finite numbers (metres), got "
+                             f"{a.tolist()}")
+        a = np.sort(a)
+        if np.any(np.diff(a) <= 0):
+            dup = a[1:][np.diff(a) <= 0][0]
+            raise InputError(f"offsets of C{fam}: position {dup:g} m is given twice; two "
+                             "lamellae of one family cannot lie on each other - remove one")
+        out.append(a)
+    return out[0], out[1]
 
 
 def gg_net_from_mesh(P: np.ndarray, *, n_lamellae: int | None = 10, spacing: float | None = None,
@@ -73,12 +119,12 @@ def gg_net_from_mesh(P: np.ndarray, *, n_lamellae: int | None = 10, spacing: flo
         (the same net on the surface of revolution).
     """
     P = np.asarray(P, float)
+    if offsets is not None:
+        offsets = check_offsets(offsets)
     _say(progress, f"rebuilding the surface of revolution of the {P.shape[0]} x {P.shape[1]} mesh")
     rev = rebuild_revolution(P, angle=angle)
     o1 = o3 = None
     if offsets is not None:
-        if len(offsets) != 2:
-            raise InputError("offsets must be a pair (offsets of C1, offsets of C3) in metres")
         s_star = rev.s[0] + at_parallel * (rev.s[-1] - rev.s[0])
         r_star = float(rev.r_of_s(s_star))
         o1 = np.asarray(offsets[0], float) / r_star + rev.phi[0]
@@ -161,9 +207,13 @@ def gg_metrics(net: Net, V: np.ndarray, F: np.ndarray, *, net_rev: Net | None = 
     dict
         ``alignability`` and ``alignability_arc`` (``{"mean", "max"}`` of ``Delta_a`` in %),
         ``alignability_revolution`` (the same net on the surface of revolution, if given),
-        ``geodesic_turning`` (ratio, %), and with a target ``deviation`` (the surface's
-        vertices) and ``deviation_joints`` (``{"mean", "max"}`` in % of the target's
-        bounding-box diagonal).
+        ``geodesic_turning`` (ratio, %, with the normals of the smooth surface through the grid
+        when ``(V, F)`` is one, see :func:`gridshell.metrics.geodesic_turning`), and with a
+        target: ``deviation`` (the surface's vertices from the target), ``deviation_joints``
+        (the joints from the target), ``deviation_target`` (the target from the surface: large
+        where the design does not reach the target's boundary), all ``{"mean", "max"}`` in % of
+        the target's bounding-box diagonal, and ``coverage`` (area of the surface / area of the
+        target, %).
     """
     out: dict[str, Any] = {
         "alignability": _pct(summary(alignability_error(net.joints, net.loops))),
@@ -179,6 +229,9 @@ def gg_metrics(net: Net, V: np.ndarray, F: np.ndarray, *, net_rev: Net | None = 
         dj = deviation(net.joints, tV, tF)
         out["deviation"] = {"mean": dv["mean"], "max": dv["max"]}
         out["deviation_joints"] = {"mean": dj["mean"], "max": dj["max"]}
+        dt = target_deviation(V, F, tV, tF)
+        out["deviation_target"] = {"mean": dt["mean"], "max": dt["max"]}
+        out["coverage"] = coverage(V, F, tV, tF)
     out["n_joints"] = int(len(net.joints))
     out["n_loops"] = int(len(net.loops))
     out["n_lamellae"] = {"C1": len(net.family(1)), "C3": len(net.family(3))}
@@ -208,7 +261,8 @@ def design_gg(target: Any, *, meridians: str = "cols", grid: tuple[int, int] | N
               offsets: tuple[Sequence[float], Sequence[float]] | None = None,
               weights: dict[str, float] | None = None, angle: float | None = None,
               rounds: int = 10, polish_iter: int = 20, allow_unconverged: bool = False,
-              progress: Progress = None) -> tuple[DesignBundle, dict[str, Any]]:
+              frames: int = 12, progress: Progress = None
+              ) -> tuple[DesignBundle, dict[str, Any]]:
     """Design a geodesic alignable gridshell on (an approximation of) a target surface.
 
     Parameters
@@ -231,6 +285,9 @@ def design_gg(target: Any, *, meridians: str = "cols", grid: tuple[int, int] | N
     allow_unconverged : bool
         Return a design whose surface optimization missed its tolerances (flagged in
         ``report["design"]["converged"]`` and ``bundle.params``) instead of raising.
+    frames : int
+        Steps of the alignment sequence from the deployed to the collapsed net
+        (:func:`gridshell.gg.simulate.gg_alignment_sequence`); 0: none.
     progress : callable, optional
         Receives one-line progress messages.
 
@@ -246,8 +303,16 @@ def design_gg(target: Any, *, meridians: str = "cols", grid: tuple[int, int] | N
         ``kind="GG"``; aligned = :func:`collapse_gg`; surface = the GG mesh; revolution = the
         isometric surface of revolution; metrics = :func:`gg_metrics`.
     report : dict
-        The surface optimization's report, the revolution's info and the collapse info.
+        The surface optimization's report, the revolution's info, the collapse info and
+        ``sequence`` (a :class:`~gridshell.gg.simulate.GGSequence`, or None with
+        ``frames=0``). With a sequence the metrics hold ``delta_l`` (``{"mean", "max"}``, %:
+        edge lengths of ``aligned`` against the deployed chords - lamellae straighten, so
+        chords lengthen to the arc lengths) and ``sequence_length_error`` (the largest such
+        change over all states, %).
     """
+    if offsets is not None:
+        offsets = check_offsets(offsets)  # before the long surface optimization
+        n_lamellae = spacing = None       # the offsets place every lamella
     V, F, target_path = _load_target(target)
     from .design import design_gg_surface
     from .initial import initial_grid
@@ -278,6 +343,14 @@ def design_gg(target: Any, *, meridians: str = "cols", grid: tuple[int, int] | N
     sV, sF = P.reshape(-1, 3), grid_quads(R, C)
     metrics = gg_metrics(net, sV, sF, net_rev=stage["net_rev"], target=(V, F))
     metrics["collapse_mismatch_max"] = collapse_info["mismatch_max"]
+    seq = None
+    if int(frames) > 0:
+        _say(progress, f"alignment sequence: {int(frames)} steps from deployed to collapsed")
+        seq = gg_alignment_sequence(net.joints, aligned, net.edges(), frames=int(frames),
+                                    progress=progress)
+        metrics["delta_l"] = _pct(summary(delta_l(net.joints, aligned, seq.edges)))
+        metrics["sequence_length_error"] = 100.0 * max(
+            float(np.nanmax(delta_l(net.joints, V, seq.edges))) for V in seq.V)
     rV, rF = rev.mesh()
     inet: IntrinsicNet = stage["inet"]
     params = {"target": target_path, "meridians": meridians, "grid": [int(R), int(C)],
@@ -286,28 +359,87 @@ def design_gg(target: Any, *, meridians: str = "cols", grid: tuple[int, int] | N
               "offsets": [list(map(float, o)) for o in offsets] if offsets else None,
               "weights": weights, "converged": design.converged, "dphi": rev.dphi,
               "total_angle": rev.total_angle,
-              "clairaut_c": inet.c, "s_star": inet.s_star}
+              "clairaut_c": inet.c, "s_star": inet.s_star, "frames": int(frames)}
     bundle = DesignBundle(kind="GG", net=net, aligned=aligned, surface_V=sV, surface_F=sF,
                           metrics=metrics, params=params, revolution_V=rV, revolution_F=rF)
     report = {"design": design_report, "revolution": rev.info, "collapse": collapse_info,
-              "net": inet.info}
+              "net": inet.info, "sequence": seq}
     return bundle, report
 
 
-def write_gg(path: str | Path, bundle: DesignBundle, *, preview: bool = True) -> Path:
-    """Write a GG design bundle (atomically), with ``preview.png``: the net on the designed
-    surface, loops coloured by the straight-edge ``Delta_a`` in %."""
+def _edge_families(net: Net, edges: np.ndarray) -> np.ndarray:
+    """Lamella family (1 or 3) of each joint-mesh edge ``(E, 2)`` (sorted pairs)."""
+    fam: dict[tuple[int, int], int] = {}
+    for lam in net.lamellae:
+        for a, b in zip(lam.joints[:-1].tolist(), lam.joints[1:].tolist()):
+            fam[(min(a, b), max(a, b))] = lam.family
+    return np.array([fam.get((int(min(a, b)), int(max(a, b))), 0) for a, b in edges], np.int64)
+
+
+def write_gg(path: str | Path, bundle: DesignBundle, *, preview: bool = True,
+             sequence: GGSequence | None = None, frames: int = 12,
+             progress: Progress = None) -> Path:
+    """Write a GG design bundle atomically.
+
+    Besides the bundle files (:func:`gridshell.bundle.write_bundle`): the alignment sequence
+    ``sequence/frame_000.obj ...`` (joints of every state with the net-loops as faces; the
+    first equals ``net.obj``, the last ``aligned.obj``), and with ``preview``: ``preview.png``
+    (the net on the designed surface, loops coloured by the straight-edge ``Delta_a`` in %),
+    ``sequence/frame_*.png``, ``alignment.gif`` and ``states.png`` (deployed, two intermediate
+    states and the collapsed net side by side).
+
+    Parameters
+    ----------
+    sequence : GGSequence, optional
+        The states to write (``report["sequence"]`` of :func:`design_gg`); computed with
+        ``frames`` steps when not given.
+    frames : int
+        Steps of a computed sequence; 0 writes none.
+    """
+    from ..quadmesh import write_mesh
+
+    net = bundle.net
     extra: dict[str, Any] = {}
+    if sequence is None and int(frames) > 0 and len(net.joints):
+        _say(progress, f"alignment sequence: {int(frames)} steps from deployed to collapsed")
+        sequence = gg_alignment_sequence(net.joints, bundle.aligned, net.edges(),
+                                         frames=int(frames), progress=progress)
+    if sequence is not None:
+        width = max(3, len(str(len(sequence.V) - 1)))
+        for k, V in enumerate(sequence.V):
+            extra[f"sequence/frame_{k:0{width}d}.obj"] = (
+                lambda p, V=V: write_mesh(p, V, net.loops))
     if preview:
         from ..render.net_preview import net_preview
 
-        values = 100.0 * alignability_error(bundle.net.joints, bundle.net.loops)
+        values = 100.0 * alignability_error(net.joints, net.loops)
 
         def _png(p: Path) -> None:
-            net_preview(p, bundle.surface_V, bundle.surface_F, bundle.net.joints,
-                        bundle.net.loops, [lam.axis for lam in bundle.net.lamellae], values,
+            net_preview(p, bundle.surface_V, bundle.surface_F, net.joints,
+                        net.loops, [lam.axis for lam in net.lamellae], values,
                         title=f"GG net: mean Delta_a {np.nanmean(values):.3g} %")
 
         extra["preview.png"] = _png
-    return write_bundle(path, bundle, extra=extra)
+        if sequence is not None:
+            from ..render import ncp_maps
+            from ..render.states import sequence_pngs, states_png
 
+            _say(progress, f"rendering {len(sequence.V)} alignment states and alignment.gif")
+            fam = _edge_families(net, sequence.edges)
+            pngs = sequence_pngs(sequence.V, sequence.edges, title="GG alignment",
+                                 families=fam, t=sequence.t)
+            for k, b in enumerate(pngs):
+                extra[f"sequence/frame_{k:0{width}d}.png"] = b
+            hold = [pngs[0]] * 3 + list(pngs) + [pngs[-1]] * 3
+            extra["alignment.gif"] = ncp_maps.gif(hold, duration_ms=250)
+            K = len(sequence.V) - 1
+            pick = sorted({0, int(round(K / 3)), int(round(2 * K / 3)), K})
+            labels = ["deployed" if k == 0 else "collapsed" if k == K else
+                      f"t = {sequence.t[k]:.2f}" for k in pick]
+            err = 100.0 * max(float(np.nanmax(delta_l(net.joints, V, sequence.edges)))
+                              for V in sequence.V)
+            extra["states.png"] = states_png(
+                [sequence.V[k] for k in pick], sequence.edges, labels=labels, families=fam,
+                title=f"GG alignment: joint-to-joint lengths within {err:.2g} % of the "
+                      "deployed net in every state")
+    return write_bundle(path, bundle, extra=extra)

@@ -60,7 +60,8 @@ _CAPTIONS = {
     "collapse.png": "The collapse curve with its flattened normals (Fig. 15).",
     "curvature_diagram.png": "Curvature diagram of the PHLW surface: samples in the (H, K) "
                              "plane, one line per u-row (Figs. 11, 13a).",
-    "states.png": "The deployed net and its collapsed state (all joints on one line).",
+    "states.png": "States of the alignment sequence, from the deployed net to the collapsed one "
+                  "(every lamella on one straight line).",
     "alignment.gif": "The alignment sequence (Fig. 16).",
     "plan.png": "Assembly plan: every lamella's id at its place.",
 }

@@ -49,7 +49,7 @@ def read_sequence(bundle_dir: str | os.PathLike) -> tuple[list[np.ndarray], np.n
     files = sequence_files(bundle_dir)
     if not files:
         raise InputError(f"{bundle_dir} has no sequence/frame_*.obj; an alignment sequence is "
-                         "written by 'gridshell ncp'")
+                         "written by 'gridshell gg' and 'gridshell ncp'")
     frames, F = [], None
     for p in files:
         V, P, sizes = read_configuration(p)

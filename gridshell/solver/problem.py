@@ -9,7 +9,7 @@ import scipy.sparse as sp
 
 from ..errors import InputError
 from .layout import Layout
-from .terms import TermFn, TermResult
+from .terms import TermFn, TermResult, registered_name
 
 
 @dataclass
@@ -45,7 +45,16 @@ class Problem:
     entries: list[Entry] = field(default_factory=list)
 
     def add(self, name: str, weight: float, fn: TermFn, data: Any = None) -> "Problem":
-        """Add term ``fn`` with ``data`` and ``weight`` under ``name``; returns ``self``."""
+        """Add term ``fn`` with ``data`` and ``weight`` under ``name``; returns ``self``.
+
+        ``fn`` must be registered with :func:`~gridshell.solver.terms.term`, so that the
+        finite-difference test (``tests/test_jacobians.py``) covers every term a problem uses.
+        """
+        if registered_name(fn) is None:
+            what = getattr(fn, "__qualname__", None) or type(fn).__name__
+            raise InputError(f"term {name!r}: {what!r} is not a registered solver term; decorate "
+                             "it with @gridshell.solver.term and add a finite-difference case "
+                             "for it in tests/fd_cases/")
         if any(e.name == name for e in self.entries):
             raise InputError(f"term {name!r} is added twice")
         if not np.isfinite(weight) or weight < 0:

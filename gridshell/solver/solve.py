@@ -26,11 +26,14 @@ class SolveResult:
 
     Attributes
     ----------
-    x : final variables (the best accepted iterate)
+    x : final variables. Method "lm" returns the last accepted iterate, which is also the
+        lowest-energy one (a step is accepted only if it lowers the energy). Methods "gn" and
+        "guided" take every step whose energy is finite, so ``x`` is the last iterate even if
+        the energy rose on the way (see ``history``); ``energy`` is the energy at ``x``.
     converged : whether a stopping tolerance was met (not merely the iteration cap)
     message : why it stopped
     iterations : number of iterations run
-    energy, energy0 : final and initial energy
+    energy, energy0 : energy at ``x`` and at ``x0``
     history : per iteration ``{"it", "energy", "terms", "step", "lambda", "accepted", "time"}``
     report : final per-term report (:meth:`Problem.report`)
     """
@@ -141,7 +144,8 @@ def solve(problem: Problem, x0: np.ndarray, *, fixed: np.ndarray | None = None,
             except RuntimeError:  # singular: raise damping
                 lam *= 10.0
                 if lam > 1e16:
-                    message = "linear system singular at every damping"
+                    message = ("linear system singular at every damping (non-finite Jacobian "
+                               "entries: a term is not differentiable at the current point)")
                     break
                 continue
             x_new = x.copy()
@@ -178,7 +182,7 @@ def solve(problem: Problem, x0: np.ndarray, *, fixed: np.ndarray | None = None,
                 message = message if "singular" in message else \
                     "no step lowers the energy (local minimum or inconsistent terms)"
                 converged = bool(np.max(np.abs(g)) <= max(tol_grad, 1e-8 * max(E, 1e-300) ** 0.5))
-            else:
+            elif "singular" not in message:
                 message = "energy became non-finite"
             break
         if method == "lm" and 0 <= rel < tol_rel:

@@ -35,6 +35,13 @@ def term(fn: TermFn) -> TermFn:
     return fn
 
 
+def registered_name(fn: Any) -> str | None:
+    """The qualified name under which ``fn`` itself is registered in :data:`TERMS`, or None
+    (not a function, never decorated with :func:`term`, or a different function of that name)."""
+    name = f"{getattr(fn, '__module__', None)}.{getattr(fn, '__name__', None)}"
+    return name if TERMS.get(name) is fn else None
+
+
 def result(r: np.ndarray, rows: np.ndarray, cols: np.ndarray, vals: np.ndarray) -> TermResult:
     """Build a :class:`TermResult`, flattening and typing the arrays."""
     return TermResult(np.asarray(r, float).reshape(-1),

@@ -1,7 +1,8 @@
 """FD cases of the PHLW surface-design terms (gridshell.ncp.phlw, paper 4.2.1).
 
 A small bi-cubic B-spline (5 x 4 control points, 3 x 4 samples) with random control points
-and random auxiliary variables near their consistent values, so every product term is active.
+and random auxiliary variables near their consistent values, so every product term is active;
+one case per mode (phlw, cnc, aa) for every term over the mode-dependent layout.
 """
 import numpy as np
 
@@ -11,7 +12,8 @@ from gridshell.ncp import phlw as P
 
 def _setup(rng, mode="phlw"):
     u0, v0 = np.meshgrid(np.linspace(0, 1, 5), np.linspace(0, 1, 4), indexing="ij")
-    ctrl = np.stack([u0, v0, 0.3 * (u0 ** 2 - v0 ** 2)], axis=-1) + 0.05 * rng.normal(size=(5, 4, 3))
+    ctrl = (np.stack([u0, v0, 0.3 * (u0 ** 2 - v0 ** 2)], axis=-1)
+            + 0.05 * rng.normal(size=(5, 4, 3)))
     surf = BSplineSurface.from_control_grid(ctrl, 3, 3)
     u, v = uniform_params(surf, (3, 4))
     data = P.make_samples(surf, u, v, mode)
@@ -41,20 +43,13 @@ def _gliding(rng):
     return lay, x, P.SampleGliding(data.ops["S"], rng.normal(size=(k, 3)), n)
 
 
-def _target_all_modes(rng):
-    # the target with a shared n (cnc); the phlw and aa variants are checked in test_phlw.py
-    return _setup(rng, "cnc")
+#: terms over the PHLW layout, whose blocks depend on the mode (``n`` per row in phlw, one
+#: ``n`` in cnc, none in aa): each is checked in every mode of ``P.MODES``. ``phlw_target``
+#: and ``beta_fairness`` also read ``n`` through the mode-dependent ``Samples.n_index``.
+MODE_TERMS = ("normal_eq", "first_form_eq", "delta_eq", "sqrt_delta_eq", "second_form_eq",
+              "curvature_eq", "principal_eq", "phlw_target", "beta_fairness")
 
-
-CASES = {
-    "gridshell.ncp.phlw.normal_eq": _case(),
-    "gridshell.ncp.phlw.first_form_eq": _case(),
-    "gridshell.ncp.phlw.delta_eq": _case(),
-    "gridshell.ncp.phlw.sqrt_delta_eq": _case(),
-    "gridshell.ncp.phlw.second_form_eq": _case(),
-    "gridshell.ncp.phlw.curvature_eq": _case(),
-    "gridshell.ncp.phlw.principal_eq": _case(),
-    "gridshell.ncp.phlw.phlw_target": _target_all_modes,
-    "gridshell.ncp.phlw.beta_fairness": _case(),
-    "gridshell.ncp.phlw.sample_gliding": _gliding,
-}
+CASES = {f"gridshell.ncp.phlw.{name}[{mode}]": _case(mode)
+         for name in MODE_TERMS for mode in P.MODES}
+# sample_gliding reads only the control points, at the same place in every mode
+CASES["gridshell.ncp.phlw.sample_gliding"] = _gliding
