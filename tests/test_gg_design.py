@@ -58,6 +58,9 @@ def test_rotationally_isometric_grids_are_fixed_points(make, moved_max):
     np.testing.assert_allclose(d.l, np.linalg.norm(np.diff(d.P, axis=1), axis=2).mean(1),
                                rtol=1e-6)
     assert d.h.shape == (P.shape[0] - 1,) and d.l.shape == (P.shape[0],)
+    # nothing moves, so the continuation ends early instead of running all its rounds
+    rounds = [h for h in d.history if h["round"] != "polish"]
+    assert len(rounds) < 10
 
 
 # ----------------------------------------------------------------------------- real work
@@ -71,6 +74,8 @@ def test_noisy_catenoid_converges_near_the_target():
     msgs = []
     d = design_gg_surface(V, F, Pn, progress=msgs.append)
     assert d.converged
+    # a mesh that still moves runs the whole continuation
+    assert len([h for h in d.history if h["round"] != "polish"]) == 10
     assert d.geodesic_residual_max < 1e-6 and d.length_residual_rel_max < 1e-6
     assert np.abs(geodesic_residual(d.P)).max() == pytest.approx(d.geodesic_residual_max)
     assert d.deviation["max"] < 2.0  # from the noisy target: the noise is up to 1 %

@@ -408,6 +408,12 @@ def _figures(P: np.ndarray) -> tuple[float, float]:
     return float(np.max(np.abs(g))) if g.size else 0.0, max(lr.values())
 
 
+#: a continuation round that moves no vertex by more than this many mean edge lengths, with
+#: the constraints met, ends the rounds (on an exact GG mesh such as a helicoid grid every
+#: round after the first moves it by 1e-6 to 3e-5 edge lengths, a noisy catenoid by 1e-2)
+STILL = 1e-5
+
+
 def design_gg_surface(target_V: Any, target_F: Any, P0: Any, *,
                       weights: GGWeights | Mapping[str, float] | None = None, outer: int = 10,
                       max_iter: int = 4, polish_iter: int = 20, tol_geodesic: float = 1e-6,
@@ -512,6 +518,14 @@ def design_gg_surface(target_V: Any, target_F: Any, P0: Any, *,
                         "time": time.perf_counter() - t0})
         _say(progress, f"round {k + 1}/{outer}: energy {res.energy0:.3e} -> {res.energy:.3e}, "
                        f"geodesic {g:.2e} rad, length spread {lr:.2e}")
+        moved = float(np.max(np.linalg.norm(lay.view(x, "P") - X, axis=1)))
+        if k > 0 and g <= 0.5 * tol_geodesic and lr <= 0.5 * tol_length and \
+                moved <= STILL * L:
+            # the constraints hold and the continuation no longer moves the mesh: the
+            # remaining rounds (lower fairness and closeness) would change nothing
+            _say(progress, f"stopping after round {k + 1}: the mesh moved {moved / L:.1e} edge "
+                           "lengths in it and meets the tolerances")
+            break
     done = 0
     while done < polish_iter:  # in short chunks, so that a converged mesh stops early
         g, lr = _figures(lay.view(x, "P").reshape(R, C, 3))
