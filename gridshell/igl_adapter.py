@@ -28,6 +28,7 @@ from .errors import InputError, MeshError
 __all__ = [
     "closest_points",
     "closest_points_with_normals",
+    "cotangent_laplacian",
     "flipped_triangles",
     "parameterize_disk",
     "per_vertex_normals",
@@ -318,6 +319,14 @@ def parameterize_disk(V: Any, F: np.ndarray | None = None,
         lo, hi = UV.min(axis=0), UV.max(axis=0)
         UV = (UV - lo) / np.where(hi > lo, hi - lo, 1.0)
     return UV
+
+
+def cotangent_laplacian(V: Any, F: np.ndarray | None = None) -> sp.csr_matrix:
+    """Cotangent Laplacian ``L (n, n)`` of a mesh (``igl.cotmatrix``), sign flipped to be
+    positive semi-definite: ``x^T L x`` is twice the Dirichlet energy of the piecewise-linear
+    ``x`` (1/m^0: cotangent weights are dimensionless). Quads are split first."""
+    V, T, _ = triangulate(V, F)
+    return sp.csr_matrix(-igl.cotmatrix(V, T))
 
 
 def _signed_areas(UV: np.ndarray, T: np.ndarray) -> np.ndarray:

@@ -185,3 +185,26 @@ def test_non_disks_are_rejected():
     two = np.r_[F, F + len(V)]
     with pytest.raises(MeshError, match="2 connected components"):
         ia.parameterize_disk(np.r_[V, V + 5.0], two)
+
+
+def test_cotangent_laplacian_integrates_the_gradient_of_linear_functions():
+    # on a planar mesh a linear x = a . p is reproduced exactly: x^T L x = |a|^2 * area, and
+    # constants are in the kernel (the adapter flips igl's negative semi-definite sign)
+    from gridshell.grid import grid_quads
+    from gridshell.igl_adapter import cotangent_laplacian
+
+    s, t = np.meshgrid(np.linspace(0, 2, 7), np.linspace(0, 1.5, 5), indexing="ij")
+    rng = np.random.default_rng(3)
+    V = np.stack([s + 0.05 * rng.normal(size=s.shape), t, 0 * s], -1).reshape(-1, 3)
+    L = cotangent_laplacian(V, grid_quads(7, 5))
+    a = np.array([0.7, -1.3])
+    x = V[:, :2] @ a
+    np.testing.assert_allclose(x @ (L @ x), (a @ a) * _area(V, grid_quads(7, 5)), rtol=1e-10)
+    np.testing.assert_allclose(L @ np.ones(len(V)), 0.0, atol=1e-12)
+    assert np.all(np.linalg.eigvalsh(L.toarray()) > -1e-10)
+
+
+def _area(V, Q):
+    """Area of planar quads (half the cross product of the diagonals)."""
+    P = V[Q]
+    return 0.5 * np.linalg.norm(np.cross(P[:, 2] - P[:, 0], P[:, 3] - P[:, 1]), axis=1).sum()

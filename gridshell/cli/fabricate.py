@@ -8,13 +8,14 @@ from typing import Any
 from .common import choice_help
 
 HELP = ("cut files of a design bundle: flat lamellae with joint holes, slots or marks and "
-        "engraved ids, nested on sheets as DXF and SVG, with a cut list and an assembly plan")
+        "engraved ids, nested on sheets as DXF and SVG with PNG previews, with a cut list and an "
+        "assembly plan")
 
 
 #: what each choice of the option sets of :mod:`fabrication.params` means (the choices and
 #: defaults come from there)
 AXIS_HELP = {"centre": "on the centre line",
-             "edge": "on one edge (orthogonal lamellae standing on the surface)"}
+             "edge": "on one edge (orthogonal lamellae standing on the surface; not GG)"}
 JOINT_HELP = {"hole": "a hole on the axis",
               "slots": "cross-halving notches (orthogonal lamellae)",
               "marks": "score lines across the strip"}
@@ -86,7 +87,7 @@ def run(args: Any) -> int:
         "strips / pieces": f"{rep['n_strips']} / {rep['n_pieces']}",
         "joint marks": rep["n_joint_marks"],
         "sheets": f"{rep['n_sheets']} x {params.sheet[0]:g} x {params.sheet[1]:g} mm "
-                  "(one DXF and one SVG per sheet)",
+                  f"({rep['sheet_files']})",
         "utilisation [%]": 100.0 * rep["utilisation"],
         "pieces split": ", ".join(f"L{d['lamella']} in {d['pieces']}"
                                   for d in rep["pieces_split"]) or "none",

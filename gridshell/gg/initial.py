@@ -126,23 +126,6 @@ def _direction_angle(direction: Any, V: np.ndarray, UV: np.ndarray) -> float:
     return float(np.arctan2(du[1], du[0]))
 
 
-def _cotan_laplacian(V: np.ndarray, T: np.ndarray) -> sp.csr_matrix:
-    """Cotangent Laplacian ``L (n, n)`` of a triangle mesh (positive semi-definite:
-    ``x^T L x`` is twice the Dirichlet energy of the piecewise-linear ``x``)."""
-    n = len(V)
-    rows, cols, vals = [], [], []
-    for k in range(3):
-        i, j, o = T[:, (k + 1) % 3], T[:, (k + 2) % 3], T[:, k]  # edge (i, j) opposite o
-        a, b = V[i] - V[o], V[j] - V[o]
-        cross = np.linalg.norm(np.cross(a, b), axis=1)
-        w = 0.5 * np.einsum("ij,ij->i", a, b) / np.maximum(cross, 1e-300)
-        rows += [i, j, i, j]
-        cols += [j, i, i, j]
-        vals += [-w, -w, w, w]
-    return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                         shape=(n, n))
-
-
 def _harmonic(L: sp.csr_matrix, zero: np.ndarray, one: np.ndarray) -> np.ndarray:
     """Harmonic function (``L x = 0`` inside) with ``x = 0`` on ``zero``, ``x = 1`` on ``one``
     and a free (natural, zero-flux) boundary elsewhere."""
@@ -217,7 +200,9 @@ def _quad_domain(V: np.ndarray, T: np.ndarray, loop: np.ndarray,
         s0, s1 = s1, s0
     if centre[k + 1, 1] > centre[(k + 3) % 4, 1]:
         t0, t1 = t1, t0
-    L = _cotan_laplacian(V, T)
+    from ..igl_adapter import cotangent_laplacian
+
+    L = cotangent_laplacian(V, T)
     W = np.stack([_harmonic(L, s0, s1), _harmonic(L, t0, t1)], axis=1)
     if not np.all(np.isfinite(W)):
         return None
