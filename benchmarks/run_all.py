@@ -185,6 +185,40 @@ def _ncp_pipeline(curves: int) -> Callable[[], Any]:
     return lambda: design_ncp(surf, mode="aa", curves=curves)
 
 
+# ============================================================================ output
+
+def _tmpdir() -> Path:
+    tmp = tempfile.mkdtemp(prefix="gridshell-bench-")
+    atexit.register(shutil.rmtree, tmp, ignore_errors=True)  # after the timed call
+    return Path(tmp)
+
+
+def _ncp_write(curves: int) -> Callable[[], Any]:
+    from gridshell.ncp.pipeline import design_ncp, write_ncp
+
+    bundle, report = design_ncp(_pseudosphere(), mode="aa", curves=curves)
+    out = _tmpdir() / "ncp"
+    return lambda: write_ncp(out, bundle, report, render=True)
+
+
+def _outputs(curves: int) -> Callable[[], Any]:
+    """render.png, report.html and the .3dm of a written NCP bundle (``gridshell render
+    --report --3dm``)."""
+    from gridshell.export import export_3dm
+    from gridshell.ncp.pipeline import design_ncp, write_ncp
+    from gridshell.render.report import write_report
+    from gridshell.render.ribbons import render_bundle
+
+    bundle, report = design_ncp(_pseudosphere(), mode="aa", curves=curves)
+    out = write_ncp(_tmpdir() / "ncp", bundle, report, render=True)
+
+    def run() -> Any:
+        render_bundle(out)
+        export_3dm(out, out / "ncp.3dm")
+        return write_report(out)
+    return run
+
+
 # ============================================================================ fabrication
 
 def _fabrication(p: tuple[int, float]) -> Callable[[], Any]:
@@ -268,6 +302,13 @@ STAGES: list[Stage] = [
                 capped="post-optimization + simulation are > 95 % of it and are measured at "
                        "40 curves above (74 s in all on 2026-11-23); run it with --only "
                        "ncp_pipeline --full")]),
+    Stage("ncp_write", "NCP bundle written with pictures, frames and GIF (write_ncp)", _ncp_write,
+          [Size("paper", 10, "10 curves per family, 12 frames"), Size("4x", 20, "20 curves"),
+           Size("16x", 40, "40 curves",
+                capped="design_ncp at 40 curves takes ~74 s to build the input; the write "
+                       "grows with the frames' size only; run it with --only ncp_write --full")]),
+    Stage("outputs", "render.png + report.html + .3dm of an NCP bundle", _outputs,
+          [Size("paper", 10, "10 curves per family"), Size("4x", 20, "20 curves")]),
     Stage("fabrication", "fabrication (fabricate, GG bundle, with plan)", _fabrication,
           [Size("paper", (10, 0.1), "10 lamellae per family, scale 1:10"),
            Size("4x", (20, 0.2), "20 lamellae (4x joints), scale 1:5"),
