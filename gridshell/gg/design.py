@@ -537,10 +537,11 @@ def design_gg_surface(target_V: Any, target_F: Any, P0: Any, *,
         _say(progress, f"round {k + 1}/{outer}: energy {res.energy0:.3e} -> {res.energy:.3e}, "
                        f"geodesic {g:.2e} rad, length spread {lr:.2e}")
         moved = float(np.max(np.linalg.norm(lay.view(x, "P") - X, axis=1)))
-        if k > 0 and g <= 0.5 * tol_geodesic and lr <= 0.5 * tol_length and \
+        if g <= 0.5 * tol_geodesic and lr <= 0.5 * tol_length and \
                 moved <= STILL * L:
-            # the constraints hold and the continuation no longer moves the mesh: the
-            # remaining rounds (lower fairness and closeness) would change nothing
+            # the constraints hold and the round left the mesh where it was: the remaining
+            # rounds (lower fairness and closeness) would change nothing (an exact GG mesh, such
+            # as a helicoid grid, stops after round 1: 100 x 100 in 6 s instead of 55 s)
             _say(progress, f"stopping after round {k + 1}: the mesh moved {moved / L:.1e} edge "
                            "lengths in it and meets the tolerances")
             break
