@@ -9,7 +9,7 @@
 import sys
 from pathlib import Path
 
-from gridshell.cli.verify import verify_bundle
+from gridshell.verification import verify_bundle
 from gridshell.ncp.pipeline import design_ncp, write_ncp
 
 HERE = Path(__file__).resolve().parent

@@ -13,7 +13,7 @@ import sys
 from pathlib import Path
 
 from fabrication import FabParams, fabricate
-from gridshell.cli.verify import verify_bundle
+from gridshell.verification import verify_bundle
 from gridshell.gg.pipeline import design_gg, write_gg
 
 HERE = Path(__file__).resolve().parent

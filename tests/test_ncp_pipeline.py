@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from gridshell.bundle import read_bundle, read_design_json
-from gridshell.cli.verify import verify_bundle
+from gridshell.verification import verify_bundle
 from gridshell.diffgeo import surface_curvature
 from gridshell.ncp.collapse import fit_circle, fit_plane, line_deviation
 from gridshell.ncp.pipeline import crossing_normal_curvature, design_ncp, write_ncp

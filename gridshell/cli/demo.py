@@ -100,7 +100,7 @@ def _finish(d: Path, label: str, name: str, fab_params: dict, progress) -> dict[
 def _gg(root: Path, sizes: dict, progress) -> dict[str, Any]:
     from .. import data
     from ..gg.pipeline import design_gg, write_gg
-    from .verify import verify_bundle
+    from ..verification import verify_bundle
 
     t0 = time.perf_counter()
     target = data.path("dome.obj")
@@ -137,7 +137,7 @@ def _ncp(root: Path, sizes: dict, progress) -> dict[str, Any]:
     from ..ncp.pipeline import design_ncp, write_ncp
     from ..ncp.reference import initial_surface
     from ..quadmesh import read_mesh
-    from .verify import verify_bundle
+    from ..verification import verify_bundle
 
     t0 = time.perf_counter()
     ref = data.path("torus_patch.obj")
