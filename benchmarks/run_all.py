@@ -362,7 +362,8 @@ def run_solver(quick: bool, results: list[dict]) -> None:
     args = ["--sizes", "1e3", "1e4", "1e5", "--lsq-sizes", "1e3", "1e4", "1e5",
             "--lsq-1e5-problems", "gg_round", "--linear-sizes", "1e3", "1e4"]
     if quick:
-        args = ["--sizes", "1e3", "1e4", "--lsq-sizes", "1e3", "1e4", "--linear-sizes", "1e3"]
+        args = ["--sizes", "1e3", "1e4", "--lsq-sizes", "1e3", "1e4", "--linear-sizes", "1e3",
+                "--section", "iterations", "least_squares", "linear"]
     with tempfile.TemporaryDirectory() as tmp:
         js = Path(tmp) / "solver.json"
         p = subprocess.run([sys.executable, str(HERE / "solver.py"), *args, "--json", str(js)],
@@ -381,6 +382,12 @@ def run_solver(quick: bool, results: list[dict]) -> None:
              f"{'>= ' if d.get('ratio_lower_bound') else ''}{d.get('ratio', float('nan')):.2f}x "
              f"(goal >= 5x at 1e4+)")
         results.append({"stage": "least_squares", **d})
+    for d in data.get("pipelines", []):
+        _row("lsq_pipeline", "1e4+", f"{d['pipeline']}, {d['n_calls']} solves, "
+             f"{d['unknowns']} unknowns", d["least_squares"], None,
+             f"ours {d['ours']:.2f} s; ratio lsq/ours {'>= ' if d['ratio_lower_bound'] else ''}"
+             f"{d['ratio']:.1f}x (goal >= 5x)")
+        results.append({"stage": "lsq_pipeline", **d})
     print()
     print("solver.py:")
     print("\n".join("  " + ln for ln in solver_out.rstrip().splitlines()))

@@ -37,11 +37,21 @@ see ``_measure.py``):
    1e-8 (inexact, iterative). Figures: factor + solve seconds, fill ``nnz(L) + nnz(U)``
    (``2 nnz(L) + n`` for LDL^T), relative residual, peak MB. Each runs in its own process
    with a time limit.
+4. ``pipelines``: the project's own problems at 1e4+ unknowns. One run of each pipeline step
+   that optimizes (``design_gg_surface`` on the 60x60 dome, ``optimize_phlw`` at 28x28
+   samples, ``post_optimize`` at 45 and ``simulate_alignment`` at 41 curves per family) is
+   recorded: every ``solve`` call, with a copy of its problem, start point and settings. Each
+   call is replayed with our solver and with ``least_squares(trf, lsmr)`` on the free
+   variables, which runs until its energy is within 1e-6 of what ours reached in that call or
+   until it has used ``--budget`` (6) times our seconds. Figures per pipeline and per call
+   site: seconds summed over the calls, how many calls least_squares finished, the ratio of
+   the sums (``>=`` if some call was stopped) and the worst single call's ratio.
 
     .venv/bin/python benchmarks/solver.py [--sizes 1e3 1e4 1e5] [--lsq-sizes 1e3 1e4 1e5]
         [--lsq-problems dome gg_round phlw_round] [--lsq-1e5-problems dome gg_round]
         [--linear-sizes 1e3 1e4] [--iter-1e5 3]
-        [--section iterations least_squares linear] [--json FILE]
+        [--pipelines gg_design phlw ncp_postopt ncp_simulation] [--budget 6]
+        [--section iterations least_squares linear pipelines] [--json FILE]
 """
 from __future__ import annotations
 
@@ -68,7 +78,7 @@ from gridshell.solver.solve import factorized  # noqa: E402
 
 #: grid side per size label: 3 n^2 + 2 n - 1 unknowns
 SIZES = {"1e3": 18, "1e4": 57, "1e5": 182}
-SECTIONS = ("iterations", "least_squares", "linear")
+SECTIONS = ("iterations", "least_squares", "linear", "pipelines")
 DAMPING = 1e-3  # relative to mean diag(J^T J), as solve()'s default
 TARGET_REL = 1e-6
 SCRIPT = Path(__file__).resolve()
@@ -264,6 +274,168 @@ def work_least_squares(problem: str, size: str, x_scales: list[str], cap: float)
     return out
 
 
+# ============================================================================ 4. pipelines
+
+#: pipeline -> (builder of run_all.py and its size, what, note); sizes chosen for 1e4+ unknowns
+PIPELINES: dict[str, tuple[str, int, str]] = {
+    "gg_design": ("_gg_design", 60, "design_gg_surface on the 60x60 dome grid"),
+    "phlw": ("_phlw", 28, "optimize_phlw on the saddle, 28x28 samples"),
+    "ncp_postopt": ("_postopt", 45, "post_optimize, pseudosphere AA net, 45 curves per family"),
+    "ncp_simulation": ("_simulation_frames", 41, "simulate_alignment, 41 curves per family, "
+                                                 "4 frames"),
+}
+#: least_squares gets this many times our seconds on each call before it is stopped
+BUDGET = 6.0
+
+
+def _simulation_frames(curves: int) -> Callable[[], Any]:
+    from run_all import _traced_net
+
+    from gridshell.ncp.postopt import post_optimize
+    from gridshell.ncp.simulate import collapse_direction, simulate_alignment
+
+    surf, tn, col = _traced_net(curves)
+    post = post_optimize(surf, tn.net, tn.joint_uv, col)
+    E, d = tn.net.edges(), collapse_direction(surf)
+    return lambda: simulate_alignment(post.V, post.r, E, d, aligned=(post.Vt, post.rt), frames=4)
+
+
+def captured_solves(run: Callable[[], Any]) -> list[dict]:
+    """Run ``run`` and return every ``solve`` call the library made in it: a copy of its
+    problem and start point, its keyword arguments and the calling module."""
+    import copy
+    import importlib
+
+    mod = importlib.import_module("gridshell.solver.solve")
+    original = mod.solve
+    calls: list[dict] = []
+
+    def recorder(name: str) -> Callable[..., Any]:
+        def rec(problem: Problem, x0: np.ndarray, **kw: Any) -> Any:
+            calls.append({"where": name.removeprefix("gridshell."), "problem":
+                          copy.deepcopy(problem), "x0": np.array(x0, dtype=float), "kw": kw})
+            return original(problem, x0, **kw)
+        return rec
+
+    users = [(k, m) for k, m in list(sys.modules.items())
+             if k.startswith("gridshell.") and getattr(m, "solve", None) is original]
+    for k, m in users:
+        m.solve = recorder(k)
+    try:
+        run()
+    finally:
+        for _, m in users:
+            m.solve = original
+    return calls
+
+
+def lsq_to_target(prob: Problem, x0: np.ndarray, fixed: Any, target: float,
+                  budget: float) -> dict[str, Any]:
+    """``least_squares(trf, lsmr)`` on the free variables from ``x0`` until its energy is
+    <= ``target`` or ``budget`` seconds have passed."""
+    from scipy.optimize import least_squares
+
+    from gridshell.solver.solve import _free_columns
+
+    free = _free_columns(len(x0), fixed)
+    cache: dict[str, Any] = {}
+
+    def assembled(xf: np.ndarray) -> Any:
+        if "x" not in cache or not np.array_equal(cache["x"], xf):
+            x = x0.copy()
+            x[free] = xf
+            cache["x"], cache["a"] = xf.copy(), prob.assemble(x)
+        return cache["a"]
+
+    state: dict[str, Any] = {"nit": 0}
+    t0 = time.perf_counter()
+
+    def callback(intermediate_result: Any) -> None:  # the name selects the result form
+        state["nit"] += 1
+        if 2.0 * float(intermediate_result.cost) <= target:
+            state["seconds"] = time.perf_counter() - t0
+            raise StopIteration
+        if time.perf_counter() - t0 > budget:
+            raise StopIteration
+
+    r = least_squares(lambda xf: assembled(xf).r, x0[free],
+                      jac=lambda xf: assembled(xf).J[:, free], method="trf", tr_solver="lsmr",
+                      ftol=1e-15, xtol=1e-15, gtol=1e-15, max_nfev=100000, callback=callback)
+    total = time.perf_counter() - t0
+    if "seconds" not in state and 2.0 * float(r.cost) <= target:
+        state["seconds"] = total
+    return {"reached": "seconds" in state, "seconds": state.get("seconds", total),
+            "iterations": state["nit"], "energy": 2.0 * float(r.cost), "message": str(r.message)}
+
+
+def work_pipeline(name: str, budget: float) -> dict:
+    import copy
+
+    import run_all
+
+    builder, size, what = PIPELINES[name]
+    build = globals()[builder] if builder in globals() else getattr(run_all, builder)
+    run = build(size)
+    t0 = time.perf_counter()
+    calls = captured_solves(run)
+    t_run = time.perf_counter() - t0
+    rows = []
+    for c in calls:
+        prob = copy.deepcopy(c["problem"])
+        t_ours, res = _timed(lambda: solve(prob, c["x0"], **c["kw"]))
+        target = res.energy * (1.0 + TARGET_REL)
+        ls = lsq_to_target(c["problem"], c["x0"], c["kw"].get("fixed"), target,
+                           max(budget * t_ours, 0.05))
+        kind = f"{c['where']} {c['kw'].get('method', 'lm')}"
+        rows.append({"kind": kind, "unknowns": int(len(c["x0"])), "ours": t_ours,
+                     "ours_iterations": res.iterations, "energy": res.energy,
+                     "least_squares": ls})
+    return {"pipeline": name, "what": what, "seconds_run": t_run, "calls": rows}
+
+
+def section_pipelines(names: list[str], timeout: float, budget: float) -> list[dict]:
+    print(f"4. the pipelines' own solves at 1e4+ unknowns: every solve() call of one run, "
+          f"replayed with ours and with least_squares(trf, lsmr) until E <= E_ours * (1 + "
+          f"{TARGET_REL:g}); least_squares is stopped at {budget:g}x our time per call")
+    print(f"  {'pipeline: calls':<44} {'n':>6} {'calls':>5} {'ours s':>8} {'lsq s':>8} "
+          f"{'reached':>7} {'ratio':>9} {'min ratio':>9}")
+    out = []
+    for name in names:
+        d = run_worker(SCRIPT, ["pipeline", name, str(budget)], timeout)
+        if d is None or "error" in d:
+            print(f"  {name:<44} {'timed out' if d is None else d['error']} "
+                  f"(limit {timeout:.0f} s)")
+            continue
+        groups: dict[str, list[dict]] = {}
+        for r in d["calls"]:
+            groups.setdefault(r["kind"], []).append(r)
+        d["groups"] = {}
+        print(f"  {name}: {d['what']}")
+        for label, rows in [("  all calls", d["calls"])] + \
+                [(f"    {k}", v) for k, v in groups.items()]:
+            whole = label == "  all calls"
+            ours = sum(r["ours"] for r in rows)
+            lsq = sum(r["least_squares"]["seconds"] for r in rows)
+            reached = sum(r["least_squares"]["reached"] for r in rows)
+            ratios = [r["least_squares"]["seconds"] / r["ours"] for r in rows]
+            lower = reached < len(rows)
+            fig = {"n_calls": len(rows), "ours": ours, "least_squares": lsq, "reached": reached,
+                   "ratio": lsq / ours, "ratio_lower_bound": lower, "ratio_min": min(ratios),
+                   "unknowns": max(r["unknowns"] for r in rows)}
+            if not whole:
+                d["groups"][label.strip()] = fig
+            else:
+                d.update(fig)
+            pre = ">=" if lower else ""
+            print(f"  {label:<44} {fig['unknowns']:>6} {len(rows):>5} {ours:>8.2f} {lsq:>8.2f} "
+                  f"{reached:>3}/{len(rows):<3} {pre + format(lsq / ours, '.1f') + 'x':>9} "
+                  f"{min(ratios):>8.1f}x")
+        out.append(d)
+    print(f"  (ratio = least_squares / ours summed over the calls, >= when least_squares was "
+          f"stopped at {budget:g}x our time on some call; min ratio: the worst single call)")
+    return out
+
+
 # ============================================================================ 3. linear solvers
 
 def _superlu(**kw: Any) -> Callable[[sp.csc_matrix, np.ndarray], tuple[np.ndarray, int]]:
@@ -427,6 +599,9 @@ def main(argv: list[str] | None = None) -> dict[str, list[dict]]:
     ap.add_argument("--lsq-cap", type=float, default=300.0,
                     help="seconds after which least_squares is stopped (reported as capped)")
     ap.add_argument("--linear-timeout", type=float, default=30.0)
+    ap.add_argument("--pipelines", nargs="+", default=list(PIPELINES), choices=list(PIPELINES))
+    ap.add_argument("--budget", type=float, default=BUDGET,
+                    help="least_squares is stopped at this many times our seconds per call")
     ap.add_argument("--section", nargs="+", default=list(SECTIONS), choices=SECTIONS)
     ap.add_argument("--json", help="also write the figures to this JSON file")
     a = ap.parse_args(argv)
@@ -439,6 +614,8 @@ def main(argv: list[str] | None = None) -> dict[str, list[dict]]:
                                                      big_problems=a.lsq_1e5_problems)
     if "linear" in a.section:
         out["linear"] = section_linear(a.linear_sizes, a.linear_timeout)
+    if "pipelines" in a.section:
+        out["pipelines"] = section_pipelines(a.pipelines, timeout=1800, budget=a.budget)
     if a.json:
         Path(a.json).write_text(json.dumps(out, indent=1, default=float))
     return out
@@ -452,6 +629,8 @@ def worker(args: list[str]) -> None:
         d = work_least_squares(args[1], args[2], args[3].split(","), float(args[4]))
     elif kind == "linear":
         d = work_linear(size, args[2])
+    elif kind == "pipeline":
+        d = work_pipeline(args[1], float(args[2]))
     else:
         raise SystemExit(f"unknown worker {kind!r}")
     print(json.dumps(d, default=float))

@@ -6,7 +6,8 @@
   side (``+s`` along ``+x``, so labels read upright), then stacked across it - along the
   symmetry direction of an arc: each part drops
   onto the ones below it in its stack until it comes ``gap`` from them (the congruent pieces of
-  one curve nest into each other); full stacks continue to the right, full sheets on a new one.
+  one curve nest into each other). Each part goes into the first stack with room for it, else
+  into a new stack right of the others on the first sheet with room, else on a new sheet.
 
 All parts keep ``gap`` mm from each other and from the sheet edges. Sheets are filled in a
 frame whose x axis is the sheet's long side, then turned to the sheet as given.
@@ -117,8 +118,8 @@ def nest(parts: list[Part], params: FabParams) -> Layout:
     if curved:
         canon = [_canonical(p, True) for p in curved]
         order = sorted(range(len(canon)), key=lambda i: -canon[i].polygon().bounds[2])
-        stack: dict | None = None       # sheet, x, width, parts [(ring, grown ring, top)]
 
+        # a stack: sheet, x, width, parts [(ring, grown ring, top)]
         def try_stack(st: dict, poly: Polygon, w: float, h: float):
             x = st["x"] + 0.5 * (st["width"] - w)
             if not st["parts"]:
@@ -138,18 +139,29 @@ def nest(parts: list[Part], params: FabParams) -> Layout:
                 y += short + 0.01
             return (x, y) if y + h <= Ly - g + 1e-9 else None
 
+        stacks: list[dict] = []
+        right: dict[int, float] = {}    # per sheet of stacks: x where the next stack may start
+
         for i in order:
             p = canon[i]
             poly = p.polygon(FLAT_TOL)
             _, _, w, h = poly.bounds
-            pos = try_stack(stack, poly, w, h) if stack and w <= stack["width"] + 1e-9 else None
-            if pos is None:
-                nx = stack["x"] + stack["width"] + g if stack else np.inf
-                if nx + w <= Lx - g + 1e-9:
-                    stack = {"sheet": stack["sheet"], "x": nx, "width": w, "parts": []}
-                else:
+            stack, pos = None, None
+            for st in stacks:           # first fit: the first stack with room for it
+                if w <= st["width"] + 1e-9:
+                    pos = try_stack(st, poly, w, h)
+                    if pos is not None:
+                        stack = st
+                        break
+            if stack is None:           # a new stack right of the others, on any sheet
+                k = next((k for k, x in right.items() if x + w <= Lx - g + 1e-9), None)
+                if k is None:
                     n_sheets += 1
-                    stack = {"sheet": n_sheets - 1, "x": g, "width": w, "parts": []}
+                    k = n_sheets - 1
+                    right[k] = g
+                stack = {"sheet": k, "x": right[k], "width": w, "parts": []}
+                stacks.append(stack)
+                right[k] += w + g
                 pos = try_stack(stack, poly, w, h)
             q = p.moved(Motion(0.0, *pos))
             qp = q.polygon(FLAT_TOL)

@@ -140,3 +140,26 @@ def test_a_sheet_smaller_than_a_joint_spacing_is_an_input_error():
     params = FabParams(scale="1:1", sheet="100x60")
     with pytest.raises(InputError, match="larger --sheet"):
         split_strip(strips_from_bundle(b, params)[0], params)
+
+
+@pytest.mark.parametrize("kind, nr, nc, sheet, most", [("CNC", 4, 4, "300x150", 2),
+                                                      ("CNC", 5, 6, "400x200", 5),
+                                                      ("NCP", 5, 6, "300x120", 7)])
+def test_curved_parts_go_to_the_first_stack_with_room(kind, nr, nc, sheet, most):
+    """First fit for stacks: a part goes into the first stack (on any sheet) with room for it,
+    else into a new stack right of the others on the first sheet with room. Before, only the
+    last stack was tried and these layouts took 3, 6 and 9 sheets. No part on a later sheet
+    fits in the width left right of an earlier sheet's stacks."""
+    parts, layout, params = _layout(kind, sheet=sheet, gap=5, nr=nr, nc=nc)
+    _assert_valid(layout, 5)
+    assert layout.n_sheets <= most
+    W, H = layout.sheet
+    L = max(W, H)
+    along = 0 if W >= H else 1          # the nesting frame's long side
+    end = {}
+    for p, s in zip(layout.parts, layout.sheet_of):
+        end[s] = max(end.get(s, 0.0), p.polygon().bounds[2 + along])
+    for p, s in zip(layout.parts, layout.sheet_of):
+        b = p.polygon().bounds
+        for s0 in range(s):
+            assert L - 5 - (end[s0] + 5) < b[2 + along] - b[along] - 1e-6, (s, s0)
