@@ -68,6 +68,29 @@ def test_quick_demo_gg_alignment_sequence(quick_demo):
     assert saved["coverage"] > 95 and saved["frames"] == 5
 
 
+def test_quick_demo_ncp_alignment_sequence(quick_demo):
+    # the CNC sequence read back from the files: frame 0 is the deployed net, the last one the
+    # aligned state, and the largest edge-length change over the states is the one reported
+    import numpy as np
+
+    from gridshell.bundle import read_bundle
+    from gridshell.render.sequence import read_sequence
+
+    _, out, s = quick_demo
+    b = read_bundle(out / "ncp")
+    frames, _ = read_sequence(out / "ncp")
+    saved = json.loads((out / "demo.json").read_text())["ncp"]
+    assert len(frames) == saved["frames"] == 5 and "5 states" in s["CNC alignment"]
+    np.testing.assert_allclose(frames[0], b.net.joints, atol=1e-9)
+    np.testing.assert_allclose(frames[-1], b.aligned, atol=1e-9)
+    E = b.net.edges()
+    ell0 = np.linalg.norm(frames[0][E[:, 1]] - frames[0][E[:, 0]], axis=1)
+    worst = max(100 * np.max(np.abs(np.linalg.norm(V[E[:, 1]] - V[E[:, 0]], axis=1) - ell0)
+                             / ell0) for V in frames)
+    assert worst == pytest.approx(saved["sequence_length_error"], rel=1e-4, abs=1e-6)
+    assert worst < 2
+
+
 def test_quick_demo_figures_meet_the_paper_bounds(quick_demo):
     _, out, s = quick_demo
     assert s["ok"] and s["output"] == str(out)

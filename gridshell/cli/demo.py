@@ -176,6 +176,7 @@ def _ncp(root: Path, sizes: dict, progress) -> dict[str, Any]:
         "n": m["n"], "collapse_radius": m["collapse_radius"],
         "aligned_radius_error": m["aligned_radius_error"],
         "frames": len(list((d / "sequence").glob("frame_*.obj"))),
+        "sequence_length_error": m["sequence_length_error"],
         "verified": _agrees(v, m, (("alignability", "delta_a_after"), ("delta_l", "delta_l"),
                                    ("delta_n", "delta_n"))),
         "checks": _checks(m), "fabrication": fab, "time": time.perf_counter() - t0,
@@ -222,7 +223,9 @@ def _summary(out: Path, gg: dict | None, ncp: dict | None, total: float) -> dict
                                        "surface from reference": ncp["phlw_deviation"]}
         s["CNC collapse circle"] = (f"radius {ncp['collapse_radius']:.4g} m (n = {ncp['n']:.4g} "
                                     f"1/m), aligned joints off it "
-                                    f"{ncp['aligned_radius_error']:.2g} %, {ncp['frames']} frames")
+                                    f"{ncp['aligned_radius_error']:.2g} %")
+        s["CNC alignment"] = (f"{ncp['frames']} states, joint-to-joint lengths within "
+                              f"{ncp['sequence_length_error']:.2g} % of the deployed net")
         s["CNC paper thresholds"] = ncp["checks"]
         s["CNC cut files"] = _sheets(ncp["fabrication"])
     s["verified from the files"] = "yes" if all(

@@ -107,6 +107,8 @@ def run(args: Any) -> int:
         "deviation [% diag]": m["deviation"],
         "crossing kn difference [%]": {"mean": m["crossing_kn"]["mean"],
                                        "max": m["crossing_kn"]["max"]},
+        "alignment sequence": f"joint-to-joint lengths within {m['sequence_length_error']:.2g} "
+                              "% of the deployed net in every state",
     }
     if "n" in m:
         summary["n [1/m]"] = m["n"]

@@ -255,6 +255,9 @@ def design_ncp(source: Any, *, mode: str = "phlw", curves: int | tuple[int, int]
                         "joints": int(len(cross["joints"]))},
         "collapse_length": float(col.s[-1]),
         "plane_distance_before_projection": seq.plane_distance,
+        # the largest edge-length change of any state of the alignment sequence, %
+        "sequence_length_error": 100.0 * max(float(np.nanmax(np.abs(delta_l(post.V, V, E))))
+                                             for V in seq.V),
     }
     if mode == "cnc":
         _, R = fit_circle(A2)
