@@ -19,7 +19,7 @@ keeps the sequence out of the folded minima the plain homotopy falls into on a p
 (edges shrinking by up to 99 %). The last frame (``t = 1``, no proximity) is exact up to the
 solver tolerance. Laplacian fairness of ``V`` and ``r`` (off in the last frame); scaled units
 (unit bounding-box diagonal of ``V*``) as in the post-optimization, with the length and axis
-constraints weighted by the net's density (:data:`EDGE_REF`).
+constraints weighted by the net's density (:func:`~gridshell.ncp.postopt.net_density`).
 """
 from __future__ import annotations
 
@@ -34,9 +34,9 @@ from ..errors import InputError
 from ..solver import Layout, Problem, solve
 from ..solver import terms as T
 from .postopt import (AxisPairs, EdgeLength, UnitNorm, edge_length_eq, interior_vertices,
-                      rotation_axis_eq, unit_norm_eq, vertex_pairs)
+                      net_density, rotation_axis_eq, unit_norm_eq, vertex_pairs)
 
-__all__ = ["SIM_WEIGHTS", "EDGE_REF", "collapse_direction", "AlignmentSequence", "simulate_alignment",
+__all__ = ["SIM_WEIGHTS", "collapse_direction", "AlignmentSequence", "simulate_alignment",
            "plane_frame", "embed_aligned"]
 
 #: Most frames of an alignment sequence (each frame is one optimization).
@@ -48,14 +48,6 @@ MAX_FRAMES = 1000
 SIM_WEIGHTS = {"length": 1.0, "axis": 1e2, "unit": 1e2, "collapse": 1e-4, "proximity": 1e-4,
                "fairness": 1e-5}
 
-#: mean joint-to-joint edge length (unit diagonal) at which the length and axis weights of
-#: :data:`SIM_WEIGHTS` hold: 10 curves per family on that pseudosphere patch. ``chi_l`` scales
-#: like an edge length squared and ``chi_r`` like an edge length, so at a mean edge length
-#: ``l`` they are weighted ``(EDGE_REF / l)^4`` and ``(EDGE_REF / l)^2`` times more. The same
-#: relative errors then cost the same against the per-joint collapse and proximity terms at
-#: any net density. Without this, the intermediate frames of a 20-curve net lost 29 % of an
-#: edge length (1.9 % with it).
-EDGE_REF = 0.09
 
 
 def collapse_direction(surf: BSplineSurface, rows: int = 48) -> np.ndarray:
@@ -151,7 +143,7 @@ def simulate_alignment(V_star: np.ndarray, r_star: np.ndarray, edges: np.ndarray
         keeps the homotopy out of the folded local minima of the collapsing energy
     frames : number of steps ``K`` (``K + 1`` states including the initial one)
     weights : overrides of :data:`SIM_WEIGHTS` (length and axis weights at the mean edge
-        length :data:`EDGE_REF`; scaled to the net's own, see there)
+        length :data:`~gridshell.ncp.postopt.EDGE_REF`, scaled to the net's own)
     max_iter : Levenberg-Marquardt iterations per frame
     project : put the last frame's joints exactly on the plane and its axes exactly in it
     """
@@ -181,10 +173,7 @@ def simulate_alignment(V_star: np.ndarray, r_star: np.ndarray, edges: np.ndarray
     from ..solver.terms import laplacian_matrix
     Lap = laplacian_matrix(n, E, fixed_rows=np.setdiff1d(np.arange(n), inner))
     D = np.tile(d, (n, 1))
-    ell = float(np.mean(np.linalg.norm(Xs[E[:, 1]] - Xs[E[:, 0]], axis=1))) if len(E) else 1.0
-    if not ell > 0:
-        raise InputError("the joint mesh has no edge of positive length; check the joints")
-    density = EDGE_REF / ell
+    density = net_density(Xs, E)  # constraints weighted as in the post-optimization
     prob = Problem(lay)
     prob.add("length (chi_l)", w["length"] * density ** 4, edge_length_eq,
              EdgeLength(E, "V", "Vt"))
