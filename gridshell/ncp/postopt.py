@@ -34,9 +34,9 @@ from ..solver import Layout, Problem, TermResult, result, solve, term
 from ..solver import terms as T
 from .collapse import CollapseResult, closest_on_polyline
 
-__all__ = ["DEFAULT_WEIGHTS", "EDGE_REF", "net_density", "EdgeLength", "edge_length_eq",
-           "AxisPairs", "rotation_axis_eq", "UnitNorm", "unit_norm_eq", "surface_closest",
-           "vertex_pairs", "PostOptResult", "post_optimize"]
+__all__ = ["DEFAULT_WEIGHTS", "EDGE_REF", "CONSTRAINT_TOL", "net_density", "constraint_errors",
+           "EdgeLength", "edge_length_eq", "AxisPairs", "rotation_axis_eq", "UnitNorm",
+           "unit_norm_eq", "surface_closest", "vertex_pairs", "PostOptResult", "post_optimize"]
 
 #: paper Table 2 (omega_c and omega_f at the upper end of their ranges)
 #: mean joint-to-joint edge length, in units of the model's diagonal, at which the length and
@@ -55,6 +55,23 @@ def net_density(V: np.ndarray, edges: np.ndarray) -> float:
     if not ell > 0:
         raise InputError("the joint mesh has no edge of positive length; check the joints")
     return EDGE_REF / ell
+
+
+#: relative constraint error below which the post-optimization counts as converged even if
+#: the solver still creeps along the soft terms (:func:`constraint_errors`)
+CONSTRAINT_TOL = 1e-6
+
+
+def constraint_errors(report: dict, ell: float) -> dict[str, float]:
+    """Largest constraint residuals of a solver report, relative: ``|chi_l| / l^2`` (twice the
+    relative length error), ``|chi_r| / l``, ``|chi_u|``; ``l`` the mean edge length (scaled
+    units)."""
+    out = {}
+    for name, power in (("length (chi_l)", 2), ("axis (chi_r)", 1), ("unit (chi_u)", 0),
+                        ("unit aligned (chi_u~)", 0)):
+        if name in report:
+            out[name] = float(report[name]["max"]) / ell ** power
+    return out
 
 
 DEFAULT_WEIGHTS = {"length": 1.0, "axis": 1e2, "unit": 1e2, "closeness": 1e-4, "gliding": 1e-5,
@@ -319,6 +336,14 @@ def post_optimize(surf: BSplineSurface, net: Net, joint_uv: np.ndarray, collapse
         history.append({"round": "polish", "iterations": sol.iterations,
                         "energy0": sol.energy0, "energy": sol.energy, "message": sol.message,
                         "time": time.perf_counter() - t0})
+    converged = bool(sol is not None and sol.converged)
+    if sol is not None:
+        # the constraints are what the post-optimization is for: when they hold to
+        # CONSTRAINT_TOL, a solver still creeping along the soft terms has done its job
+        ell = EDGE_REF / density
+        rel = constraint_errors(sol.report, ell)
+        history[-1]["constraints_rel_max"] = rel
+        converged = converged or max(rel.values()) <= CONSTRAINT_TOL
     V = lay.view(x, "V") * scale + centre
     uv, _, _ = surface_closest(surf, V, uv)
     r = lay.view(x, "r").copy()
@@ -327,4 +352,4 @@ def post_optimize(surf: BSplineSurface, net: Net, joint_uv: np.ndarray, collapse
                          Vt=lay.view(x, "Vt") * scale, rt=rt / np.linalg.norm(rt, axis=1)[:, None],
                          uv=uv, V0=V0, r0=r0, Vt0=Vt0, rt0=rt0, history=history,
                          report=sol.report if sol is not None else {},
-                         converged=bool(sol is not None and sol.converged), weights=w)
+                         converged=converged, weights=w)
