@@ -339,11 +339,13 @@ def post_optimize(surf: BSplineSurface, net: Net, joint_uv: np.ndarray, collapse
     converged = bool(sol is not None and sol.converged)
     if sol is not None:
         # the constraints are what the post-optimization is for: when they hold to
-        # CONSTRAINT_TOL, a solver still creeping along the soft terms has done its job
+        # CONSTRAINT_TOL after at least one round (which adds the terms keeping the joints on
+        # the surface and the aligned joints on the collapse curve), a solver still creeping
+        # along the soft terms has done its job
         ell = EDGE_REF / density
         rel = constraint_errors(sol.report, ell)
         history[-1]["constraints_rel_max"] = rel
-        converged = converged or max(rel.values()) <= CONSTRAINT_TOL
+        converged = converged or (int(rounds) >= 1 and max(rel.values()) <= CONSTRAINT_TOL)
     V = lay.view(x, "V") * scale + centre
     uv, _, _ = surface_closest(surf, V, uv)
     r = lay.view(x, "r").copy()
