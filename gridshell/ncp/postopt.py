@@ -15,7 +15,9 @@ joints, ``r (n, 3)`` their rotation axes, ``Vt (n, 2)`` the joints on the collap
   Laplacian fairness of ``V`` (interior joints).
 
 The optimization runs on geometry scaled to a unit bounding-box diagonal of the surface, so the
-weights mean the same on any model; results are returned in metres. The same three constraint
+weights mean the same on any model, and the length and axis constraints are weighted by the
+net's density (:data:`EDGE_REF`), so they mean the same at any number of curves; results are
+returned in metres. The same three constraint
 terms drive the alignment simulation (:mod:`gridshell.ncp.simulate`), with the reference
 configuration as fixed blocks.
 """
@@ -38,7 +40,6 @@ __all__ = ["DEFAULT_WEIGHTS", "EDGE_REF", "CONSTRAINT_TOL", "net_density", "cons
            "EdgeLength", "edge_length_eq", "AxisPairs", "rotation_axis_eq", "UnitNorm",
            "unit_norm_eq", "surface_closest", "vertex_pairs", "PostOptResult", "post_optimize"]
 
-#: paper Table 2 (omega_c and omega_f at the upper end of their ranges)
 #: mean joint-to-joint edge length, in units of the model's diagonal, at which the length and
 #: axis weights hold (10 curves per family on the pseudosphere patch of the tests). ``chi_l``
 #: scales like an edge length squared and ``chi_r`` like an edge length, so at a mean edge
@@ -74,6 +75,7 @@ def constraint_errors(report: dict, ell: float) -> dict[str, float]:
     return out
 
 
+#: paper Table 2 (omega_c and omega_f at the upper end of their ranges)
 DEFAULT_WEIGHTS = {"length": 1.0, "axis": 1e2, "unit": 1e2, "closeness": 1e-4, "gliding": 1e-5,
                    "closeness_aligned": 1e-1, "gliding_aligned": 1e-1, "normal": 1e-2,
                    "normal_aligned": 1e-1, "fairness": 1e-4}
@@ -255,7 +257,8 @@ def post_optimize(surf: BSplineSurface, net: Net, joint_uv: np.ndarray, collapse
     ----------
     surf : the PHLW surface; net : the traced net; joint_uv : (n, 2) parameters of its joints
     collapse : the collapse curve (:func:`gridshell.ncp.collapse.collapse_curve`)
-    weights : overrides of :data:`DEFAULT_WEIGHTS`
+    weights : overrides of :data:`DEFAULT_WEIGHTS` (length and axis weights at the mean edge
+        length :data:`EDGE_REF`, scaled to the net's own)
     rounds : outer rounds (closest points on the surface and the collapse curve refreshed)
     max_iter : Levenberg-Marquardt iterations per round
     polish : if > 0, a last round with the soft terms (closeness, gliding, normals, fairness)

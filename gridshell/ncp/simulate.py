@@ -49,7 +49,6 @@ SIM_WEIGHTS = {"length": 1.0, "axis": 1e2, "unit": 1e2, "collapse": 1e-4, "proxi
                "fairness": 1e-5}
 
 
-
 def collapse_direction(surf: BSplineSurface, rows: int = 48) -> np.ndarray:
     """Unit collapse direction ``d (3,)``: the mean of ``S(u_i, v_last) - S(u_i, v_first)``
     over ``rows`` u-rows (paper 4.2.4)."""
