@@ -230,9 +230,50 @@ def _time_to_target(res: Any, target: float, total: float) -> dict[str, Any]:
             "seconds_total": total, "iterations_total": res.iterations}
 
 
-def work_least_squares(problem: str, size: str, x_scales: list[str], cap: float) -> dict:
+def lsq_to_target(prob: Problem, x0: np.ndarray, fixed: Any, target: float, budget: float,
+                  *, x_scale: str = "default", max_nfev: int = 100000,
+                  tol: float = 1e-15) -> dict[str, Any]:
+    """``least_squares(trf, lsmr)`` on the free variables from ``x0`` (the residual and
+    Jacobian of ``Problem.assemble``, cached per point) until its energy is <= ``target``,
+    ``budget`` seconds have passed or it stops by itself (``max_nfev``, tolerances ``tol``)."""
     from scipy.optimize import least_squares
 
+    from gridshell.solver.solve import _free_columns
+
+    free = _free_columns(len(x0), fixed)
+    cache: dict[str, Any] = {}
+
+    def assembled(xf: np.ndarray) -> Any:
+        if "x" not in cache or not np.array_equal(cache["x"], xf):
+            x = x0.copy()
+            x[free] = xf
+            cache["x"], cache["a"] = xf.copy(), prob.assemble(x)
+        return cache["a"]
+
+    state: dict[str, Any] = {"nit": 0}
+    t0 = time.perf_counter()
+
+    def callback(intermediate_result: Any) -> None:  # the name selects the result form
+        state["nit"] += 1
+        if 2.0 * float(intermediate_result.cost) <= target:
+            state["seconds"] = time.perf_counter() - t0
+            raise StopIteration
+        if time.perf_counter() - t0 > budget:
+            raise StopIteration
+
+    r = least_squares(lambda xf: assembled(xf).r, x0[free],
+                      jac=lambda xf: assembled(xf).J[:, free], method="trf", tr_solver="lsmr",
+                      x_scale=None if x_scale == "default" else x_scale, ftol=tol, xtol=tol,
+                      gtol=tol, max_nfev=max_nfev, callback=callback)
+    total = time.perf_counter() - t0
+    if "seconds" not in state and 2.0 * float(r.cost) <= target:
+        state["seconds"] = total
+    return {"reached": "seconds" in state, "seconds": state.get("seconds", total),
+            "iterations": state["nit"], "nfev": int(r.nfev), "energy": 2.0 * float(r.cost),
+            "message": str(r.message), "capped": total > budget and "seconds" not in state}
+
+
+def work_least_squares(problem: str, size: str, x_scales: list[str], cap: float) -> dict:
     build, sides, _ = PROBLEMS[problem]
     prob, x0 = build(sides[size])
     t_ours, res = _timed(lambda: solve(prob, x0, method="lm", max_iter=100, tol_rel=1e-10))
@@ -245,38 +286,14 @@ def work_least_squares(problem: str, size: str, x_scales: list[str], cap: float)
                                       damping=1e-6))
     out["ours_damping_1e-6"] = _time_to_target(low, target, t_low)
     for xs in x_scales:
-        cache: dict[str, Any] = {}
-
-        def assembled(x: np.ndarray) -> Any:
-            if "x" not in cache or not np.array_equal(cache["x"], x):
-                cache["x"], cache["a"] = x.copy(), prob.assemble(x)
-            return cache["a"]
-
-        state: dict[str, Any] = {"nit": 0}
-        t0 = time.perf_counter()
-
-        def callback(intermediate_result: Any) -> None:  # the name selects the result form
-            state["nit"] += 1
-            if 2.0 * float(intermediate_result.cost) <= target:
-                state["seconds"] = time.perf_counter() - t0
-                raise StopIteration
-            if time.perf_counter() - t0 > cap:
-                raise StopIteration
-
-        r = least_squares(lambda x: assembled(x).r, x0, jac=lambda x: assembled(x).J,
-                          method="trf", tr_solver="lsmr", x_scale=None if xs == "default" else xs,
-                          ftol=1e-12, xtol=1e-12, gtol=1e-12, max_nfev=500, callback=callback)
-        total = time.perf_counter() - t0
-        out["least_squares"][xs] = {
-            "reached": "seconds" in state, "seconds": state.get("seconds", total),
-            "iterations": state["nit"], "nfev": int(r.nfev), "energy": 2.0 * float(r.cost),
-            "message": str(r.message), "capped": total > cap and "seconds" not in state}
+        out["least_squares"][xs] = lsq_to_target(prob, x0, None, target, cap, x_scale=xs,
+                                                 max_nfev=500, tol=1e-12)
     return out
 
 
 # ============================================================================ 4. pipelines
 
-#: pipeline -> (builder of run_all.py and its size, what, note); sizes chosen for 1e4+ unknowns
+#: pipeline -> (builder in run_all.py or here, its size, what); sizes chosen for 1e4+ unknowns
 PIPELINES: dict[str, tuple[str, int, str]] = {
     "gg_design": ("_gg_design", 60, "design_gg_surface on the 60x60 dome grid"),
     "phlw": ("_phlw", 28, "optimize_phlw on the saddle, 28x28 samples"),
@@ -327,45 +344,6 @@ def captured_solves(run: Callable[[], Any]) -> list[dict]:
         for _, m in users:
             m.solve = original
     return calls
-
-
-def lsq_to_target(prob: Problem, x0: np.ndarray, fixed: Any, target: float,
-                  budget: float) -> dict[str, Any]:
-    """``least_squares(trf, lsmr)`` on the free variables from ``x0`` until its energy is
-    <= ``target`` or ``budget`` seconds have passed."""
-    from scipy.optimize import least_squares
-
-    from gridshell.solver.solve import _free_columns
-
-    free = _free_columns(len(x0), fixed)
-    cache: dict[str, Any] = {}
-
-    def assembled(xf: np.ndarray) -> Any:
-        if "x" not in cache or not np.array_equal(cache["x"], xf):
-            x = x0.copy()
-            x[free] = xf
-            cache["x"], cache["a"] = xf.copy(), prob.assemble(x)
-        return cache["a"]
-
-    state: dict[str, Any] = {"nit": 0}
-    t0 = time.perf_counter()
-
-    def callback(intermediate_result: Any) -> None:  # the name selects the result form
-        state["nit"] += 1
-        if 2.0 * float(intermediate_result.cost) <= target:
-            state["seconds"] = time.perf_counter() - t0
-            raise StopIteration
-        if time.perf_counter() - t0 > budget:
-            raise StopIteration
-
-    r = least_squares(lambda xf: assembled(xf).r, x0[free],
-                      jac=lambda xf: assembled(xf).J[:, free], method="trf", tr_solver="lsmr",
-                      ftol=1e-15, xtol=1e-15, gtol=1e-15, max_nfev=100000, callback=callback)
-    total = time.perf_counter() - t0
-    if "seconds" not in state and 2.0 * float(r.cost) <= target:
-        state["seconds"] = total
-    return {"reached": "seconds" in state, "seconds": state.get("seconds", total),
-            "iterations": state["nit"], "energy": 2.0 * float(r.cost), "message": str(r.message)}
 
 
 def work_pipeline(name: str, budget: float) -> dict:

@@ -46,14 +46,18 @@ def test_constraints_vanish_on_consistent_configurations():
     assert np.allclose(PO.rotation_axis_eq(x2, lay2, PO.AxisPairs(j, k)).r, 0)
 
 
+def _traced_post(surf, mode, curves):
+    """The traced net, collapse curve and post-optimization of ``surf`` (``mode`` net)."""
+    d = net_directions(surf, *uniform_params(surf, (48, 48)), mode=mode)
+    tn = LS.trace(surf, d, curves=curves)
+    col = collapse_curve(surf, mode=mode, samples=(400, 400))
+    return tn, col, PO.post_optimize(surf, tn.net, tn.joint_uv, col)
+
+
 @pytest.fixture(scope="module")
 def pseudo_post():
     surf = pseudosphere()
-    d = net_directions(surf, *uniform_params(surf, (48, 48)), mode="aa")
-    tn = LS.trace(surf, d, curves=10)
-    col = collapse_curve(surf, mode="aa", samples=(400, 400))
-    post = PO.post_optimize(surf, tn.net, tn.joint_uv, col)
-    return surf, tn, col, post
+    return (surf, *_traced_post(surf, "aa", 10))
 
 
 def test_post_optimization_lowers_alignability_error_tenfold(pseudo_post):
@@ -92,10 +96,8 @@ def test_alignment_sequence_collapses_onto_the_plane(pseudo_post):
 @pytest.fixture(scope="module")
 def pseudo_post20():
     surf = pseudosphere()
-    d = net_directions(surf, *uniform_params(surf, (48, 48)), mode="aa")
-    tn = LS.trace(surf, d, curves=20)
-    col = collapse_curve(surf, mode="aa", samples=(400, 400))
-    return surf, tn, PO.post_optimize(surf, tn.net, tn.joint_uv, col)
+    tn, _, post = _traced_post(surf, "aa", 20)
+    return surf, tn, post
 
 
 def test_constraints_are_weighted_by_the_net_density():
@@ -153,11 +155,7 @@ def test_cnc_post_optimization_at_20_curves_counts_as_converged():
     its iteration limit (energy -0.4 % in 60 iterations), while the constraints have held to
     1e-8 for long. That is convergence; before, the CLI reported the post-optimization as
     not converged and --strict failed."""
-    surf = torus()
-    d = net_directions(surf, *uniform_params(surf, (48, 48)), mode="cnc")
-    tn = LS.trace(surf, d, curves=20)
-    col = collapse_curve(surf, mode="cnc", samples=(400, 400))
-    post = PO.post_optimize(surf, tn.net, tn.joint_uv, col)
+    tn, _, post = _traced_post(torus(), "cnc", 20)
     assert post.converged
     last = post.history[-1]
     assert last["round"] == "polish"
