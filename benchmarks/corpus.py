@@ -155,7 +155,8 @@ def _figures(mode: str, metrics: dict[str, Any]) -> dict[str, Any]:
             "deviation": get("deviation")}
 
 
-def run_one(ref: Reference, mode: str, work: Path, timeout: float) -> dict[str, Any]:
+def run_one(ref: Reference, mode: str, work: Path, timeout: float,
+            fab_args: list[str] = ()) -> dict[str, Any]:
     """One run of ``mode`` on ``ref`` in ``work``, with its checks; a JSON-able record."""
     d = work / ref.name
     d.mkdir(parents=True, exist_ok=True)
@@ -206,7 +207,7 @@ def run_one(ref: Reference, mode: str, work: Path, timeout: float) -> dict[str, 
         rec["verify_gates_ok"] = passed(design_gates(vj.get("kind", KIND[mode]), vj))
         if not rec["verify_ok"] and not rec["message"]:
             rec["message"] = "verify: ok false " + str(vj.get("failing", vj.get("mismatch", "")))
-    f = _call(["fabricate", str(out), "-o", str(out / "fab"), "-q"], timeout)
+    f = _call(["fabricate", str(out), "-o", str(out / "fab"), "-q", *fab_args], timeout)
     rec["fabricate"] = f["code"]
     rec["fabricate_time"] = f["time"]
     if f["code"] != 0 and not rec["message"]:
@@ -308,17 +309,22 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--modes", nargs="+", help="runs, e.g. gg ncp-cnc (default: all that apply)")
     ap.add_argument("--limit", type=int, help="at most this many references")
     ap.add_argument("--every", type=int, default=1, help="every N-th reference (default 1)")
+    ap.add_argument("--start", type=int, default=0,
+                    help="first reference for --every (e.g. --every 2 --start 1: the other half)")
     ap.add_argument("--jobs", type=int, default=1, help="runs at a time (default 1)")
     ap.add_argument("--timeout", type=float, default=180.0, help="seconds per command")
     ap.add_argument("--no-net", action="store_true",
                     help="also the runs that must answer 'no net exists' (aa on K > 0)")
     ap.add_argument("--phlw", action="store_true", help="also 'gridshell phlw' alone")
+    ap.add_argument("--fab-args", default="", metavar="ARGS",
+                    help="extra options of 'gridshell fabricate', e.g. '--scale 1:1' (default: "
+                         "none, the 1:10 polypropylene defaults)")
     ap.add_argument("--keep", metavar="DIR", help="work in DIR and keep it (default: a temp dir)")
     ap.add_argument("--json", metavar="OUT", help="write the raw records to OUT")
     ap.add_argument("--list", action="store_true", help="list the references and their runs")
     args = ap.parse_args(argv)
 
-    refs = select(args.subset)[:: max(1, args.every)]
+    refs = select(args.subset)[args.start:: max(1, args.every)]
     if args.limit:
         refs = refs[: args.limit]
     jobs: list[tuple[Reference, str]] = []
@@ -348,7 +354,7 @@ def main(argv: list[str] | None = None) -> int:
         done: list[dict[str, Any]] = []
 
         def one(job: tuple[Reference, str]) -> dict[str, Any]:
-            rec = run_one(job[0], job[1], work, args.timeout)
+            rec = run_one(job[0], job[1], work, args.timeout, args.fab_args.split())
             done.append(rec)
             print(f"[{time.perf_counter() - t0:7.0f}s] {len(done):3d}/{len(jobs)} "
                   f"{rec['reference']} {rec['mode']}: "
