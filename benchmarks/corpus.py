@@ -109,10 +109,17 @@ def _json(text: str) -> Any:
         return None
 
 
+def _up(e0: Any, e1: Any) -> bool:
+    """``e1`` above ``e0`` (both numbers), beyond rounding."""
+    return (isinstance(e0, (int, float)) and isinstance(e1, (int, float))
+            and e1 > e0 * (1 + 1e-9) + 1e-300)
+
+
 def energy_increases(doc: Any, where: str = "") -> list[str]:
     """Places in a report where an optimizer says converged while its energy ended above
     where it started: every dict with a ``history`` list of rounds holding ``energy`` (and
-    ``energy0``), and ``converged`` true in it or in an enclosing dict; and PHLW's
+    ``energy0``), and ``converged`` true in it or in an enclosing dict (first ``energy0`` to
+    last ``energy``, and every round's ``energy0`` to its ``energy``); and PHLW's
     ``report_before`` / ``report_after`` ``E_PHLW`` totals."""
     found: list[str] = []
 
@@ -123,9 +130,12 @@ def energy_increases(doc: Any, where: str = "") -> list[str]:
             if isinstance(h, list) and h and all(isinstance(r, dict) for r in h):
                 e0 = h[0].get("energy0", h[0].get("energy"))
                 e1 = h[-1].get("energy")
-                if (conv is True and isinstance(e0, (int, float)) and isinstance(e1, (int, float))
-                        and e1 > e0 * (1 + 1e-9) + 1e-300):
+                if conv is True and _up(e0, e1):
                     found.append(f"{path or '/'}: energy {e0:.3g} -> {e1:.3g}")
+                for r in h:  # no round may end above where it started
+                    if conv is True and _up(r.get("energy0"), r.get("energy")):
+                        found.append(f"{path or '/'} round {r.get('round', '?')}: energy "
+                                     f"{r['energy0']:.3g} -> {r['energy']:.3g}")
             b, a = d.get("report_before"), d.get("report_after")
             if conv is True and isinstance(b, dict) and isinstance(a, dict):
                 eb, ea = (b.get("E_PHLW") or {}).get("total"), (a.get("E_PHLW") or {}).get("total")
