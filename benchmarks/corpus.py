@@ -28,6 +28,7 @@ references (success: exit 0, converged, no energy increase).
     .venv/bin/python benchmarks/corpus.py --only gg --every 2 --jobs 2 --json out/corpus.json
     .venv/bin/python benchmarks/corpus.py --subset saddle,dome-01 --only ncp
     .venv/bin/python benchmarks/corpus.py --list                # the references and their runs
+    .venv/bin/python benchmarks/corpus.py --report a.json b.json  # the table of saved runs
 """
 from __future__ import annotations
 
@@ -35,6 +36,7 @@ import argparse
 import json
 import math
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -269,7 +271,8 @@ def table(records: list[dict[str, Any]]) -> str:
 
 def summary(records: list[dict[str, Any]]) -> str:
     out = []
-    modes = list(dict.fromkeys(r["mode"] for r in records))
+    rank = {m: i for i, m in enumerate([*MODES, *PHLW_MODES])}
+    modes = sorted(dict.fromkeys(r["mode"] for r in records), key=lambda m: rank.get(m, 99))
     out.append("\nSuccess (exit 0, every figure within the paper's thresholds, verify ok, "
                "fabricate exit 0):")
     for m in modes:
@@ -284,12 +287,31 @@ def summary(records: list[dict[str, Any]]) -> str:
         goal = GOALS.get(m)
         goal_s = f", goal >= {goal:.0%}: {'met' if ok / len(rs) >= goal else 'NOT met'}" \
             if goal else ""
+        design = sum(r["code"] == 0 and bool(r["gates"]) and all(g["ok"] for g in r["gates"])
+                     and r["verify_ok"] is True for r in rs)
         out.append(f"  {m:10s} {ok:3d} / {len(rs):3d} = {ok / len(rs):6.1%}{goal_s}  "
-                   f"({', '.join(f'{k}: {v}' for k, v in sorted(codes.items()))})")
+                   f"({', '.join(f'{k}: {v}' for k, v in sorted(codes.items()))}; "
+                   f"design and verify alone, without fabricate: {design})")
     nn = [r for r in records if r["expect_no_net"]]
     if nn:
         good = sum(r["code"] == 3 for r in nn)
         out.append(f"  no-net runs answering exit 3: {good} / {len(nn)}")
+    fams = list(dict.fromkeys(r["family"] for r in records))
+    out.append("\nSuccess per family (" + ", ".join(modes) + "):")
+    for fam in fams:
+        cells = []
+        for m in modes:
+            rs = [r for r in records if r["family"] == fam and r["mode"] == m
+                  and not r["expect_no_net"]]
+            cells.append(f"{sum(success(r) for r in rs)}/{len(rs)}" if rs else "-")
+        out.append(f"  {fam:18s} " + "  ".join(f"{c:>5s}" for c in cells))
+    causes: dict[str, int] = {}
+    for r in records:
+        if not success(r) and not (r["expect_no_net"] and r["code"] == 3):
+            key = re.sub(r"[-+]?\d[\d.e+-]*", "#", r["message"] or f"exit {r['code']}")[:70]
+            causes[f"{r['mode']}: {key}"] = causes.get(f"{r['mode']}: {key}", 0) + 1
+    out.append("\nFailure causes (numbers replaced by #):")
+    out += [f"  {n:3d}  {k}" for k, n in sorted(causes.items(), key=lambda kv: -kv[1])]
     lying = [r for r in records if r["code"] == 0 and r["gates"]
              and not all(g["ok"] for g in r["gates"])]
     out.append(f"\nRuns that exit 0 while a figure fails (must be 0): {len(lying)}"
@@ -332,7 +354,18 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--keep", metavar="DIR", help="work in DIR and keep it (default: a temp dir)")
     ap.add_argument("--json", metavar="OUT", help="write the raw records to OUT")
     ap.add_argument("--list", action="store_true", help="list the references and their runs")
+    ap.add_argument("--report", nargs="+", metavar="JSON",
+                    help="print the table and summary of saved records (--json files) instead "
+                         "of running")
     args = ap.parse_args(argv)
+    if args.report:
+        records = [r for p in args.report for r in json.loads(Path(p).read_text())]
+        order = {n: i for i, n in enumerate(r.name for r in select(None))}
+        rank = {m: i for i, m in enumerate([*MODES, *PHLW_MODES])}
+        records.sort(key=lambda r: (order.get(r["reference"], 1e9), rank.get(r["mode"], 99)))
+        print(table(records))
+        print(summary(records))
+        return 0
 
     refs = select(args.subset)[args.start:: max(1, args.every)]
     if args.limit:
