@@ -163,7 +163,8 @@ def _figures(mode: str, metrics: dict[str, Any]) -> dict[str, Any]:
     # GG: no Delta_l / Delta_n gate (its delta_l is the chords' lengthening to the arcs)
     return {"da_mean": get(da, "mean"), "da_max": get(da),
             "dl": None if mode == "gg" else get("delta_l"),
-            "dn": None if mode == "gg" else get("delta_n"), "collapse": coll if isinstance(coll, (int, float)) else None,
+            "dn": None if mode == "gg" else get("delta_n"),
+            "collapse": coll if isinstance(coll, (int, float)) else None,
             "deviation": get("deviation")}
 
 

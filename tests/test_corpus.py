@@ -121,7 +121,8 @@ def test_gaussian_curvature_matches_the_closed_form(ref):
 def test_constant_curvature_patches():
     for ref in select("sphere-cap"):
         K = ref.gaussian_curvature(*AB)
-        R = ref.size / ref._shape.params["X"] / 2   # canonical R = 1 over a span of 2 X
+        R = ref.size / ref.shape.params["X"] / 2    # canonical R = 1 over a span of 2 X
+        assert R == pytest.approx(ref.scale)
         np.testing.assert_allclose(K, 1 / R**2, rtol=1e-5)
     for ref in select("pseudosphere,dini"):
         K = ref.gaussian_curvature(*AB)
@@ -144,7 +145,7 @@ def test_sphere_cap_angle_defect():
         np.add.at(area, F[:, k], np.linalg.norm(np.cross(u, w), axis=1) / 6)
     inner = np.setdiff1d(np.arange(len(V)), TriMesh(V, F).boundary_vertices)
     K = defect[inner].sum() / area[inner].sum()
-    R = ref.size / ref._shape.params["X"] / 2
+    R = ref.size / ref.shape.params["X"] / 2
     assert K == pytest.approx(1 / R**2, rel=0.02)
 
 

@@ -93,6 +93,16 @@ class Reference:
     _scale: float = field(repr=False, compare=False)
     _shape: Shape = field(repr=False, compare=False)
 
+    @property
+    def scale(self) -> float:
+        """Metres per canonical unit of the family (:mod:`gridshell.corpus.surfaces`)."""
+        return self._scale
+
+    @property
+    def shape(self) -> Shape:
+        """The canonical patch (family coefficients, closed forms)."""
+        return self._shape
+
     # ------------------------------------------------------------------ geometry (metres)
     def surface(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         """Points ``(..., 3)`` of the reference at parameters ``(a, b)`` of the unit square."""
