@@ -26,6 +26,12 @@ def test_the_corpus_spans_families_sizes_resolutions_and_meshes():
     assert kinds["quad"] >= 20 and kinds["tri"] >= 20
     assert {r.orientation for r in REFERENCES} == {"upright", "yaw", "tilted", "y-up", "any"}
     assert sum(np.linalg.norm(r.offset) > 10 * r.size for r in REFERENCES) >= 10
+    for f in FAMILIES:  # each family at several resolutions and sizes, as quads and triangles
+        rs = [r for r in REFERENCES if r.family == f]
+        assert {r.mesh for r in rs} == {"quad", "tri"}, f
+        assert len({max(r.rows, r.cols) for r in rs}) >= 3, f
+        assert max(r.size for r in rs) / min(r.size for r in rs) > 10, f
+        assert len({r.orientation for r in rs}) >= 3, f
     # every pipeline and mode has references to run on
     runs = collections.Counter(m for r in REFERENCES for m in r.modes)
     assert set(runs) == set(MODES) and runs["gg"] == len(REFERENCES)
