@@ -107,6 +107,19 @@ class DesignBundle:
         return d
 
 
+def finite_json(obj: Any) -> Any:
+    """:func:`_jsonable` of ``obj`` with every non-finite float (NaN, Inf: a figure that could
+    not be measured) replaced by None, so the JSON written is strict (no ``NaN`` token)."""
+    obj = _jsonable(obj)
+    if isinstance(obj, dict):
+        return {k: finite_json(v) for k, v in obj.items()}
+    if isinstance(obj, list):
+        return [finite_json(v) for v in obj]
+    if isinstance(obj, float) and not np.isfinite(obj):
+        return None
+    return obj
+
+
 def _jsonable(obj: Any) -> Any:
     """Turn numpy scalars/arrays nested in dicts and lists into JSON types."""
     if isinstance(obj, dict):
