@@ -142,9 +142,18 @@ def write_bundle(path: str | Path, bundle: DesignBundle,
     from .quadmesh import write_mesh, write_polylines
 
     path = Path(path)
-    with atomic_dir(path) as tmp:
-        (tmp / "design.json").write_text(json.dumps(bundle.design_json(), indent=1),
-                                         encoding="utf-8")
+    with atomic_dir(path, owner="gg" if bundle.kind == "GG" else "ncp",
+                    kind=f"design bundle {bundle.kind}") as tmp:
+        d = bundle.design_json()
+        d["metrics"], d["params"] = finite_json(d["metrics"]), finite_json(d["params"])
+        try:  # geometry (joint_s, collapse curve) must be finite: a bug if not
+            text = json.dumps(d, indent=1, allow_nan=False)
+        except ValueError:
+            from .errors import GridshellError
+            raise GridshellError("refusing to write design.json: a lamella's joint_s / "
+                                 "collapse_s or the collapse curve holds NaN or Inf; this is a "
+                                 "bug, please report it") from None
+        (tmp / "design.json").write_text(text, encoding="utf-8")
         write_mesh(tmp / "net.obj", bundle.net.joints, bundle.net.loops)
         write_mesh(tmp / "aligned.obj", bundle.aligned, bundle.net.loops)
         write_polylines(tmp / "axes.obj", [lam.axis for lam in bundle.net.lamellae])
@@ -214,13 +223,39 @@ def lamellae_from_design(d: dict, axes: list[np.ndarray], where: str | Path) -> 
     out = []
     for k, (r, ax) in enumerate(zip(d["lamellae"], axes)):
         try:
+            for key in ("joint_s", "collapse_s", "length"):
+                if key in r:
+                    _finite_field(r[key], f"{where}: lamella record {k} of design.json, "
+                                          f"field '{key}'")
             out.append(Lamella(id=int(r["id"]), family=int(r["family"]), joints=r["joints"],
                                joint_s=r["joint_s"], axis=ax))
         except (KeyError, TypeError, ValueError) as exc:
+            if isinstance(exc, InputError):
+                raise
             what = f"lacks {exc}" if isinstance(exc, KeyError) else f"is malformed ({exc})"
             raise InputError(f"{where}: lamella record {k} of design.json {what}; re-run the "
                              "design command") from None
+        if "collapse_s" in r and np.size(r["collapse_s"]) != len(out[-1].joints):
+            raise InputError(f"{where}: lamella record {k} of design.json has "
+                             f"{np.size(r['collapse_s'])} collapse_s values for "
+                             f"{len(out[-1].joints)} joints; re-run the design command")
+    ids = [lam.id for lam in out]
+    if len(set(ids)) != len(ids):
+        raise InputError(f"{where}: design.json names lamella ids more than once; re-run the "
+                         "design command")
     return out
+
+
+def _finite_field(value: Any, what: str) -> None:
+    """:class:`InputError` naming ``what`` unless ``value`` is a number or a list of finite
+    numbers."""
+    try:
+        a = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"{what} is not a list of numbers; re-run the design command") from None
+    if not np.all(np.isfinite(a)):
+        raise InputError(f"{what} holds {int((~np.isfinite(a)).sum())} non-finite values (NaN "
+                         "or Inf); re-run the design command")
 
 
 def read_bundle(path: str | Path) -> DesignBundle:
@@ -253,6 +288,14 @@ def read_bundle(path: str | Path) -> DesignBundle:
     except (KeyError, TypeError, ValueError) as exc:
         raise InputError(f"{path}: the collapse curve in design.json is malformed ({exc!r}); "
                          "re-run the design command") from None
+    if collapse is not None:
+        for key, v in (("points", collapse.points), ("normals", collapse.normals),
+                       ("radius", collapse.radius)):
+            if v is not None:
+                _finite_field(v, f"{path}: design.json, field 'collapse.{key}'")
+        if collapse.radius is not None and not float(collapse.radius) > 0:
+            raise InputError(f"{path}: design.json, field 'collapse.radius' must be positive, "
+                             f"got {collapse.radius}; re-run the design command")
     return DesignBundle(kind=d["kind"], net=net, aligned=aligned, surface_V=surf.V,
                         surface_F=surf.F, metrics=d.get("metrics", {}),
                         params=d.get("params", {}), collapse=collapse, collapse_s=collapse_s,

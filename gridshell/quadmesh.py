@@ -794,7 +794,24 @@ def read_configuration(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray,
     if len(P) and (P.max() >= len(V)):
         raise MeshError(f"{path.name}: a face refers to vertex {int(P.max())} but the file has "
                         f"{len(V)} vertices; the file is truncated or corrupt")
+    check_coordinates(V, path.name)
     return V, P, sizes
+
+
+def check_coordinates(V: np.ndarray, name: str, what: str = "vertex") -> None:
+    """:class:`MeshError` naming the first finite coordinate of ``V (n,3)`` (metres) beyond
+    ``EXTENT_RANGE[1]`` from the origin: out-of-range coordinates (other units, or a corrupt
+    file), reported as such rather than as the degenerate faces they cause."""
+    V = np.asarray(V, dtype=np.float64).reshape(-1, 3)
+    fin = np.isfinite(V).all(axis=1)
+    big = fin & (np.abs(np.where(np.isfinite(V), V, 0.0)).max(axis=1, initial=0.0)
+                 > EXTENT_RANGE[1])
+    if big.any():
+        i = int(np.flatnonzero(big)[0])
+        x, y, z = V[i]
+        raise MeshError(f"{name}: {int(big.sum())} coordinates are out of range ({what} {i} at "
+                        f"({x:.3g}, {y:.3g}, {z:.3g}) m, beyond +-{EXTENT_RANGE[1]:g} m); "
+                        "coordinates are read as metres - rescale the mesh or repair the file")
 
 
 def read_mesh(path: str | os.PathLike, kind: str = "any",
@@ -828,6 +845,7 @@ def read_mesh(path: str | os.PathLike, kind: str = "any",
         raise ValueError(f"kind must be 'any', 'quad' or 'tri', got {kind!r}")
     path = Path(path)
     V, P, sizes = _read_raw(path)
+    check_coordinates(V, path.name)
     validate_mesh(V, P, require_quads=kind == "quad", name=path.name,
                   manifold_vertices=manifold_vertices)
     _check_extent(V, path.name)
@@ -985,5 +1003,11 @@ def read_polylines(path: str | os.PathLike) -> list[np.ndarray]:
         idx = np.asarray(idx, dtype=np.int64)
         if np.any((idx < 0) | (idx >= len(V))):
             raise _corrupt(path, f"polyline {i} refers to missing vertices")
-        out.append(V[idx])
+        P = np.asarray(V[idx], dtype=np.float64)
+        if not np.all(np.isfinite(P)):
+            raise MeshError(f"{path.name}: polyline {i} has "
+                            f"{int((~np.isfinite(P)).any(axis=1).sum())} points with NaN or "
+                            "infinite coordinates; re-run the design command")
+        check_coordinates(P, path.name, f"polyline {i} point")
+        out.append(P)
     return out

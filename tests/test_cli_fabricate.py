@@ -83,8 +83,8 @@ def test_nonsensical_parameters_fail_before_writing(bundles, tmp_path, capsys, a
 def test_bad_bundle_and_unsafe_output(bundles, tmp_path, capsys):
     assert main(["fabricate", "--force", str(tmp_path / "nothing"), "-q"]) == 2
     # refuse to replace the bundle or a foreign directory
-    assert main(["fabricate", "--force", str(bundles / "gg"), "-o", str(bundles / "gg"), "-q"]) == 2
+    assert main(["fabricate", "--force", str(bundles / "gg"), "-o", str(bundles / "gg"), "-q"]) == 5
     (tmp_path / "mine").mkdir()
     (tmp_path / "mine" / "notes.txt").write_text("keep")
-    assert main(["fabricate", "--force", str(bundles / "gg"), "-o", str(tmp_path / "mine"), "-q"]) == 2
+    assert main(["fabricate", "--force", str(bundles / "gg"), "-o", str(tmp_path / "mine"), "-q"]) == 5
     assert (tmp_path / "mine" / "notes.txt").read_text() == "keep"

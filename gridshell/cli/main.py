@@ -78,6 +78,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"\ngridshell: error: give a command, one of {', '.join(SUBCOMMANDS)} "
               "(gridshell COMMAND --help describes its options)", file=sys.stderr)
         return 2
+    from ..manifest import set_command
+
+    set_command(args.command, ["gridshell", *argv])
     try:
         result = args._run(args)
     except GridshellError as exc:
@@ -88,6 +91,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)
         return 130
+    finally:
+        set_command(None)
     return int(result or 0)
 
 
