@@ -246,6 +246,24 @@ def lamellae_from_design(d: dict, axes: list[np.ndarray], where: str | Path) -> 
     return out
 
 
+def check_collapse(d: dict, where: str | Path) -> None:
+    """:class:`InputError` naming the field unless the collapse curve of design.json ``d`` (if
+    any) has finite ``points`` and ``normals`` and a finite positive ``radius`` (or none)."""
+    c = d.get("collapse")
+    if c is None:
+        return
+    if not isinstance(c, dict):
+        raise InputError(f"{where}: design.json, field 'collapse' must be a record; re-run the "
+                         "design command")
+    for key in ("points", "normals", "radius"):
+        if c.get(key) is not None:
+            _finite_field(c[key], f"{where}: design.json, field 'collapse.{key}'")
+    r = c.get("radius")
+    if r is not None and not (isinstance(r, (int, float)) and r > 0):
+        raise InputError(f"{where}: design.json, field 'collapse.radius' must be a positive "
+                         f"number (metres), got {r!r}; re-run the design command")
+
+
 def _finite_field(value: Any, what: str) -> None:
     """:class:`InputError` naming ``what`` unless ``value`` is a number or a list of finite
     numbers."""
@@ -288,14 +306,7 @@ def read_bundle(path: str | Path) -> DesignBundle:
     except (KeyError, TypeError, ValueError) as exc:
         raise InputError(f"{path}: the collapse curve in design.json is malformed ({exc!r}); "
                          "re-run the design command") from None
-    if collapse is not None:
-        for key, v in (("points", collapse.points), ("normals", collapse.normals),
-                       ("radius", collapse.radius)):
-            if v is not None:
-                _finite_field(v, f"{path}: design.json, field 'collapse.{key}'")
-        if collapse.radius is not None and not float(collapse.radius) > 0:
-            raise InputError(f"{path}: design.json, field 'collapse.radius' must be positive, "
-                             f"got {collapse.radius}; re-run the design command")
+    check_collapse(d, path)
     return DesignBundle(kind=d["kind"], net=net, aligned=aligned, surface_V=surf.V,
                         surface_F=surf.F, metrics=d.get("metrics", {}),
                         params=d.get("params", {}), collapse=collapse, collapse_s=collapse_s,

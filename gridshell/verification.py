@@ -173,7 +173,7 @@ def verify_bundle(path: str | Path) -> dict[str, Any]:
     holds and there is no problem. A bundle whose net.obj, axes.obj, surface.obj or
     design.json cannot be read raises :class:`~gridshell.errors.InputError`.
     """
-    from .bundle import lamellae_from_design, read_design_json, read_net_mesh
+    from .bundle import check_collapse, lamellae_from_design, read_design_json, read_net_mesh
     from .errors import InputError, MeshError
     from .metrics import (alignability_error, alignability_error_arc,
                            crossing_normal_curvature_on_mesh, delta_l, delta_n,
@@ -184,6 +184,7 @@ def verify_bundle(path: str | Path) -> dict[str, Any]:
 
     path = Path(path)
     d = read_design_json(path)
+    check_collapse(d, path)
     for name in ("net.obj", "axes.obj", "surface.obj"):
         if not (path / name).is_file():
             raise InputError(f"design bundle {path} lacks {name}; re-run the design command")
