@@ -226,8 +226,12 @@ def _check_spread(ctrl: np.ndarray) -> None:
     from .quadmesh import EXTENT_RANGE
 
     P = ctrl.reshape(-1, 3)
-    span = float(np.linalg.norm(P.max(axis=0) - P.min(axis=0)))
     lo, hi = EXTENT_RANGE
+    if np.abs(P).max() > hi:  # before any arithmetic that could overflow
+        raise InputError(f"a control point lies at {np.abs(P).max():.3g} m from the origin, "
+                         f"beyond the {hi:g} m a gridshell can have (out-of-range coordinates); "
+                         "control points are read as metres - convert them")
+    span = float(np.linalg.norm(P.max(axis=0) - P.min(axis=0)))
     if not span >= lo:
         raise InputError(f"the control points span {span:.3g} m: they all lie at one point, so "
                          "there is no surface (a degenerate input); re-export the surface")

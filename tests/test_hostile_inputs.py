@@ -511,3 +511,15 @@ def test_numeric_options_beyond_their_limits(tmp_path, capsys, good, command, op
 OPTION_WORDS = {"--lamellae": "lamellae", "--spacing": "spacing", "--angle": "angle",
                 "--at": "parallel", "--grid": "grid", "--offsets": "offsets", "--scale": "scale",
                 "--sheet": "sheet"}
+
+
+def test_exit_codes_have_one_table():
+    """The codes the error classes carry are the documented ones, each once."""
+    from gridshell import errors
+
+    classes = [errors.GridshellError, errors.InputError, errors.MeshError, errors.NoNetError,
+               errors.ConvergenceError, errors.OutputError]
+    assert {c.exit_code for c in classes} | {0} == set(errors.EXIT_CODES) == {0, 1, 2, 3, 4, 5}
+    readme = (Path(__file__).parents[1] / "README.md").read_text()
+    for code in errors.EXIT_CODES:
+        assert f"\n| {code} |" in readme

@@ -67,9 +67,9 @@ def _requested(argv: Sequence[str]) -> list[str]:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run the CLI; returns the exit code (0 success, 2 bad input or no command, 3 no net,
-    4 no convergence, 5 output not writable, 1 other tool error; argparse exits with 2 on an
-    unknown option)."""
+    """Run the CLI; returns the exit code (:data:`gridshell.errors.EXIT_CODES`: 0 success,
+    2 bad input or no command, 3 no net, 4 not converged, 5 output refused or not writable,
+    1 other tool error; argparse exits with 2 on an unknown option)."""
     argv = sys.argv[1:] if argv is None else list(argv)
     parser = build_parser(_requested(argv))
     args = parser.parse_args(argv)
