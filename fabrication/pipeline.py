@@ -8,6 +8,7 @@ file is written; the output directory then appears at once (``gridshell.atomic.a
     cutlist.csv                        one row per piece
     plan.png, plan.svg                 the net with every lamella's id at its place
     fabrication.json                   this report
+    manifest.json                      the files written (gridshell.manifest)
 """
 from __future__ import annotations
 
@@ -19,7 +20,8 @@ import numpy as np
 
 from gridshell.atomic import atomic_dir
 from gridshell.bundle import DesignBundle, read_bundle
-from gridshell.errors import InputError
+from gridshell.errors import InputError, OutputError
+from gridshell.manifest import MANIFEST, refusal
 
 from .cutlist import cutlist_rows, write_cutlist
 from .dxf import write_sheet_dxf
@@ -33,6 +35,8 @@ from .strips import strips_from_bundle
 from .svg import write_sheet_svg
 
 REPORT = "fabrication.json"
+#: the command whose outputs :func:`fabricate` writes and may replace (gridshell.manifest)
+OWNER = "fabricate"
 
 
 def _check_out(out: Path, bundle_dir: Path | None) -> None:
@@ -40,14 +44,11 @@ def _check_out(out: Path, bundle_dir: Path | None) -> None:
     if bundle_dir is not None:
         b = bundle_dir.resolve()
         if out_r == b or out_r in b.parents:
-            raise InputError(f"output directory {out} would replace the design bundle {bundle_dir};"
-                             " choose another -o (default: DIR/fabrication)")
-    if out.exists():
-        if not out.is_dir():
-            raise InputError(f"{out} exists and is not a directory; choose another -o")
-        if any(out.iterdir()) and not (out / REPORT).is_file():
-            raise InputError(f"{out} exists and is not the output of 'gridshell fabricate' (no "
-                             f"{REPORT}); choose another -o or remove it")
+            raise OutputError(f"output directory {out} would replace the design bundle "
+                              f"{bundle_dir}; choose another -o (default: DIR/fabrication)")
+    why = refusal(out, OWNER)
+    if why:
+        raise OutputError(why)
 
 
 def plan_parts(bundle: DesignBundle, params: FabParams,
@@ -123,7 +124,7 @@ def fabricate(bundle: str | Path | DesignBundle, out_dir: str | Path,
     names = [f"sheet_{k + 1:02d}" for k in range(layout.n_sheets)]
     previews = [f"{n}.png" for n in names]
     files = [f"{n}{ext}" for n in names for ext in (".dxf", ".svg", ".png")]
-    files += ["cutlist.csv"] + (["plan.png", "plan.svg"] if plan else []) + [REPORT]
+    files += ["cutlist.csv"] + (["plan.png", "plan.svg"] if plan else []) + [REPORT, MANIFEST]
     mm = params.mm_per_m
     axis_lengths = {int(lam.id): lam.length * mm for lam in bundle.net.lamellae}
     report = {
@@ -150,7 +151,7 @@ def fabricate(bundle: str | Path | DesignBundle, out_dir: str | Path,
                    for p, s in zip(layout.parts, layout.sheet_of)],
     }
     say(f"writing {out}")
-    with atomic_dir(out) as tmp:
+    with atomic_dir(out, owner=OWNER, kind=f"fabrication of a {bundle.kind} design") as tmp:
         for k, name in enumerate(names):
             sp = layout.on_sheet(k)
             write_sheet_dxf(tmp / f"{name}.dxf", sp, (W, H), params)

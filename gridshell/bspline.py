@@ -219,6 +219,32 @@ def _as_ctrl(ctrl: Any) -> np.ndarray:
     return ctrl
 
 
+def _check_spread(ctrl: np.ndarray) -> None:
+    """:class:`InputError` for control points of a file that cannot carry a surface: all at one
+    point or on one line (degenerate input), or spanning more than a gridshell can (metres,
+    :data:`gridshell.quadmesh.EXTENT_RANGE`)."""
+    from .quadmesh import EXTENT_RANGE
+
+    P = ctrl.reshape(-1, 3)
+    lo, hi = EXTENT_RANGE
+    if np.abs(P).max() > hi:  # before any arithmetic that could overflow
+        raise InputError(f"a control point lies at {np.abs(P).max():.3g} m from the origin, "
+                         f"beyond the {hi:g} m a gridshell can have (out-of-range coordinates); "
+                         "control points are read as metres - convert them")
+    span = float(np.linalg.norm(P.max(axis=0) - P.min(axis=0)))
+    if not span >= lo:
+        raise InputError(f"the control points span {span:.3g} m: they all lie at one point, so "
+                         "there is no surface (a degenerate input); re-export the surface")
+    if span > hi:
+        raise InputError(f"the control points span {span:.3g} m, beyond the {hi:g} m a "
+                         "gridshell can have (out-of-range coordinates); control points are "
+                         "read as metres - convert them")
+    sv = np.linalg.svd(P - P.mean(axis=0), compute_uv=False)
+    if not sv[1] > 1e-9 * sv[0]:
+        raise InputError("the control points all lie on one line, so there is no surface (a "
+                         "degenerate input); re-export the surface")
+
+
 _DERIVS = {"S": (0, 0), "Su": (1, 0), "Sv": (0, 1), "Suu": (2, 0), "Suv": (1, 1), "Svv": (0, 2)}
 
 
@@ -448,7 +474,9 @@ class BSplineSurface:
         except (TypeError, ValueError) as exc:
             raise InputError(f"B-spline knots/ctrl are not numeric arrays ({exc}); "
                              "ctrl must be nested lists [[[x, y, z], ...], ...]") from exc
-        return cls(d["degree_u"], d["degree_v"], knots_u, knots_v, ctrl)
+        surf = cls(d["degree_u"], d["degree_v"], knots_u, knots_v, ctrl)
+        _check_spread(surf.ctrl)
+        return surf
 
     def save(self, path: str | os.PathLike) -> None:
         """Write the surface as JSON to ``path`` atomically."""

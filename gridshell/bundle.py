@@ -107,6 +107,19 @@ class DesignBundle:
         return d
 
 
+def finite_json(obj: Any) -> Any:
+    """:func:`_jsonable` of ``obj`` with every non-finite float (NaN, Inf: a figure that could
+    not be measured) replaced by None, so the JSON written is strict (no ``NaN`` token)."""
+    obj = _jsonable(obj)
+    if isinstance(obj, dict):
+        return {k: finite_json(v) for k, v in obj.items()}
+    if isinstance(obj, list):
+        return [finite_json(v) for v in obj]
+    if isinstance(obj, float) and not np.isfinite(obj):
+        return None
+    return obj
+
+
 def _jsonable(obj: Any) -> Any:
     """Turn numpy scalars/arrays nested in dicts and lists into JSON types."""
     if isinstance(obj, dict):
@@ -129,9 +142,18 @@ def write_bundle(path: str | Path, bundle: DesignBundle,
     from .quadmesh import write_mesh, write_polylines
 
     path = Path(path)
-    with atomic_dir(path) as tmp:
-        (tmp / "design.json").write_text(json.dumps(bundle.design_json(), indent=1),
-                                         encoding="utf-8")
+    with atomic_dir(path, owner="gg" if bundle.kind == "GG" else "ncp",
+                    kind=f"design bundle {bundle.kind}") as tmp:
+        d = bundle.design_json()
+        d["metrics"], d["params"] = finite_json(d["metrics"]), finite_json(d["params"])
+        try:  # geometry (joint_s, collapse curve) must be finite: a bug if not
+            text = json.dumps(d, indent=1, allow_nan=False)
+        except ValueError:
+            from .errors import GridshellError
+            raise GridshellError("refusing to write design.json: a lamella's joint_s / "
+                                 "collapse_s or the collapse curve holds NaN or Inf; this is a "
+                                 "bug, please report it") from None
+        (tmp / "design.json").write_text(text, encoding="utf-8")
         write_mesh(tmp / "net.obj", bundle.net.joints, bundle.net.loops)
         write_mesh(tmp / "aligned.obj", bundle.aligned, bundle.net.loops)
         write_polylines(tmp / "axes.obj", [lam.axis for lam in bundle.net.lamellae])
@@ -201,13 +223,57 @@ def lamellae_from_design(d: dict, axes: list[np.ndarray], where: str | Path) -> 
     out = []
     for k, (r, ax) in enumerate(zip(d["lamellae"], axes)):
         try:
+            for key in ("joint_s", "collapse_s", "length"):
+                if key in r:
+                    _finite_field(r[key], f"{where}: lamella record {k} of design.json, "
+                                          f"field '{key}'")
             out.append(Lamella(id=int(r["id"]), family=int(r["family"]), joints=r["joints"],
                                joint_s=r["joint_s"], axis=ax))
         except (KeyError, TypeError, ValueError) as exc:
+            if isinstance(exc, InputError):
+                raise
             what = f"lacks {exc}" if isinstance(exc, KeyError) else f"is malformed ({exc})"
             raise InputError(f"{where}: lamella record {k} of design.json {what}; re-run the "
                              "design command") from None
+        if "collapse_s" in r and np.size(r["collapse_s"]) != len(out[-1].joints):
+            raise InputError(f"{where}: lamella record {k} of design.json has "
+                             f"{np.size(r['collapse_s'])} collapse_s values for "
+                             f"{len(out[-1].joints)} joints; re-run the design command")
+    ids = [lam.id for lam in out]
+    if len(set(ids)) != len(ids):
+        raise InputError(f"{where}: design.json names lamella ids more than once; re-run the "
+                         "design command")
     return out
+
+
+def check_collapse(d: dict, where: str | Path) -> None:
+    """:class:`InputError` naming the field unless the collapse curve of design.json ``d`` (if
+    any) has finite ``points`` and ``normals`` and a finite positive ``radius`` (or none)."""
+    c = d.get("collapse")
+    if c is None:
+        return
+    if not isinstance(c, dict):
+        raise InputError(f"{where}: design.json, field 'collapse' must be a record; re-run the "
+                         "design command")
+    for key in ("points", "normals", "radius"):
+        if c.get(key) is not None:
+            _finite_field(c[key], f"{where}: design.json, field 'collapse.{key}'")
+    r = c.get("radius")
+    if r is not None and not (isinstance(r, (int, float)) and r > 0):
+        raise InputError(f"{where}: design.json, field 'collapse.radius' must be a positive "
+                         f"number (metres), got {r!r}; re-run the design command")
+
+
+def _finite_field(value: Any, what: str) -> None:
+    """:class:`InputError` naming ``what`` unless ``value`` is a number or a list of finite
+    numbers."""
+    try:
+        a = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"{what} is not a list of numbers; re-run the design command") from None
+    if not np.all(np.isfinite(a)):
+        raise InputError(f"{what} holds {int((~np.isfinite(a)).sum())} non-finite values (NaN "
+                         "or Inf); re-run the design command")
 
 
 def read_bundle(path: str | Path) -> DesignBundle:
@@ -240,6 +306,7 @@ def read_bundle(path: str | Path) -> DesignBundle:
     except (KeyError, TypeError, ValueError) as exc:
         raise InputError(f"{path}: the collapse curve in design.json is malformed ({exc!r}); "
                          "re-run the design command") from None
+    check_collapse(d, path)
     return DesignBundle(kind=d["kind"], net=net, aligned=aligned, surface_V=surf.V,
                         surface_F=surf.F, metrics=d.get("metrics", {}),
                         params=d.get("params", {}), collapse=collapse, collapse_s=collapse_s,

@@ -38,3 +38,16 @@ class OutputError(GridshellError, OSError):
     """An output location cannot be written."""
 
     exit_code = 5
+
+
+#: exit code -> category, the one table of the CLI's exit codes (README "Exit codes"); each
+#: error class above carries its code
+EXIT_CODES: dict[int, str] = {
+    0: "success",
+    GridshellError.exit_code: "a bug of the tool (please report it)",
+    InputError.exit_code: "bad input: unreadable, degenerate or inconsistent files, "
+                          "out-of-range coordinates, nonsensical parameters",
+    NoNetError.exit_code: "no net of the requested kind exists on the surface",
+    ConvergenceError.exit_code: "not converged: the design misses the paper's figures",
+    OutputError.exit_code: "output refused or not writable",
+}

@@ -794,7 +794,24 @@ def read_configuration(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray,
     if len(P) and (P.max() >= len(V)):
         raise MeshError(f"{path.name}: a face refers to vertex {int(P.max())} but the file has "
                         f"{len(V)} vertices; the file is truncated or corrupt")
+    check_coordinates(V, path.name)
     return V, P, sizes
+
+
+def check_coordinates(V: np.ndarray, name: str, what: str = "vertex") -> None:
+    """:class:`MeshError` naming the first finite coordinate of ``V (n,3)`` (metres) beyond
+    ``EXTENT_RANGE[1]`` from the origin: out-of-range coordinates (other units, or a corrupt
+    file), reported as such rather than as the degenerate faces they cause."""
+    V = np.asarray(V, dtype=np.float64).reshape(-1, 3)
+    fin = np.isfinite(V).all(axis=1)
+    big = fin & (np.abs(np.where(np.isfinite(V), V, 0.0)).max(axis=1, initial=0.0)
+                 > EXTENT_RANGE[1])
+    if big.any():
+        i = int(np.flatnonzero(big)[0])
+        x, y, z = V[i]
+        raise MeshError(f"{name}: {int(big.sum())} coordinates are out of range ({what} {i} at "
+                        f"({x:.3g}, {y:.3g}, {z:.3g}) m, beyond +-{EXTENT_RANGE[1]:g} m); "
+                        "coordinates are read as metres - rescale the mesh or repair the file")
 
 
 def read_mesh(path: str | os.PathLike, kind: str = "any",
@@ -828,6 +845,7 @@ def read_mesh(path: str | os.PathLike, kind: str = "any",
         raise ValueError(f"kind must be 'any', 'quad' or 'tri', got {kind!r}")
     path = Path(path)
     V, P, sizes = _read_raw(path)
+    check_coordinates(V, path.name)
     validate_mesh(V, P, require_quads=kind == "quad", name=path.name,
                   manifold_vertices=manifold_vertices)
     _check_extent(V, path.name)
@@ -860,6 +878,46 @@ def _index_text(prefix: str, F: np.ndarray, offset: int) -> str:
     return "".join(prefix + " ".join(row) + "\n" for row in S.tolist())
 
 
+def orientation_problem(F: np.ndarray, n_vertices: int) -> str | None:
+    """Why the faces ``F (m,k)`` are not consistently oriented, or None.
+
+    Purely combinatorial (each directed edge ``(F[i, j], F[i, j+1])`` at most once, so the two
+    faces of an interior edge run it in opposite directions), so it holds for a collapsed net
+    whose loops are geometrically degenerate (aligned.obj).
+    """
+    F = np.asarray(F, dtype=np.int64)
+    if F.size == 0:
+        return None
+    src, dst = F.ravel(), np.roll(F, -1, axis=1).ravel()
+    directed = src * np.int64(max(n_vertices, 1)) + dst
+    u, c = np.unique(directed, return_counts=True)
+    if np.any(c > 1):
+        d = u[c > 1]
+        n = max(n_vertices, 1)
+        return (f"{len(d)} edges are run in the same direction by two faces (the first joins "
+                f"vertices {d[0] // n} and {d[0] % n}): the faces are inconsistently oriented")
+    return None
+
+
+def _check_writable_mesh(name: str, V: np.ndarray, F: np.ndarray) -> None:
+    """:class:`GridshellError` (a bug of the caller: the tool never writes such a file) unless
+    ``V`` is finite, ``F`` refers to existing vertices and is consistently oriented."""
+    from .errors import GridshellError
+
+    bad = ~np.isfinite(V).all(axis=1)
+    if bad.any():
+        raise GridshellError(f"refusing to write {name}: {int(bad.sum())} vertices are not "
+                             f"finite (NaN or Inf; the first is vertex {int(np.flatnonzero(bad)[0])})"
+                             "; this is a bug, please report it")
+    if F.size and (F.min() < 0 or F.max() >= len(V)):
+        raise GridshellError(f"refusing to write {name}: faces refer to vertices outside 0 .. "
+                             f"{len(V) - 1}; this is a bug, please report it")
+    problem = orientation_problem(F, len(V))
+    if problem is not None:
+        raise GridshellError(f"refusing to write {name}: {problem}; this is a bug, please "
+                             "report it")
+
+
 def write_mesh(path: str | os.PathLike, V: np.ndarray, F: np.ndarray) -> None:
     """Write ``V (n,3)``, ``F (m,k)`` to an OBJ, PLY or OFF file (ASCII), atomically.
 
@@ -874,7 +932,11 @@ def write_mesh(path: str | os.PathLike, V: np.ndarray, F: np.ndarray) -> None:
     V : (n,3) float
         Vertex positions, metres.
     F : (m,k) int
-        Faces (0-based vertex indices), all of one size ``k``.
+        Faces (0-based vertex indices), all of one size ``k``, consistently oriented
+        (:func:`orientation_problem`).
+
+    Raises :class:`~gridshell.errors.GridshellError` for non-finite vertices, faces outside
+    the vertices or inconsistent orientation: the tool never writes such a mesh.
     """
     path = Path(path)
     ext = path.suffix.lower()
@@ -885,6 +947,7 @@ def write_mesh(path: str | os.PathLike, V: np.ndarray, F: np.ndarray) -> None:
     F = np.asarray(F, dtype=np.int64)
     if V.ndim != 2 or V.shape[1] != 3 or F.ndim != 2:
         raise MeshError(f"{path.name}: expected V (n,3) and F (m,k), got {V.shape} and {F.shape}")
+    _check_writable_mesh(path.name, V, F)
     vtext = "".join(" ".join(map(repr, r)) + "\n" for r in V.tolist())
     if ext == ".obj":
         text = (f"# {len(V)} vertices, {len(F)} faces\n" + "".join("v " + s for s in
@@ -917,6 +980,10 @@ def write_polylines(path: str | os.PathLike, polylines: Sequence[np.ndarray]) ->
         P = np.asarray(P, dtype=np.float64)
         if P.ndim != 2 or P.shape[1] != 3 or len(P) < 2:
             raise MeshError(f"polyline {i}: expected (k,3) points with k >= 2, got {P.shape}")
+        if not np.all(np.isfinite(P)):
+            from .errors import GridshellError
+            raise GridshellError(f"refusing to write {Path(path).name}: polyline {i} has "
+                                 "non-finite points (NaN or Inf); this is a bug, please report it")
         parts.append(_obj_vertex_text(P))
         lines.append("l " + " ".join(map(str, range(start, start + len(P)))) + "\n")
         start += len(P)
@@ -936,5 +1003,11 @@ def read_polylines(path: str | os.PathLike) -> list[np.ndarray]:
         idx = np.asarray(idx, dtype=np.int64)
         if np.any((idx < 0) | (idx >= len(V))):
             raise _corrupt(path, f"polyline {i} refers to missing vertices")
-        out.append(V[idx])
+        P = np.asarray(V[idx], dtype=np.float64)
+        if not np.all(np.isfinite(P)):
+            raise MeshError(f"{path.name}: polyline {i} has "
+                            f"{int((~np.isfinite(P)).any(axis=1).sum())} points with NaN or "
+                            "infinite coordinates; re-run the design command")
+        check_coordinates(P, path.name, f"polyline {i} point")
+        out.append(P)
     return out

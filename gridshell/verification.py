@@ -6,7 +6,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["NCP_STORED", "verify_bundle"]
+__all__ = ["GG_STORED", "NCP_STORED", "exit_code", "verify_bundle"]
 
 
 #: verified figure -> the stored metric of an NCP / CNC / AA design.json it recomputes
@@ -14,6 +14,19 @@ NCP_STORED = {"alignability": "delta_a_after", "deviation": "deviation", "delta_
               "delta_n": "delta_n", "aligned_radius": "aligned_radius",
               "aligned_radius_error": "aligned_radius_error",
               "aligned_line_error": "aligned_line_error"}
+
+
+#: verified figure -> the stored metric of a GG design.json it recomputes
+GG_STORED = {"alignability": "alignability", "alignability_arc": "alignability_arc",
+             "geodesic_turning": "geodesic_turning", "deviation": "deviation",
+             "deviation_joints": "deviation_joints"}
+
+#: files each bundle kind needs for its figures (besides design.json, net.obj, axes.obj and
+#: surface.obj, without which nothing can be checked): a missing one makes ``ok`` false
+FIGURE_FILES = {"GG": ("aligned.obj",),
+                "NCP": ("aligned.obj", "axes_r.npy", "aligned_r.npy"),
+                "CNC": ("aligned.obj", "axes_r.npy", "aligned_r.npy"),
+                "AA": ("aligned.obj", "axes_r.npy", "aligned_r.npy")}
 
 
 def _aligned_figures(Va: np.ndarray, d: dict) -> dict[str, Any]:
@@ -67,21 +80,79 @@ def _aligned_figures(Va: np.ndarray, d: dict) -> dict[str, Any]:
     return out
 
 
-def _mismatch(out: dict[str, Any], stored: dict[str, Any]) -> list[str]:
+def _as_floats(v: Any) -> np.ndarray | None:
+    try:
+        return np.asarray(v, float)
+    except (TypeError, ValueError):
+        return None
+
+
+def _mismatch(out: dict[str, Any], stored: dict[str, Any], table: dict[str, str]) -> list[str]:
     """Names of the figures of ``out`` that do not reproduce their stored counterpart
-    (:data:`NCP_STORED`; relative 1e-6, absolute 1e-9 of the figure's unit)."""
+    (``table``: :data:`GG_STORED` or :data:`NCP_STORED`; relative 1e-6, absolute 1e-9 of the
+    figure's unit). A stored figure that is not a number (or a ``{"mean", "max"}`` of numbers)
+    is a mismatch too."""
     bad = []
-    for key, skey in NCP_STORED.items():
+    for key, skey in table.items():
         a, b = out.get(key), stored.get(skey)
-        if a is None or b is None:
+        if a is None or b is None or (isinstance(a, dict) and "skipped" in a):
             continue
         if isinstance(a, dict):
+            if not isinstance(b, dict):
+                bad.append(key)
+                continue
             a, b = [a.get(s) for s in ("mean", "max")], [b.get(s) for s in ("mean", "max")]
-        x = np.asarray(a, float)
-        y = np.asarray(b, float)
-        if not np.all(np.isclose(x, y, rtol=1e-6, atol=1e-9, equal_nan=True)):
+        x, y = _as_floats(a), _as_floats(b)
+        if x is None or y is None or x.shape != y.shape or not np.all(
+                np.isclose(x, y, rtol=1e-6, atol=1e-9, equal_nan=True)):
             bad.append(key)
     return bad
+
+
+def _count_mismatch(d: dict, n_joints: int, n_loops: int, families: dict[str, int]) -> list[str]:
+    """The stored counts of design.json ``d`` (top level and ``metrics``) that differ from the
+    files: ``n_joints`` / ``n_loops`` (net.obj), ``n_lamellae`` (lamella records per family)."""
+    m = d.get("metrics") if isinstance(d.get("metrics"), dict) else {}
+    bad = []
+    for key, real in (("n_joints", n_joints), ("n_loops", n_loops)):
+        for where, src in (("", d), ("metrics.", m)):
+            if key in src and not (isinstance(src[key], int) and src[key] == real):
+                bad.append(f"{where}{key}")
+    if "n_lamellae" in m:
+        st = m["n_lamellae"]
+        if not (isinstance(st, dict) and all(st.get(k) == v for k, v in families.items())):
+            bad.append("metrics.n_lamellae")
+    return bad
+
+
+def _load_axes(path: Path, n: int) -> np.ndarray:
+    """Rotation axes ``(n, 3)`` of ``path`` (axes_r.npy / aligned_r.npy), loaded without
+    pickles; :class:`InputError` naming the file when it is not such an array."""
+    from .errors import InputError
+
+    try:
+        r = np.load(path, allow_pickle=False)
+    except (ValueError, OSError, EOFError) as exc:
+        raise InputError(f"{path}: not a readable NumPy array of rotation axes ({exc}); re-run "
+                         "the design command") from None
+    if not isinstance(r, np.ndarray) or r.shape != (n, 3) or r.dtype.kind not in "fi":
+        raise InputError(f"{path}: expected ({n}, 3) rotation axes (one per joint of net.obj), "
+                         f"got {getattr(r, 'shape', '?')} {getattr(r, 'dtype', '')}; re-run the "
+                         "design command")
+    r = r.astype(float)
+    if not np.all(np.isfinite(r)):
+        raise InputError(f"{path}: {int((~np.isfinite(r)).any(axis=1).sum())} rotation axes are "
+                         "not finite (NaN or Inf); re-run the design command")
+    return r
+
+
+def exit_code(res: dict[str, Any]) -> int:
+    """The exit code of ``gridshell verify`` for the result ``res`` of :func:`verify_bundle`:
+    0 ok; 2 the bundle is incomplete or its files disagree with design.json (``problems``);
+    4 the bundle is consistent but its figures miss the paper's thresholds (``gates``)."""
+    if res["ok"]:
+        return 0
+    return 2 if res["problems"] else 4
 
 
 def verify_bundle(path: str | Path) -> dict[str, Any]:
@@ -92,18 +163,28 @@ def verify_bundle(path: str | Path) -> dict[str, Any]:
     bounding-box diagonal), the figures of :func:`_aligned_figures` from aligned.obj, and
     ``mismatch``, the figures that differ from those stored in design.json (a bundle whose
     files were changed after the design). GG bundles: ``deviation`` of the surface (and
-    ``deviation_joints``) from the target mesh of ``params.target`` when it is readable.
+    ``deviation_joints``) from the target mesh of ``params.target`` when it is readable, and
+    ``mismatch`` against :data:`GG_STORED`. Both: the stored counts (``n_joints``,
+    ``n_loops``, ``n_lamellae``) against the files.
+
+    The verdict: ``gates`` (:func:`gridshell.quality.design_gates` of the recomputed figures,
+    as dicts), ``checks`` (their pass / FAIL lines), ``problems`` (a file of
+    :data:`FIGURE_FILES` missing, a figure not computed, a mismatch) and ``ok``: every gate
+    holds and there is no problem. A bundle whose net.obj, axes.obj, surface.obj or
+    design.json cannot be read raises :class:`~gridshell.errors.InputError`.
     """
-    from .bundle import lamellae_from_design, read_design_json, read_net_mesh
+    from .bundle import check_collapse, lamellae_from_design, read_design_json, read_net_mesh
     from .errors import InputError, MeshError
     from .metrics import (alignability_error, alignability_error_arc,
                            crossing_normal_curvature_on_mesh, delta_l, delta_n,
                            deviation, geodesic_turning, summary)
     from .net import Net
+    from .quality import design_gates, failing
     from .quadmesh import read_configuration, read_mesh, read_polylines
 
     path = Path(path)
     d = read_design_json(path)
+    check_collapse(d, path)
     for name in ("net.obj", "axes.obj", "surface.obj"):
         if not (path / name).is_file():
             raise InputError(f"design bundle {path} lacks {name}; re-run the design command")
@@ -141,25 +222,42 @@ def verify_bundle(path: str | Path) -> dict[str, Any]:
             dj = deviation(net.joints, t.V, t.F)
             out["deviation"] = {"mean": dv["mean"], "max": dv["max"]}
             out["deviation_joints"] = {"mean": dj["mean"], "max": dj["max"]}
+    problems = [f"{name} is missing: the figures that need it were not computed"
+                for name in FIGURE_FILES[d["kind"]] if not (path / name).is_file()]
     r_star, r_a = path / "axes_r.npy", path / "aligned_r.npy"
     Va = None
     has_r = r_star.is_file() and r_a.is_file()
-    if (path / "aligned.obj").is_file() and (ncp or has_r):
+    if (path / "aligned.obj").is_file():
         Va = read_configuration(path / "aligned.obj")[0]
         if Va.shape != net.joints.shape:
             raise InputError(f"{path}: aligned.obj has {len(Va)} vertices but net.obj "
                              f"{len(net.joints)}; re-run the design command")
+        if not np.all(np.isfinite(Va)):
+            raise InputError(f"{path / 'aligned.obj'}: "
+                             f"{int((~np.isfinite(Va)).any(axis=1).sum())} vertices are not "
+                             "finite (NaN or Inf); re-run the design command")
         if ncp:
             out.update(_aligned_figures(Va, d))
     if has_r and Va is not None:
-        rs, ra = np.load(r_star), np.load(r_a)
+        rs, ra = _load_axes(r_star, len(net.joints)), _load_axes(r_a, len(net.joints))
         E = net.edges()
         out["delta_l"] = {k: 100 * v for k, v in summary(delta_l(net.joints, Va, E)).items()}
         out["delta_n"] = {k: 100 * v for k, v in
                           summary(delta_n(net.joints, rs, Va, ra, E)).items()}
     else:
         out["delta_l"] = out["delta_n"] = None  # no rotation axes stored (GG, or older NCP)
-    out["stored"] = d.get("metrics", {})
-    if ncp:
-        out["mismatch"] = _mismatch(out, out["stored"])
+    stored = d.get("metrics", {})
+    out["stored"] = stored if isinstance(stored, dict) else {}
+    families = {"C1": len(net.family(1)), "C3": len(net.family(3))}
+    out["mismatch"] = (_count_mismatch(d, len(net.joints), len(net.loops), families)
+                       + _mismatch(out, out["stored"], NCP_STORED if ncp else GG_STORED))
+    if out["mismatch"]:
+        problems.append("design.json disagrees with the files on " + ", ".join(out["mismatch"])
+                        + " (the bundle was changed after the design)")
+    gates = design_gates(d["kind"], out)
+    bad = failing(gates)
+    out["gates"] = [g.as_dict() for g in gates]
+    out["checks"] = [g.line() for g in gates]
+    out["problems"] = problems
+    out["ok"] = not bad and not problems
     return out

@@ -7,6 +7,7 @@ import json
 
 import pytest
 
+from gridshell import manifest
 from gridshell.cli import demo
 from gridshell.cli.main import main
 from gridshell.errors import ConvergenceError
@@ -125,7 +126,7 @@ def test_demo_refuses_a_directory_it_did_not_write(tmp_path, capsys):
     (tmp_path / "keep.txt").write_text("mine")
     assert main(["demo", "--quick", "-o", str(tmp_path)]) == 5
     err = capsys.readouterr().err
-    assert "not the output of an earlier run (no demo.json)" in err
+    assert "not the output of an earlier run" in err and "manifest.json" in err
     assert "GG: designing" not in err
     assert [p.name for p in tmp_path.iterdir()] == ["keep.txt"]
     assert main(["demo", "--quick", "-o", str(tmp_path / "keep.txt")]) == 5
@@ -137,11 +138,12 @@ def test_a_failing_demo_leaves_the_previous_output(tmp_path, monkeypatch, capsys
     out = tmp_path / "demo"
     out.mkdir()
     (out / demo.MARKER).write_text("{}")
+    manifest.write(out, manifest.build(out, "demo"))  # an earlier demo's output
 
     def fail(*args, **kwargs):
         raise ConvergenceError("no convergence (test)")
 
     monkeypatch.setattr(demo, "_gg", fail)
     assert main(["demo", "--quick", "--only", "gg", "-o", str(out)]) == 4
-    assert [p.name for p in out.iterdir()] == [demo.MARKER]
+    assert sorted(p.name for p in out.iterdir()) == [demo.MARKER, manifest.MANIFEST]
     assert [p.name for p in tmp_path.iterdir()] == ["demo"]          # no temporary left

@@ -25,7 +25,7 @@ def bundles(tmp_path_factory):
 @pytest.mark.parametrize("name", ["gg", "ncp"])
 def test_fabricate_from_the_cli(bundles, name, capsys):
     d = bundles / name
-    code = main(["fabricate", str(d), *ISSUE_ARGS, "-q", "--json"])
+    code = main(["fabricate", "--force", str(d), *ISSUE_ARGS, "-q", "--json"])
     assert code == 0
     summary = json.loads(capsys.readouterr().out)
     assert summary["ok"] and "utilisation [%]" in summary
@@ -51,7 +51,7 @@ def test_fabricate_from_the_cli(bundles, name, capsys):
 
 
 def test_summary_in_text(bundles, tmp_path, capsys):
-    assert main(["fabricate", str(bundles / "gg"), "-o", str(tmp_path / "o"), "--joints", "marks",
+    assert main(["fabricate", "--force", str(bundles / "gg"), "-o", str(tmp_path / "o"), "--joints", "marks",
                  "--no-labels", "--dxf-version", "R12", "--segments", "--kerf", "0.1",
                  "--no-plan"]) == 0
     cap = capsys.readouterr()
@@ -73,7 +73,7 @@ def test_summary_in_text(bundles, tmp_path, capsys):
 ])
 def test_nonsensical_parameters_fail_before_writing(bundles, tmp_path, capsys, args, message):
     out = tmp_path / "out"
-    code = main(["fabricate", str(bundles / "gg"), "-o", str(out), "-q", *args])
+    code = main(["fabricate", "--force", str(bundles / "gg"), "-o", str(out), "-q", *args])
     assert code == 2
     assert message in capsys.readouterr().err
     assert not out.exists()
@@ -81,10 +81,10 @@ def test_nonsensical_parameters_fail_before_writing(bundles, tmp_path, capsys, a
 
 
 def test_bad_bundle_and_unsafe_output(bundles, tmp_path, capsys):
-    assert main(["fabricate", str(tmp_path / "nothing"), "-q"]) == 2
+    assert main(["fabricate", "--force", str(tmp_path / "nothing"), "-q"]) == 2
     # refuse to replace the bundle or a foreign directory
-    assert main(["fabricate", str(bundles / "gg"), "-o", str(bundles / "gg"), "-q"]) == 2
+    assert main(["fabricate", "--force", str(bundles / "gg"), "-o", str(bundles / "gg"), "-q"]) == 5
     (tmp_path / "mine").mkdir()
     (tmp_path / "mine" / "notes.txt").write_text("keep")
-    assert main(["fabricate", str(bundles / "gg"), "-o", str(tmp_path / "mine"), "-q"]) == 2
+    assert main(["fabricate", "--force", str(bundles / "gg"), "-o", str(tmp_path / "mine"), "-q"]) == 5
     assert (tmp_path / "mine" / "notes.txt").read_text() == "keep"

@@ -76,14 +76,16 @@ def test_verify_ncp_bundle_with_and_without_rotation_axes(tmp_path, capsys):
     np.save(buf, r)
     write_bundle(tmp_path / "ncp", b, extra={"axes_r.npy": buf.getvalue(),
                                               "aligned_r.npy": buf.getvalue()})
-    assert main(["verify", str(tmp_path / "ncp")]) == 0
+    assert main(["verify", str(tmp_path / "ncp")]) == 4  # Delta_l 10 % misses the 1 %
     res = json.loads(capsys.readouterr().out)
     assert res["alignability"]["max"] == pytest.approx(0.0, abs=1e-12)
     assert res["delta_l"]["max"] == pytest.approx(10.0)
-    assert "geodesic_turning" not in res
+    assert "geodesic_turning" not in res and not res["ok"] and not res["problems"]
     write_bundle(tmp_path / "ncp2", b)
-    assert main(["verify", str(tmp_path / "ncp2")]) == 0
-    assert json.loads(capsys.readouterr().out)["delta_n"] is None
+    assert main(["verify", str(tmp_path / "ncp2")]) == 2  # no rotation axes: incomplete
+    res = json.loads(capsys.readouterr().out)
+    assert res["delta_n"] is None and not res["ok"] and "axes_r.npy is missing" in \
+        res["problems"][0]
     assert main(["verify", str(tmp_path / "nothing")]) == 2
 
 

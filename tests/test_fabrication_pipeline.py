@@ -286,4 +286,5 @@ def test_fabrication_never_imports_an_optimizer():
                 assert not n.startswith(("gridshell.gg", "gridshell.ncp", "gridshell.solver")), f
                 if n.startswith("gridshell"):
                     assert n in ("gridshell.bundle", "gridshell.errors", "gridshell.atomic",
+                                 "gridshell.manifest",
                                  "gridshell.net"), (f, n)

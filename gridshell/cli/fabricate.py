@@ -62,6 +62,26 @@ def add_args(p: argparse.ArgumentParser) -> None:
                    help="write arcs as short segments instead of bulges")
     g.add_argument("--no-labels", action="store_true", help="do not engrave ids")
     p.add_argument("--no-plan", action="store_true", help="do not draw plan.png / plan.svg")
+    p.add_argument("--force", action="store_true",
+                   help="cut a design whose recomputed figures miss the paper's thresholds, or "
+                        "whose files disagree with design.json ('gridshell verify' lists them; "
+                        "default: refused, exit 2)")
+
+
+def check_design(bundle: str, force: bool) -> dict[str, Any]:
+    """:func:`gridshell.verification.verify_bundle` of ``bundle``; :class:`InputError` naming
+    the failing figures and problems unless it is ok or ``force``. The verdict comes from the
+    figures recomputed from the files, never from a flag stored in design.json."""
+    from ..errors import InputError
+    from ..verification import verify_bundle
+
+    res = verify_bundle(bundle)
+    if res["ok"] or force:
+        return res
+    bad = [line.split("  ", 1)[1] for line in res["checks"] if line.startswith("FAIL")]
+    why = "; ".join(bad + res["problems"])
+    raise InputError(f"{bundle}: the design fails its checks ({why}); 'gridshell verify "
+                     f"{bundle}' shows them - pass --force to cut it anyway")
 
 
 def run(args: Any) -> int:
@@ -80,6 +100,10 @@ def run(args: Any) -> int:
     read_design_json(args.bundle)  # a bad bundle is named before its output location
     out = Path(args.out) if args.out else Path(args.bundle) / "fabrication"
     check_output(out)
+    progress(f"verifying {args.bundle}")
+    verdict = check_design(args.bundle, args.force)
+    if not verdict["ok"]:
+        progress("warning: the design fails its checks; cut anyway (--force)")
     rep = fabricate(args.bundle, out, params, progress=progress.callback, plan=not args.no_plan)
     summary = {
         "output": str(out),

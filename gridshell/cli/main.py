@@ -67,9 +67,9 @@ def _requested(argv: Sequence[str]) -> list[str]:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run the CLI; returns the exit code (0 success, 2 bad input or no command, 3 no net,
-    4 no convergence, 5 output not writable, 1 other tool error; argparse exits with 2 on an
-    unknown option)."""
+    """Run the CLI; returns the exit code (:data:`gridshell.errors.EXIT_CODES`: 0 success,
+    2 bad input or no command, 3 no net, 4 not converged, 5 output refused or not writable,
+    1 other tool error; argparse exits with 2 on an unknown option)."""
     argv = sys.argv[1:] if argv is None else list(argv)
     parser = build_parser(_requested(argv))
     args = parser.parse_args(argv)
@@ -78,6 +78,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"\ngridshell: error: give a command, one of {', '.join(SUBCOMMANDS)} "
               "(gridshell COMMAND --help describes its options)", file=sys.stderr)
         return 2
+    from ..manifest import set_command
+
+    set_command(args.command, ["gridshell", *argv])
     try:
         result = args._run(args)
     except GridshellError as exc:
@@ -88,6 +91,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)
         return 130
+    finally:
+        set_command(None)
     return int(result or 0)
 
 

@@ -1,13 +1,24 @@
-"""``gridshell verify``: recompute a bundle's metrics (paper 5.1) from its files alone."""
+"""``gridshell verify``: recompute a bundle's metrics (paper 5.1) from its files alone and
+check them against the paper's thresholds (:mod:`gridshell.quality`).
+
+Prints the JSON of :func:`gridshell.verification.verify_bundle` on stdout (``"ok"`` first) and
+one pass / FAIL line per figure on stderr. Exit code (:func:`gridshell.verification.exit_code`):
+0 every figure holds; 2 the bundle is incomplete or its files disagree with design.json;
+4 a figure misses its threshold.
+"""
 from __future__ import annotations
 
 import argparse
 import json
+import sys
 from typing import Any
 
-from ..verification import verify_bundle
+from ..bundle import finite_json
+from ..verification import exit_code, verify_bundle
 
-HELP = "recompute the alignability metrics of a design bundle from its files and print JSON"
+HELP = ("recompute the figures of a design bundle from its files, check them against the paper's "
+        "thresholds and print JSON (exit 0 ok, 2 incomplete or inconsistent bundle, 4 a figure "
+        "fails)")
 
 
 def add_args(p: argparse.ArgumentParser) -> None:
@@ -20,5 +31,13 @@ def run(args: Any) -> int:
     res = verify_bundle(args.bundle)
     if not args.per_loop:
         res.pop("per_loop")
-    print(json.dumps({"ok": True, **res}, indent=1, default=float))
-    return 0
+    ok = res.pop("ok")
+    print(json.dumps(finite_json({"ok": ok, **res}), indent=1, allow_nan=False))
+    if not getattr(args, "quiet", False):
+        for line in res["checks"]:
+            print(f"  {line}", file=sys.stderr)
+        for p in res["problems"]:
+            print(f"  problem: {p}", file=sys.stderr)
+        verdict = "ok" if ok else "NOT ok"
+        print(f"gridshell verify: {verdict}: {args.bundle}", file=sys.stderr)
+    return exit_code({"ok": ok, **res})
