@@ -95,3 +95,77 @@ def test_map_back_on_a_helicoid_keeps_alignability():
     da = alignability_error(net.joints, net.loops)
     assert np.mean(da) < 0.01 and np.max(da) < 0.03
     assert np.mean(alignability_error_arc(net)) < 0.01
+
+
+def _same_direction_edges(F: np.ndarray) -> int:
+    """Directed edges run by more than one face (0 for a consistently oriented mesh)."""
+    F = np.asarray(F)
+    e = np.stack([F.ravel(), np.roll(F, -1, axis=1).ravel()], axis=1)
+    _, count = np.unique(e, axis=0, return_counts=True)
+    return int(np.sum(count - 1))
+
+
+def _random_profile(seed):
+    """r(s) = r0 + a s + b sin(w s): a random smooth profile (|dr/ds| < 1), z from the arc."""
+    rng = np.random.default_rng(seed)
+    r0, a, b, w = rng.uniform(0.4, 1.0), rng.uniform(-0.3, 0.3), rng.uniform(0.05, 0.2), \
+        rng.uniform(1.0, 3.0)
+    s = np.linspace(0.0, 1.6, 400)
+    dr = a + b * w * np.cos(w * s)
+    z = np.concatenate([[0], np.cumsum(0.5 * (np.sqrt(1 - dr[1:] ** 2) +
+                                              np.sqrt(1 - dr[:-1] ** 2)) * np.diff(s))])
+    return (lambda t: np.interp(t, s, r0 + a * s + b * np.sin(w * s)),
+            lambda t: np.interp(t, s, dr), lambda t: np.interp(t, s, z))
+
+
+@pytest.mark.parametrize("case", ["sphere", "catenoid", "cone", "random0", "random1"])
+@pytest.mark.parametrize("flip", [False, True])
+def test_net_loops_are_consistently_oriented_on_surfaces_of_revolution(case, flip):
+    # regression: near a Clairaut turning parallel (sphere patch at small r) the loops are
+    # folded slivers; each was oriented by its own area, and 16 edges were run in the same
+    # direction by both of their loops (gridshell verify / fabricate refused the bundle)
+    from gg_cases import cone, sphere
+
+    funcs = {"sphere": sphere(1.0), "catenoid": catenoid(0.5), "cone": cone(),
+             "random0": _random_profile(0), "random1": _random_profile(1)}[case]
+    s = np.linspace(0.3, 1.6, 14)
+    phi = np.linspace(0.0, 1.2, 12)
+    P = revolution_grid(funcs, s, phi)
+    if flip:
+        P = P[:, ::-1].copy()
+    rev = rebuild_revolution(P)
+    inet = geodesic_net(rev, n_lamellae=10, crossing_angle=90.0)
+    for net, _ in (map_back(inet, P, rev), map_to_revolution(inet, rev)):
+        assert len(net.loops) > 50
+        assert _same_direction_edges(net.loops) == 0
+    # and counter-clockwise in (phi, s) overall, like the grid's faces
+    net, extra = map_back(inet, P, rev)
+    xy = extra["sphi"][:, ::-1][net.loops]
+    area = 0.5 * np.sum(xy[..., 0] * np.roll(xy[..., 1], -1, axis=1)
+                        - np.roll(xy[..., 0], -1, axis=1) * xy[..., 1], axis=1)
+    assert area.sum() > 0
+    rV, rF = rev.mesh()
+    assert _same_direction_edges(rF) == 0
+
+
+def test_orient_loops_flips_a_component_as_a_whole():
+    from gridshell.gg.mapback import _signed_areas, orient_loops
+
+    # a 3 x 2 lattice of loops in (phi, s); one loop reversed, one folded sliver whose own
+    # area is negative but whose neighbours fix its orientation
+    k, l = np.meshgrid(np.arange(4), np.arange(3), indexing="ij")
+    sphi = np.stack([k.ravel() * 1.0, l.ravel() * 1.0], axis=1)  # joint (k, l) at s=k, phi=l
+    idx = np.arange(12).reshape(4, 3)
+    loops = np.array([[idx[i, j], idx[i, j + 1], idx[i + 1, j + 1], idx[i + 1, j]]
+                      for i in range(3) for j in range(2)])
+    loops[2] = loops[2][[0, 3, 2, 1]]
+    sphi2 = sphi.copy()
+    sphi2[idx[3, 1]] = [1.5, 2.5]  # folds a loop of the last row over
+    assert np.sum(_signed_areas(loops, sphi2) < 0) == 2  # the reversed one and the fold
+    for sp_ in (sphi, sphi2):
+        out = orient_loops(loops, sp_)
+        assert _same_direction_edges(out) == 0
+        assert out[0].tolist() == [idx[0, 0], idx[0, 1], idx[1, 1], idx[1, 0]]
+    # the whole mesh reversed comes back counter-clockwise
+    out = orient_loops(loops[:, ::-1], sphi)
+    assert np.all(_signed_areas(out, sphi) > 0) and _same_direction_edges(out) == 0

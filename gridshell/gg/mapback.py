@@ -10,7 +10,8 @@ Joints are the intersections of C1 and C3 curves, computed in ``(s, phi)`` on th
 polylines; net-loops are the quads ``A, B, C, D`` with ``A -> B`` forwards along a C1 curve,
 ``B -> C`` forwards along a C3 curve, ``D -> C`` forwards along the next C1 curve and
 ``A -> D`` forwards along the C3 curve through ``A`` (Definition 4: alignable iff
-``l_AB + l_BC = l_AD + l_DC``), ordered counter-clockwise in ``(phi, s)`` like the mesh's faces.
+``l_AB + l_BC = l_AD + l_DC``), consistently oriented (neighbours run a shared edge in opposite
+directions) and counter-clockwise in ``(phi, s)`` overall, like the mesh's faces.
 """
 from __future__ import annotations
 
@@ -24,7 +25,8 @@ from ..net import Lamella, Net, polyline_arclength
 from .clairaut import IntrinsicNet
 from .revolution import Revolution
 
-__all__ = ["SurfaceMap", "map_net", "map_to_revolution", "net_loops", "segment_intersections"]
+__all__ = ["SurfaceMap", "map_net", "map_to_revolution", "net_loops", "orient_loops",
+           "segment_intersections"]
 
 
 class SurfaceMap:
@@ -223,7 +225,8 @@ def net_loops(k1: np.ndarray, p1: np.ndarray, k3: np.ndarray, p3: np.ndarray,
     loops : (m, 4) int
         ``A, B, C, D`` with ``B`` next after ``A`` on A's C1 curve, ``C`` next after ``B`` on
         B's C3 curve, ``C`` next after ``D`` on D's C1 curve, ``D`` next after ``A`` on A's C3
-        curve (reversed to ``A, D, C, B`` where that is clockwise in ``(phi, s)``).
+        curve (reversed to ``A, D, C, B`` by :func:`orient_loops` where needed: consistently
+        oriented, counter-clockwise in ``(phi, s)`` overall).
     order : dict
         ``"c1"``, ``"c3"``: for each curve the joints in order along it (lists of arrays).
     """
@@ -246,12 +249,75 @@ def net_loops(k1: np.ndarray, p1: np.ndarray, k3: np.ndarray, p3: np.ndarray,
     ok = (B >= 0) & (C >= 0) & (D >= 0) & (nxt3[A] == D) & (D != A)
     loops = np.stack([A[ok], B[ok], C[ok], D[ok]], axis=1)
     if sphi is not None and len(loops):
-        xy = np.asarray(sphi, float)[:, ::-1][loops]  # (m, 4, 2) in (phi, s)
-        area = 0.5 * np.sum(xy[:, :, 0] * np.roll(xy[:, :, 1], -1, axis=1)
-                            - np.roll(xy[:, :, 0], -1, axis=1) * xy[:, :, 1], axis=1)
-        cw = area < 0
-        loops[cw] = loops[cw][:, [0, 3, 2, 1]]
+        loops = orient_loops(loops, sphi)
     return loops, {"c1": along1, "c3": along3}
+
+
+def _signed_areas(loops: np.ndarray, sphi: np.ndarray) -> np.ndarray:
+    """Signed area ``(m,)`` of each loop in ``(phi, s)`` (positive: counter-clockwise)."""
+    xy = np.asarray(sphi, float)[:, ::-1][loops]  # (m, 4, 2) in (phi, s)
+    return 0.5 * np.sum(xy[:, :, 0] * np.roll(xy[:, :, 1], -1, axis=1)
+                        - np.roll(xy[:, :, 0], -1, axis=1) * xy[:, :, 1], axis=1)
+
+
+def orient_loops(loops: np.ndarray, sphi: np.ndarray) -> np.ndarray:
+    """The loops ``(m, 4)`` consistently oriented, counter-clockwise in ``(phi, s)`` overall.
+
+    Orientation is combinatorial: every two loops sharing an edge run it in opposite
+    directions (the loops are a consistently oriented quad mesh). Within each edge-connected
+    component the orientation is propagated from loop to loop; the component is then turned
+    so that its total signed area in ``(phi, s)`` is positive (counter-clockwise, like the
+    mesh's faces ``(i,j), (i,j+1), (i+1,j+1), (i+1,j)``).
+
+    Judging each loop by its own signed area instead fails where the net folds in the
+    parameter domain: near a Clairaut turning parallel (where the geodesics touch a parallel,
+    ``r = c``) the loops are slivers whose corners overlap, their own area has either sign,
+    and neighbours ended up running a shared edge in the same direction.
+    """
+    loops = np.array(loops, np.int64, copy=True)
+    m = len(loops)
+    if m == 0:
+        return loops
+    area = _signed_areas(loops, sphi)
+    # directed edges (a -> b) of every loop, and the undirected key of each
+    a = loops.ravel()
+    b = np.roll(loops, -1, axis=1).ravel()
+    owner = np.repeat(np.arange(m), 4)
+    key = np.minimum(a, b) * (int(loops.max()) + 1) + np.maximum(a, b)
+    order = np.argsort(key, kind="stable")
+    ks = key[order]
+    # pairs of loop-edges on one undirected edge (an edge of a consistent quad mesh has two)
+    first = np.flatnonzero(ks[1:] == ks[:-1])
+    e0, e1 = order[first], order[first + 1]
+    # same: the two loops run the edge in the same direction (they need opposite flips)
+    same = a[e0] == a[e1]
+    nbr: list[list[tuple[int, bool]]] = [[] for _ in range(m)]
+    for p, q, s_ in zip(owner[e0].tolist(), owner[e1].tolist(), same.tolist()):
+        if p != q:
+            nbr[p].append((q, s_))
+            nbr[q].append((p, s_))
+    flip = np.zeros(m, bool)
+    comp = np.full(m, -1, np.int64)
+    n_comp = 0
+    # start every component at its largest loop (the most reliable area)
+    for start in np.argsort(-np.abs(area), kind="stable").tolist():
+        if comp[start] >= 0:
+            continue
+        comp[start] = n_comp
+        stack = [start]
+        while stack:
+            p = stack.pop()
+            for q, s_ in nbr[p]:
+                if comp[q] < 0:
+                    comp[q] = n_comp
+                    flip[q] = flip[p] ^ s_
+                    stack.append(q)
+        n_comp += 1
+    signed = np.where(flip, -area, area)
+    total = np.bincount(comp, signed, n_comp)
+    flip ^= (total < 0)[comp]
+    loops[flip] = loops[flip][:, [0, 3, 2, 1]]
+    return loops
 
 
 def _axis_with_joints(inet: IntrinsicNet, family: int, ci: int, pos: np.ndarray,

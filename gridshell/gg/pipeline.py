@@ -22,18 +22,19 @@ from scipy.sparse.csgraph import connected_components
 from scipy.sparse.linalg import lsqr
 
 from ..bundle import DesignBundle, write_bundle
-from ..errors import ConvergenceError, InputError
+from ..errors import ConvergenceError, GridshellError, InputError
 from ..grid import grid_quads
 from ..metrics import (alignability_error, alignability_error_arc, coverage, delta_l, deviation,
                        geodesic_turning, summary, target_deviation)
 from ..net import Net
+from ..quality import Gate, design_gates, gate_lines, gate_summary, passed
 from .clairaut import IntrinsicNet, geodesic_net
 from .mapback import map_back, map_to_revolution
 from .revolution import rebuild_revolution
 from .simulate import GGSequence, gg_alignment_sequence
 
-__all__ = ["check_offsets", "collapse_gg", "design_gg", "gg_metrics", "gg_net_from_mesh",
-           "write_gg"]
+__all__ = ["check_offsets", "collapse_gg", "design_gg", "gg_gates", "gg_metrics",
+           "gg_net_from_mesh", "gg_score", "write_gg"]
 
 Progress = Callable[[str], None] | None
 
@@ -238,6 +239,31 @@ def gg_metrics(net: Net, V: np.ndarray, F: np.ndarray, *, net_rev: Net | None = 
     return out
 
 
+def gg_gates(metrics: dict[str, Any]) -> list[Gate]:
+    """The quality gates of a GG design (:func:`gridshell.quality.design_gates`): ``Delta_a``
+    mean < 1 % and max < 3 % on the traced net, with straight edges and with arc lengths."""
+    return design_gates("GG", metrics)
+
+
+def gg_score(P: np.ndarray, **net_options: Any) -> float:
+    """How far the net traced on a GG mesh ``P (R, C, 3)`` is from the paper's figures: the
+    largest ``figure / threshold`` over :func:`gg_gates` (below 1: every gate passes); ``inf``
+    where no net can be traced. ``net_options`` as in :func:`gg_net_from_mesh`."""
+    try:
+        stage = gg_net_from_mesh(P, **net_options)
+        net = stage["net"]
+        if len(net.loops) == 0:
+            return float("inf")
+        m = {"alignability": summary(alignability_error(net.joints, net.loops)),
+             "alignability_arc": summary(alignability_error_arc(net))}
+    except GridshellError:
+        return float("inf")
+    gates = gg_gates({k: _pct(v) for k, v in m.items()})
+    ratios = [g.value / g.limit if g.value is not None and np.isfinite(g.value) else np.inf
+              for g in gates]
+    return float(max(ratios))
+
+
 # ----------------------------------------------------------------------------- the pipeline
 
 
@@ -281,10 +307,12 @@ def design_gg(target: Any, *, meridians: str = "cols", grid: tuple[int, int] | N
     weights : dict, optional
         Weights of the surface optimization (see ``design_gg_surface``).
     rounds, polish_iter : int
-        Outer rounds and final projection iterations of the surface optimization.
+        Outer rounds and most final projection iterations of the surface optimization (the
+        projection stops once the figures of the traced net hold and stagnate, and returns
+        the best of its checkpoints: a longer polish never gives a worse design).
     allow_unconverged : bool
-        Return a design whose surface optimization missed its tolerances (flagged in
-        ``report["design"]["converged"]`` and ``bundle.params``) instead of raising.
+        Return a design that misses the paper's figures instead of raising; it is marked in
+        ``bundle.params["quality"]`` (``"ok": False``) and ``bundle.params["converged"]``.
     frames : int
         Steps of the alignment sequence from the deployed to the collapsed net
         (:func:`gridshell.gg.simulate.gg_alignment_sequence`); 0: none.
@@ -294,14 +322,17 @@ def design_gg(target: Any, *, meridians: str = "cols", grid: tuple[int, int] | N
     Raises
     ------
     ConvergenceError
-        The surface optimization did not meet its tolerances (and ``allow_unconverged`` is
-        off): no GG net would be alignable on it.
+        The design misses the paper's figures (:func:`gg_gates`: ``Delta_a`` mean < 1 %, max
+        < 3 %, straight and arc, on the net traced on the designed surface) and
+        ``allow_unconverged`` is off; the message names the failing figures.
 
     Returns
     -------
     bundle : DesignBundle
         ``kind="GG"``; aligned = :func:`collapse_gg`; surface = the GG mesh; revolution = the
-        isometric surface of revolution; metrics = :func:`gg_metrics`.
+        isometric surface of revolution; metrics = :func:`gg_metrics`; ``params["quality"]``
+        = ``{"ok", "gates" (Gate.as_dict() each), "summary"}``, ``params["surface"]`` = the
+        surface optimization's residuals and why its polish stopped.
     report : dict
         The surface optimization's report, the revolution's info, the collapse info and
         ``sequence`` (a :class:`~gridshell.gg.simulate.GGSequence`, or None with
@@ -320,21 +351,17 @@ def design_gg(target: Any, *, meridians: str = "cols", grid: tuple[int, int] | N
     _say(progress, f"target: {len(V)} vertices, {len(F)} faces")
     P0 = initial_grid(V, F, meridians=meridians, grid=grid, direction=direction)
     _say(progress, f"initial grid {P0.shape[0]} x {P0.shape[1]}; designing the GG surface")
+    net_options = {"n_lamellae": n_lamellae, "spacing": spacing,
+                   "crossing_angle": crossing_angle, "at_parallel": at_parallel,
+                   "offsets": offsets, "angle": angle}
     design = design_gg_surface(V, F, P0, weights=weights, outer=rounds,
-                               polish_iter=polish_iter, progress=progress)
-    if not design.converged and not allow_unconverged:
-        raise ConvergenceError(
-            f"the GG surface optimization did not converge (geodesic residual "
-            f"{design.geodesic_residual_max:.2e} rad, edge-length spread "
-            f"{design.length_residual_rel_max:.2e}; tolerances 1e-6): the net would not be "
-            "alignable. Give it more rounds / polish iterations, a coarser grid, or a target "
-            "closer to a surface of revolution (or allow an unconverged design explicitly)")
+                               polish_iter=polish_iter, progress=progress,
+                               evaluate=lambda P: gg_score(P, **net_options))
     P, design_report = design.P, dict(design.report, converged=design.converged,
-                                      history=design.history,
+                                      history=design.history, stop=design.stop,
+                                      checkpoint=design.checkpoint, score=design.score,
                                       deviation=design.deviation)
-    stage = gg_net_from_mesh(P, n_lamellae=n_lamellae, spacing=spacing,
-                             crossing_angle=crossing_angle, at_parallel=at_parallel,
-                             offsets=offsets, angle=angle, progress=progress)
+    stage = gg_net_from_mesh(P, **net_options, progress=progress)
     net, rev = stage["net"], stage["rev"]
     _say(progress, f"net: {len(net.joints)} joints, {len(net.loops)} loops, "
          f"{len(net.lamellae)} lamellae; collapsing and measuring")
@@ -343,6 +370,17 @@ def design_gg(target: Any, *, meridians: str = "cols", grid: tuple[int, int] | N
     sV, sF = P.reshape(-1, 3), grid_quads(R, C)
     metrics = gg_metrics(net, sV, sF, net_rev=stage["net_rev"], target=(V, F))
     metrics["collapse_mismatch_max"] = collapse_info["mismatch_max"]
+    gates = gg_gates(metrics)
+    quality = {"ok": passed(gates), "gates": [g.as_dict() for g in gates],
+               "summary": gate_summary(gates)}
+    _say(progress, "quality: " + quality["summary"])
+    if not quality["ok"] and not allow_unconverged:
+        raise ConvergenceError(
+            f"the GG design misses the paper's figures ({quality['summary']}; surface residuals: "
+            f"geodesic {design.geodesic_residual_max:.2e} rad, edge-length spread "
+            f"{design.length_residual_rel_max:.2e}, polish stopped: {design.stop}). Try more "
+            "rounds (--rounds), a coarser grid, fewer lamellae, or a target closer to a surface "
+            "of revolution; --allow-unconverged writes the design anyway, marked as failing")
     seq = None
     if int(frames) > 0:
         _say(progress, f"alignment sequence: {int(frames)} steps from deployed to collapsed")
@@ -357,7 +395,12 @@ def design_gg(target: Any, *, meridians: str = "cols", grid: tuple[int, int] | N
               "direction": direction, "n_lamellae": n_lamellae, "spacing": spacing,
               "crossing_angle": crossing_angle, "at_parallel": at_parallel,
               "offsets": [list(map(float, o)) for o in offsets] if offsets else None,
-              "weights": weights, "converged": design.converged, "dphi": rev.dphi,
+              "weights": weights, "converged": quality["ok"], "quality": quality,
+              "surface": {"geodesic_residual_max": design.geodesic_residual_max,
+                          "length_residual_rel_max": design.length_residual_rel_max,
+                          "residuals_at_round_off": design.converged, "polish_stop": design.stop,
+                          "checkpoint": design.checkpoint},
+              "dphi": rev.dphi,
               "total_angle": rev.total_angle,
               "clairaut_c": inet.c, "s_star": inet.s_star, "frames": int(frames)}
     bundle = DesignBundle(kind="GG", net=net, aligned=aligned, surface_V=sV, surface_F=sF,
