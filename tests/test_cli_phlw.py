@@ -22,15 +22,20 @@ def _torus_obj(path, a=12, b=12, inner=False):
 
 SMALL = ["--ctrl", "5", "5", "--degree", "3", "3", "--samples", "7", "7", "--outer", "1",
          "--max-iter", "4", "--check-samples", "15", "15"]
+#: SMALL stops the optimizer before it converges: such a surface is written only when allowed
+ALLOW = ["--allow-unconverged"]
 
 
 def test_cli_writes_every_output_and_a_json_summary(tmp_path, capsys):
     ref = _torus_obj(tmp_path / "torus.obj")
     out = tmp_path / "design"
-    code = main(["phlw", str(ref), "-o", str(out), "--mode", "cnc", "--json", *SMALL])
+    code = main(["phlw", str(ref), "-o", str(out), "--mode", "cnc", "--json", *SMALL, *ALLOW])
     assert code == 0
     summary = json.loads(capsys.readouterr().out)
     assert summary["ok"] and summary["mode"] == "cnc"
+    # the figures of the step, in the summary and in report.json
+    assert isinstance(summary["quality"]["ok"], bool) and len(summary["quality"]["gates"]) == 4
+    assert json.loads((out / "report.json").read_text())["quality"] == summary["quality"]
     for name in ("surface.json", "surface.obj", "rows.csv", "report.json",
                  "curvature_diagram.png"):
         assert (out / name).stat().st_size > 0, name
@@ -45,11 +50,41 @@ def test_cli_writes_every_output_and_a_json_summary(tmp_path, capsys):
 def test_cli_progress_on_stderr_and_modes(tmp_path, capsys):
     for mode in ("phlw", "aa"):
         ref = _torus_obj(tmp_path / f"torus_{mode}.obj", inner=mode == "aa")
-        assert main(["phlw", str(ref), "-o", str(tmp_path / mode), "--mode", mode, *SMALL]) == 0
+        assert main(["phlw", str(ref), "-o", str(tmp_path / mode), "--mode", mode, *SMALL,
+                     *ALLOW]) == 0
         cap = capsys.readouterr()
         assert "round 1/1" in cap.err and "PHLW surface design" in cap.out
+        # the summary ends with one pass / FAIL line per figure of the PHLW step
+        last = cap.out.strip().splitlines()[-4:]
+        assert all(ln.strip().startswith(("pass  ", "FAIL  ")) for ln in last), last
+        assert "FAIL  optimizer converged: no" in cap.out
 
 
 def test_cli_bad_reference_exits_with_input_error(tmp_path, capsys):
     assert main(["phlw", str(tmp_path / "missing.obj"), "-o", str(tmp_path / "o")]) == 2
     assert "no such file" in capsys.readouterr().err
+
+
+def test_cli_unconverged_surface_exits_4_unless_allowed(tmp_path, capsys):
+    """A PHLW step stopped after 4 iterations has not converged: exit 4, nothing written,
+    the failing figure named; --strict is still accepted (deprecated, same behaviour)."""
+    ref = _torus_obj(tmp_path / "torus.obj")
+    for extra in ([], ["--strict"]):
+        out = tmp_path / "design"
+        assert main(["phlw", str(ref), "-o", str(out), "--mode", "phlw", *SMALL, *extra]) == 4
+        err = capsys.readouterr().err
+        assert "optimizer converged: no" in err and "--allow-unconverged" in err
+        assert not out.exists()
+
+
+def test_cli_converged_surface_passes_every_gate(tmp_path, capsys):
+    """With its default iteration limits the step converges on a torus zone (a CNC surface
+    already): exit 0, every figure passes and report.json says so."""
+    ref = _torus_obj(tmp_path / "torus.obj")
+    out = tmp_path / "design"
+    assert main(["phlw", str(ref), "-o", str(out), "--mode", "cnc", "--json", "--ctrl", "6",
+                 "6", "--samples", "8", "8", "--check-samples", "15", "15"]) == 0
+    q = json.loads(capsys.readouterr().out)["quality"]
+    assert q["ok"] and [g["name"] for g in q["gates"]] == ["converged", "energy", "relation",
+                                                            "angle"]
+    assert json.loads((out / "report.json").read_text())["quality"]["ok"] is True

@@ -404,12 +404,16 @@ def _write_helicoid(tmp_path: Path, n: int = 8) -> Path:
 def test_phlw_strict_fails_when_the_optimizer_stops_early(tmp_path, capsys):
     ref, out = _write(tmp_path, "saddle.obj"), tmp_path / "out"
     opts = _without(PHLW, "--max-iter") + ["--max-iter", "1"]
-    assert_clean_failure(capsys, ["phlw", str(ref), "-o", str(out), *opts, "--strict"], 4,
-                         ["did not converge", "--max-iter", "--strict"], [out])
-    # without --strict the design is written, and the summary says it did not converge
-    code, stdout, err = _run(capsys, ["phlw", str(ref), "-o", str(out), *opts, "--json"])
+    # the default now (--strict is a deprecated alias): exit 4, nothing written
+    for extra in ([], ["--strict"]):
+        assert_clean_failure(capsys, ["phlw", str(ref), "-o", str(out), *opts, *extra], 4,
+                             ["did not converge", "--max-iter", "--allow-unconverged"], [out])
+    # with --allow-unconverged the design is written, and the summary says it did not converge
+    code, stdout, err = _run(capsys, ["phlw", str(ref), "-o", str(out), *opts, "--json",
+                                      "--allow-unconverged"])
     assert code == 0, err
-    assert json.loads(stdout)["converged"] is False
+    summary = json.loads(stdout)
+    assert summary["converged"] is False and summary["quality"]["ok"] is False
     assert "warning: the PHLW optimization did not converge" in err
 
 
@@ -449,11 +453,20 @@ def test_ncp_reports_an_unconverged_post_optimization(tmp_path, capsys, surfaces
     opts = _without(NCP, "--rounds") + ["--rounds", "0", "--mode", "cnc"]
     assert_clean_failure(capsys, ["ncp", str(src), "-o", str(out), *opts, "--strict"], 4,
                          ["post-optimization did not converge", "--rounds"], [out])
-    code, stdout, err = _run(capsys, ["ncp", str(src), "-o", str(out), *opts, "--json"])
+    # without a round the figures miss the thresholds (Delta_a, collapse): exit 4, naming
+    # them; with --allow-unconverged the design is written, marked as failing
+    assert_clean_failure(capsys, ["ncp", str(src), "-o", str(out), *opts], 4,
+                         ["misses the paper's figures", "Delta_a", "--rounds",
+                          "--allow-unconverged"], [out])
+    code, stdout, err = _run(capsys, ["ncp", str(src), "-o", str(out), *opts, "--json",
+                                      "--allow-unconverged"])
     assert code == 0, err
     summary = json.loads(stdout)
     assert summary["ok"] and summary["converged"] is False
     assert summary["not converged"] == "post-optimization"
+    assert summary["quality"]["ok"] is False
+    d = json.loads((out / "design.json").read_text())
+    assert d["metrics"]["quality"]["ok"] is False and d["params"]["allow_unconverged"]
 
 
 def test_gg_unconverged_design_is_an_error_unless_allowed(tmp_path, capsys):

@@ -40,9 +40,13 @@ def add_args(p: argparse.ArgumentParser) -> None:
                    help="outer rounds (closest points refreshed) (default 4)")
     p.add_argument("--max-iter", type=int, default=60,
                    help="Levenberg-Marquardt iterations per round (default 60)")
+    p.add_argument("--allow-unconverged", action="store_true",
+                   help="write a surface whose optimization did not converge, raised its "
+                        "energy, relation error or principal angle, marked as failing in "
+                        "report.json (default: exit 4 and write nothing)")
     p.add_argument("--strict", action="store_true",
-                   help="exit with code 4, writing nothing, if the optimization misses its "
-                        "tolerances (default: write it; the summary says 'converged: False')")
+                   help="deprecated, the default now: a surface that misses its figures exits "
+                        "4 unless --allow-unconverged")
     for key, default in (("closeness", None), ("gliding", None), ("target", None), ("beta", None),
                          ("constraints", None)):
         p.add_argument(f"--w-{key}", type=float, default=default, metavar="W",
@@ -71,7 +75,9 @@ def run(args: Any) -> int:
     from ..bspline import uniform_params
     from ..errors import ConvergenceError
     from ..ncp.phlw import optimize_phlw, row_relation_residual, write_phlw
-    from .common import Progress, print_summary
+    from ..ncp.phlw_gates import phlw_gates
+    from .common import Progress
+    from .ncp import print_gates
 
     check_output(args.output, marker="report.json")
     progress = Progress(args)
@@ -88,18 +94,24 @@ def run(args: Any) -> int:
                         check_samples=tuple(args.check_samples), progress=progress.callback)
     for line in res.diagnostics:
         progress(f"note: {line}")
-    if not res.converged:
-        last = res.history[-1]
-        msg = (f"the PHLW optimization did not converge ({last['message']} after "
+    gates = phlw_gates(res.report_before, res.report_after, res.converged,
+                       len(res.u_rows) * len(res.v_samples))
+    quality = {"ok": all(g.ok for g in gates), "gates": [g.as_dict() for g in gates]}
+    if not quality["ok"]:
+        last = res.history[-1] if res.history else {"message": "no round run"}
+        bad = "; ".join(g.line().split("  ", 1)[1] for g in gates if not g.ok)
+        msg = (f"the PHLW optimization did not converge ({bad}; last round: {last['message']}, "
                f"{args.outer} round(s) of at most {args.max_iter} iterations)")
-        if args.strict:
-            raise ConvergenceError(f"{msg}; raise --outer / --max-iter, or drop --strict to "
-                                   "write the unconverged surface")
-        progress(f"warning: {msg}")
+        if args.strict or not args.allow_unconverged:
+            raise ConvergenceError(f"{msg}; raise --outer / --max-iter, change the weights "
+                                   "(--w-closeness, --w-gliding), or pass --allow-unconverged "
+                                   "to write the surface anyway, marked as failing")
+        progress(f"warning: {msg}; written because of --allow-unconverged")
     u, v = uniform_params(res.surface, tuple(args.check_samples))
     dense = row_relation_residual(res.surface, u, v, mode=args.mode)
     progress(f"writing {args.output}")
     files = write_phlw(args.output, res, sample_grid=tuple(args.check_samples))
+    _add_quality(args.output, quality)
     b, a = res.report_before, res.report_after
     summary = {
         "output": args.output,
@@ -116,5 +128,18 @@ def run(args: Any) -> int:
         "diagnostics": len(res.diagnostics),
         "diagram": files["curvature_diagram"],
     }
-    print_summary(args, "PHLW surface design", summary)
+    print_gates(args, summary, "PHLW surface design", quality)
     return 0
+
+
+def _add_quality(directory: str, quality: dict) -> None:
+    """``report.json`` of the written design gains ``"quality": {"ok", "gates"}``."""
+    import json
+    from pathlib import Path
+
+    from ..atomic import write_text
+
+    path = Path(directory) / "report.json"
+    report = json.loads(path.read_text())
+    report["quality"] = quality
+    write_text(path, json.dumps(report, indent=1) + "\n")

@@ -28,7 +28,8 @@ import numpy as np
 from ..bspline import BSplineSurface
 from ..errors import InputError, NoNetError
 from ..bspline import uniform_params
-from .directions import grid_curvature, net_angle, row_normal_curvature
+from .directions import (MAX_DROPPED, grid_curvature, net_angle, row_normal_curvature,
+                         surface_size)
 
 __all__ = ["CollapseResult", "collapse_chords", "integrate_collapse", "collapse_curve",
            "fit_circle", "fit_plane", "line_deviation", "closest_on_polyline"]
@@ -223,12 +224,13 @@ def collapse_curve(surf: BSplineSurface, *, mode: Literal["phlw", "cnc", "aa"] =
     chords = np.empty(a - 1)
     prev_S = prev_ic = None
     invalid = 0
+    floor = 1.0 / max(surface_size(surf.ctrl), 1e-300)
     for start in range(0, a, block):
         sl = slice(start, min(start + block, a))
         g = grid_curvature(surf, u[sl], v)
         nr = row_normal_curvature(g["K"], g["H"], mode, n)
         n_rows[sl] = nr
-        beta, valid = net_angle(g["kI"], g["kII"], nr[:, None])
+        beta, valid = net_angle(g["kI"], g["kII"], nr[:, None], scale=floor)
         invalid += int(np.sum(~valid))
         ic = 1.0 / np.cos(beta)
         S = g["S"]
@@ -239,10 +241,11 @@ def collapse_curve(surf: BSplineSurface, *, mode: Literal["phlw", "cnc", "aa"] =
         first = sl.start - (1 if prev_S is not None else 0)
         chords[first:first + len(c)] = c
         prev_S, prev_ic = g["S"][-1], (1.0 / np.cos(beta))[-1]
-    if invalid:
+    if invalid > MAX_DROPPED * a * len(v):
         raise NoNetError(f"the net has no real direction at {invalid} of {a * len(v)} collapse "
-                         "samples (n outside [kappa_I, kappa_II], eq. 4.10); re-run the PHLW "
-                         "optimization or trim the surface")
+                         f"samples ({100.0 * invalid / (a * len(v)):.3g} %, more than the "
+                         f"{100 * MAX_DROPPED:g} % left out; n outside [kappa_I, kappa_II] or "
+                         "umbilic, eq. 4.10); re-run the PHLW optimization or trim the surface")
     P, N = integrate_collapse(chords, n_rows)
     s = np.concatenate([[0.0], np.cumsum(chords)])
     shape = {"cnc": "circle", "aa": "line"}.get(mode, "curve")
@@ -255,5 +258,7 @@ def collapse_curve(surf: BSplineSurface, *, mode: Literal["phlw", "cnc", "aa"] =
             fit = {"radius": r, "radius_error": abs(r - radius) / radius}
     elif mode == "aa":
         fit = {"line_error": line_deviation(P)}
+    # samples without a net direction (at most MAX_DROPPED of them) count with beta clipped
+    fit["invalid_samples"] = int(invalid)
     return CollapseResult(u=u, points=P, normals=N, chords=chords, s=s, n_rows=n_rows,
                           shape=shape, radius=radius, fit=fit)

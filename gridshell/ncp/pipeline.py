@@ -18,13 +18,14 @@ import numpy as np
 
 from ..bspline import BSplineSurface
 from ..bundle import CollapseCurve, DesignBundle, write_bundle
-from ..errors import ConvergenceError, InputError
+from ..errors import ConvergenceError, InputError, NoNetError
 from ..metrics import alignability_error, delta_l, delta_n, deviation, summary
+from ..quality import design_gates, gate_summary, passed
 from ..net import move_joints
 from .collapse import (CollapseResult, closest_on_polyline, collapse_curve, fit_circle,
                        line_deviation)
 from ..bspline import uniform_params
-from .directions import net_directions
+from .directions import net_directions, reference_net_check
 from .levelset import TracedNet, trace
 from .postopt import PostOptResult, interior_vertices, post_optimize
 from .simulate import AlignmentSequence, collapse_direction, plane_frame, simulate_alignment
@@ -83,10 +84,47 @@ def load_surface(source: Any, *, mode: str, phlw_options: dict | None = None,
                            transpose=bool(opts.pop("transpose", False)))
     if progress is not None:
         progress(f"PHLW step: initial B-spline ({init.method} fit, rms {init.rms:.3g} m)")
-    res = optimize_phlw(init.surface, (V, F), mode=mode, progress=progress, **opts)
+    # a reference without the net anywhere (umbilic everywhere; K > 0 everywhere for aa) is a
+    # true no-net answer (exit 3); any later no-net answer is the PHLW step's failure (exit 4)
+    reference_net_check(init.surface, mode)
+    try:
+        res = optimize_phlw(init.surface, (V, F), mode=mode, progress=progress, **opts)
+    except NoNetError as exc:
+        if str(exc).startswith("the reference"):
+            raise
+        raise ConvergenceError(
+            f"the PHLW step failed: {exc}. The reference itself has distinct principal "
+            f"curvatures{' and K < 0 somewhere' if mode == 'aa' else ''}, so a net may exist "
+            "near it; raise --phlw-outer / --phlw-max-iter, or run 'gridshell phlw' on it and "
+            "inspect the curvature diagram") from exc
     n = float(res.n_rows[0]) if mode == "cnc" else None
+    e0 = res.report_before.get("E_PHLW", {}).get("total") if res.report_before else None
+    e1 = res.report_after.get("E_PHLW", {}).get("total") if res.report_after else None
     return res.surface, n, {"source": name, "phlw_deviation": res.deviation,
-                            "phlw_converged": res.converged, "phlw_diagnostics": res.diagnostics}
+                            "phlw_converged": res.converged, "phlw_diagnostics": res.diagnostics,
+                            "phlw_energy": [e0, e1]}
+
+
+def _phlw_failure(info: dict, mode: str, exc: Exception) -> ConvergenceError:
+    """The no-net answer ``exc`` on a surface the PHLW step produced, as the optimizer's
+    failure: the reference passed :func:`reference_net_check`, so a net may exist near it."""
+    e0, e1 = (info.get("phlw_energy") or [None, None])[:2]
+    energy = (f", E_PHLW {e0:.4g} -> {e1:.4g}" if isinstance(e0, (int, float)) and
+              isinstance(e1, (int, float)) else "")
+    return ConvergenceError(
+        f"the PHLW step (converged {info.get('phlw_converged')}{energy}, deviation "
+        f"{info.get('phlw_deviation', float('nan')):.3g} % of the diagonal) left a surface "
+        f"without the {mode} net: {exc}. The reference itself admits a start (distinct "
+        f"principal curvatures{', K < 0 somewhere' if mode == 'aa' else ''}), so this is the "
+        "optimizer's failure: raise --phlw-outer / --phlw-max-iter, or run 'gridshell phlw' on "
+        "the reference and inspect its curvature diagram")
+
+
+def _stopped(info: dict, traced: TracedNet, post: PostOptResult) -> list[str]:
+    """The optimizers of a design that stopped without meeting their own tolerances."""
+    out = ["the PHLW step"] if info.get("phlw_converged") is False else []
+    out += [f"the level-set fit {f}" for f, fit in traced.fits.items() if not fit.converged]
+    return out + ([] if post.converged else ["the post-optimization"])
 
 
 def crossing_normal_curvature(surf: BSplineSurface, traced: TracedNet) -> dict[str, Any]:
@@ -132,7 +170,7 @@ def design_ncp(source: Any, *, mode: str = "phlw", curves: int | tuple[int, int]
                postopt_weights: dict[str, float] | None = None, postopt_rounds: int = 3,
                frames: int = 12, sim_weights: dict[str, float] | None = None,
                surface_samples: tuple[int, int] = (100, 100), phlw_options: dict | None = None,
-               strict: bool = False,
+               allow_unconverged: bool = False, strict: bool = False,
                progress: Callable[[str], None] | None = None) -> tuple[DesignBundle, dict]:
     """Design a normal-curvature-preserving alignable gridshell (paper 4.2.2-4.2.4, 5.1).
 
@@ -153,11 +191,23 @@ def design_ncp(source: Any, *, mode: str = "phlw", curves: int | tuple[int, int]
     surface_samples : the PHLW sample mesh of the bundle (surface.obj)
     phlw_options : options of the PHLW step for a mesh source (``ctrl``, ``degree``,
         ``transpose``, and any keyword of :func:`gridshell.ncp.phlw.optimize_phlw`)
-    strict : raise :class:`~gridshell.errors.ConvergenceError` as soon as an optimizer (the
-        PHLW step, a level-set fit, the post-optimization) stops without meeting its
-        tolerances; otherwise the report records it (``phlw_converged`` in the params,
-        ``converged`` of ``levelset`` and ``postopt``)
+    allow_unconverged : return a design whose figures miss the paper's thresholds
+        (:func:`gridshell.quality.design_gates`: Delta_a mean / max after the
+        post-optimization, Delta_l max, Delta_n max, the collapse error of CNC / AA) instead of
+        raising :class:`~gridshell.errors.ConvergenceError`; its ``metrics["quality"]`` says
+        ``"ok": false`` with the failing gates
+    strict : deprecated (the figures decide now); also raise as soon as an optimizer (the
+        PHLW step, a level-set fit, the post-optimization) stops without meeting its own
+        tolerances, even when the figures hold; otherwise the report records it
+        (``phlw_converged`` in the params, ``converged`` of ``levelset`` and ``postopt``)
     progress : called with one line per stage
+
+    Raises
+    ------
+    NoNetError : the surface has no net of ``mode`` (a B-spline source; or a reference mesh
+        without one anywhere: umbilic, or K > 0 everywhere for ``aa``)
+    ConvergenceError : the figures miss the thresholds (unless ``allow_unconverged``), or the
+        PHLW step left a surface without the net
 
     Returns
     -------
@@ -182,21 +232,37 @@ def design_ncp(source: Any, *, mode: str = "phlw", curves: int | tuple[int, int]
             "the PHLW step did not converge within its iteration limits (phlw_options outer x "
             "max_iter; --phlw-outer, --phlw-max-iter); raise them, or run without strict to "
             "continue from the unconverged surface")
-    if n is None:
-        n = n_src
+    from_phlw = "phlw_converged" in info
 
+    def guarded(stage: Callable[[], Any]) -> Any:
+        """A stage's no-net answer on a surface of the PHLW step is the step's failure."""
+        try:
+            return stage()
+        except NoNetError as exc:
+            if from_phlw:
+                raise _phlw_failure(info, mode, exc) from exc
+            raise
+
+    notes: list[str] = []
     t0 = time.perf_counter()
     u, v = uniform_params(surf, samples)
-    dirs = net_directions(surf, u, v, mode=mode, n=n if mode == "cnc" else None)
+    dirs = guarded(lambda: net_directions(surf, u, v, mode=mode,
+                                          n=n if mode == "cnc" else None,
+                                          n_hint=n_src if mode == "cnc" else None))
+    notes += dirs.notes
     if mode == "cnc":
         n = float(dirs.n_rows[0])
     timings["directions"] = time.perf_counter() - t0
+    ok = dirs.valid
     say(f"net directions on {samples[0]} x {samples[1]} samples: beta in "
-        f"[{np.degrees(dirs.beta.min()):.1f}, {np.degrees(dirs.beta.max()):.1f}] deg")
+        f"[{np.degrees(dirs.beta[ok].min()):.1f}, {np.degrees(dirs.beta[ok].max()):.1f}] deg")
+    for note in dirs.notes:
+        say(f"note: {note}")
 
     t0 = time.perf_counter()
-    traced = trace(surf, dirs, curves=curves, spacing=spacing, n_ctrl=levelset_ctrl,
-                   degree=levelset_degree, omega_f=omega_f, grid=trace_grid, progress=progress)
+    traced = guarded(lambda: trace(surf, dirs, curves=curves, spacing=spacing,
+                                   n_ctrl=levelset_ctrl, degree=levelset_degree,
+                                   omega_f=omega_f, grid=trace_grid, progress=progress))
     net = traced.net
     timings["tracing"] = time.perf_counter() - t0
     say(f"traced {len(net.lamellae)} lamellae, {len(net.joints)} joints, {len(net.loops)} loops")
@@ -210,7 +276,11 @@ def design_ncp(source: Any, *, mode: str = "phlw", curves: int | tuple[int, int]
             "without strict")
 
     t0 = time.perf_counter()
-    col = collapse_curve(surf, mode=mode, n=n, samples=collapse_samples)
+    col = guarded(lambda: collapse_curve(surf, mode=mode, n=n, samples=collapse_samples))
+    if col.fit.get("invalid_samples"):
+        notes.append(f"the collapse curve counts {col.fit['invalid_samples']} of "
+                     f"{collapse_samples[0] * collapse_samples[1]} samples without a net "
+                     "direction with the net angle clipped to [0, pi/2]")
     timings["collapse"] = time.perf_counter() - t0
     say(f"collapse curve ({collapse_samples[0]} x {collapse_samples[1]} samples): length "
         f"{col.s[-1]:.4g} m, shape {col.shape}")
@@ -269,9 +339,21 @@ def design_ncp(source: Any, *, mode: str = "phlw", curves: int | tuple[int, int]
     elif mode == "aa":
         metrics["collapse_line_error"] = 100 * col.fit["line_error"]
         metrics["aligned_line_error"] = 100 * line_deviation(A2)
+    gates = design_gates(KIND[mode], metrics)
+    metrics["quality"] = {"ok": passed(gates), "summary": gate_summary(gates),
+                          "gates": [{**g.as_dict(), "line": g.line()} for g in gates]}
     timings["metrics"] = time.perf_counter() - t0
     timings["total"] = time.perf_counter() - t_all
     metrics["timings"] = timings
+    if not passed(gates) and not allow_unconverged:
+        stopped = _stopped(info, traced, post)
+        raise ConvergenceError(
+            f"the {KIND[mode]} design misses the paper's figures: {gate_summary(gates)}"
+            + (f" ({', '.join(stopped)} stopped short of its tolerances)" if stopped else "")
+            + (f"; notes: {'; '.join(notes)}" if notes else "")
+            + "; try more post-optimization rounds (--rounds), more or fewer curves (--curves), "
+            "or pass --allow-unconverged (allow_unconverged=True) to write it anyway, marked as "
+            "failing")
 
     ds = max(1, len(col.points) // 600)
     keep = np.unique(np.concatenate([np.arange(0, len(col.points), ds), [len(col.points) - 1]]))
@@ -281,7 +363,8 @@ def design_ncp(source: Any, *, mode: str = "phlw", curves: int | tuple[int, int]
               "levelset": {"ctrl": list(levelset_ctrl), "degree": list(levelset_degree),
                            "omega_f": omega_f},
               "collapse_samples": list(collapse_samples), "frames": frames,
-              "collapse_direction": d.tolist(), "postopt_weights": post.weights, **info}
+              "collapse_direction": d.tolist(), "postopt_weights": post.weights,
+              "allow_unconverged": bool(allow_unconverged), "notes": notes, **info}
     # the lamellae carried onto the post-optimized joints: axes.obj and joint_s (the cut
     # files' joint positions) describe the gridshell that aligns, not the traced net
     out_net = move_joints(net, post.V)
@@ -294,7 +377,8 @@ def design_ncp(source: Any, *, mode: str = "phlw", curves: int | tuple[int, int]
               "postopt": {"history": post.history, "converged": post.converged,
                           "terms": post.report},
               "simulation": {"history": seq.history},
-              "dropped": traced.dropped,
+              "dropped": traced.dropped, "notes": notes,
+              "quality": metrics["quality"],
               "state": NCPState(surf, traced, col, post, seq, A2)}
     say(f"Delta_a {metrics['delta_a_before']['mean']:.3g} % -> "
         f"{metrics['delta_a_after']['mean']:.3g} %, Delta_l max {metrics['delta_l']['max']:.3g} %, "
