@@ -809,9 +809,10 @@ def check_coordinates(V: np.ndarray, name: str, what: str = "vertex") -> None:
     if big.any():
         i = int(np.flatnonzero(big)[0])
         x, y, z = V[i]
-        raise MeshError(f"{name}: {int(big.sum())} coordinates are out of range ({what} {i} at "
-                        f"({x:.3g}, {y:.3g}, {z:.3g}) m, beyond +-{EXTENT_RANGE[1]:g} m); "
-                        "coordinates are read as metres - rescale the mesh or repair the file")
+        raise MeshError(f"{name}: {int(big.sum())} points have coordinates out of range ({what} "
+                        f"{i} at ({x:.3g}, {y:.3g}, {z:.3g}) m, beyond +-{EXTENT_RANGE[1]:g} m: "
+                        "the mesh spans more than a gridshell can); coordinates are read as "
+                        "metres - rescale the mesh or repair the file")
 
 
 def read_mesh(path: str | os.PathLike, kind: str = "any",

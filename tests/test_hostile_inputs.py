@@ -523,3 +523,67 @@ def test_exit_codes_have_one_table():
     readme = (Path(__file__).parents[1] / "README.md").read_text()
     for code in errors.EXIT_CODES:
         assert f"\n| {code} |" in readme
+
+
+# ------------------------------------------------------------------------ output-path races
+
+RACES = ["appears", "appears empty", "gains a file", "gains a subdirectory", "file changed",
+         "replaced by a symlink"]
+
+
+@pytest.mark.parametrize("race", RACES)
+@pytest.mark.parametrize("command", ["gg", "fabricate"])
+def test_output_changing_while_the_command_runs(tmp_path, capsys, good, monkeypatch, command,
+                                                race):
+    """Whatever happens at ``-o`` while the command computes is checked at the rename: the
+    command either replaces an empty directory or refuses (exit 5) and leaves it as it is."""
+    import fabrication.pipeline as fab
+    import gridshell.gg.pipeline as gg
+
+    out = tmp_path / "out"
+    if race not in ("appears", "appears empty"):
+        _foreign_manifest(out, command)  # an earlier output of this command
+
+    def meddle():
+        if race == "appears":
+            out.mkdir()
+            (out / "arrived.txt").write_text("meanwhile")
+        elif race == "appears empty":
+            out.mkdir()
+        elif race == "gains a file":
+            (out / "notes.txt").write_text("meanwhile")
+        elif race == "gains a subdirectory":
+            (out / "photos").mkdir()
+        elif race == "file changed":
+            (out / "a.txt").write_text("z")
+        else:
+            shutil.rmtree(out)
+            (tmp_path / "elsewhere").mkdir()
+            out.symlink_to(tmp_path / "elsewhere")
+
+    module, name = (gg, "design_gg") if command == "gg" else (fab, "plan_parts")
+    real = getattr(module, name)
+
+    def racing(*args, **kwargs):
+        res = real(*args, **kwargs)
+        meddle()
+        return res
+
+    monkeypatch.setattr(module, name, racing)
+    src = str(good["gg"]) if command == "fabricate" else str(_target(tmp_path))
+    argv = [command, src, "-o", str(out), *(["--no-plan"] if command == "fabricate" else GG)]
+    code = main([*argv, "-q"])
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    if race == "appears empty":
+        assert code == 0 and (out / "manifest.json").is_file()
+        return
+    assert code == 5 and len(err.strip().splitlines()) == 1, err
+    after = snapshot(tmp_path)
+    assert not [k for k in after if k.startswith(".") or "/." in k]  # no temporaries left
+    if race == "appears":
+        assert snapshot(out) == {"arrived.txt": b"meanwhile"}
+    elif race == "replaced by a symlink":
+        assert out.is_symlink() and list((tmp_path / "elsewhere").iterdir()) == []
+    else:
+        assert "manifest.json" in snapshot(out) and len(snapshot(out)) >= 2
