@@ -167,7 +167,26 @@ def write_bundle(path: str | Path, bundle: DesignBundle,
                 content(target)
             else:
                 target.write_bytes(content)
+        _check_obj_orientation(tmp)
     return path
+
+
+def _check_obj_orientation(directory: Path) -> None:
+    """:class:`GridshellError` (a bug) if an OBJ under ``directory`` (``extra`` files given as
+    bytes included) has inconsistently oriented faces: every OBJ of a bundle passes its own
+    readers (:func:`gridshell.quadmesh.orientation_problem`, combinatorial, so collapsed
+    loops pass)."""
+    from .errors import GridshellError
+    from .quadmesh import orientation_problem, read_configuration
+
+    for f in sorted(directory.rglob("*.obj")):
+        V, P, sizes = read_configuration(f)
+        if len(P) == 0 or f.name == "axes.obj":
+            continue
+        problem = orientation_problem(P, len(V))
+        if problem is not None:
+            raise GridshellError(f"refusing to write {f.relative_to(directory)}: {problem}; "
+                                 "this is a bug, please report it")
 
 
 def read_design_json(path: str | Path) -> dict:

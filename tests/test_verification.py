@@ -204,3 +204,16 @@ def test_write_mesh_refuses_non_finite_vertices(tmp_path, bad):
     with pytest.raises(GridshellError, match="not finite"):
         write_mesh(tmp_path / "m.obj", V, [[0, 1, 2, 3]])
     assert list(tmp_path.iterdir()) == []
+
+
+def test_bundle_writer_checks_every_obj_it_holds(tmp_path):
+    """An OBJ handed to write_bundle as bytes (``extra``) is checked too; mixed face sizes."""
+    b = make_bundle("GG", **FLAT)
+    bad = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 -1 0\nf 1 2 3 4\nf 1 2 5\n"
+    with pytest.raises(GridshellError, match="frame_000.obj.*inconsistently oriented"):
+        write_bundle(tmp_path / "b", b, extra={"sequence/frame_000.obj": bad.encode()})
+    assert list(tmp_path.iterdir()) == []
+    good = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 -1 0\nf 1 2 3 4\nf 2 1 5\n"
+    write_bundle(tmp_path / "b", b, extra={"sequence/frame_000.obj": good.encode()})
+    assert orientation_problem([[0, 1, 2, 3], [0, 1, 4, -1]], 5) is not None
+    assert orientation_problem([[0, 1, 2, 3], [1, 0, 4, -1]], 5) is None
