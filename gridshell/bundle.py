@@ -265,6 +265,16 @@ def lamellae_from_design(d: dict, axes: list[np.ndarray], where: str | Path) -> 
     return out
 
 
+def check_counts(d: dict, n_joints: int, n_loops: int, where: str | Path) -> None:
+    """:class:`InputError` naming the field if the counts stored at the top of design.json
+    ``d`` (``n_joints``, ``n_loops``) differ from net.obj's."""
+    for key, real in (("n_joints", n_joints), ("n_loops", n_loops)):
+        if key in d and not (type(d[key]) is int and d[key] == real):
+            raise InputError(f"{where}: design.json, field '{key}' is {d[key]!r} but net.obj has "
+                             f"{real}; the bundle was changed after the design - re-run the "
+                             "design command")
+
+
 def check_collapse(d: dict, where: str | Path) -> None:
     """:class:`InputError` naming the field unless the collapse curve of design.json ``d`` (if
     any) has finite ``points`` and ``normals`` and a finite positive ``radius`` (or none)."""
@@ -310,6 +320,7 @@ def read_bundle(path: str | Path) -> DesignBundle:
     if aligned.shape != net_mesh.V.shape:
         raise InputError(f"{path}: aligned.obj has {len(aligned)} vertices but net.obj "
                          f"{len(net_mesh.V)}; re-run the design command")
+    check_counts(d, len(net_mesh.V), len(net_mesh.F), path)
     axes = read_polylines(path / "axes.obj")
     lamellae = lamellae_from_design(d, axes, path)
     net = Net(joints=net_mesh.V, loops=net_mesh.F, lamellae=lamellae)
