@@ -218,6 +218,10 @@ def read_design_json(path: str | Path) -> dict:
     if not isinstance(d["lamellae"], list) or not all(isinstance(r, dict) for r in d["lamellae"]):
         raise InputError(f"{f}: 'lamellae' must be a list of lamella records; re-run the design "
                          "command")
+    for key in ("metrics", "params", "collapse"):
+        if key in d and d[key] is not None and not isinstance(d[key], dict):
+            raise InputError(f"{f}: '{key}' must be a record (a JSON object), got "
+                             f"{type(d[key]).__name__}; re-run the design command")
     return d
 
 
