@@ -252,7 +252,7 @@ def lamellae_from_design(d: dict, axes: list[np.ndarray], where: str | Path) -> 
                                           f"field '{key}'")
             out.append(Lamella(id=int(r["id"]), family=int(r["family"]), joints=r["joints"],
                                joint_s=r["joint_s"], axis=ax))
-        except (KeyError, TypeError, ValueError) as exc:
+        except (KeyError, TypeError, ValueError, OverflowError) as exc:
             if isinstance(exc, InputError):
                 raise
             what = f"lacks {exc}" if isinstance(exc, KeyError) else f"is malformed ({exc})"
@@ -289,8 +289,12 @@ def check_collapse(d: dict, where: str | Path) -> None:
         raise InputError(f"{where}: design.json, field 'collapse' must be a record; re-run the "
                          "design command")
     for key in ("points", "normals", "radius"):
-        if c.get(key) is not None:
+        if key in c and (c[key] is not None or key != "radius"):
             _finite_field(c[key], f"{where}: design.json, field 'collapse.{key}'")
+    for key in ("points", "normals"):
+        if key in c and not (np.ndim(c[key]) == 2 and np.shape(c[key])[1] == 2):
+            raise InputError(f"{where}: design.json, field 'collapse.{key}' must be a list of "
+                             "[x, y] pairs; re-run the design command")
     r = c.get("radius")
     if r is not None and not (isinstance(r, (int, float)) and r > 0):
         raise InputError(f"{where}: design.json, field 'collapse.radius' must be a positive "
@@ -302,7 +306,7 @@ def _finite_field(value: Any, what: str) -> None:
     numbers."""
     try:
         a = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise InputError(f"{what} is not a list of numbers; re-run the design command") from None
     if not np.all(np.isfinite(a)):
         raise InputError(f"{what} holds {int((~np.isfinite(a)).sum())} non-finite values (NaN "

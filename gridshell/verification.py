@@ -58,6 +58,8 @@ def _aligned_figures(Va: np.ndarray, d: dict) -> dict[str, Any]:
         "max": 100 * float(np.abs(dist).max()) / span}}
     curve = d.get("collapse") or {}
     design_r, n = curve.get("radius"), (d.get("metrics") or {}).get("n")
+    if not (isinstance(n, (int, float)) and not isinstance(n, bool) and np.isfinite(n)):
+        n = None  # the stored normal curvature is not a number: no figure against it
     if d["kind"] == "CNC":
         A2 = (Va - c) @ basis.T
         centre, R = fit_circle(A2)

@@ -599,3 +599,40 @@ def test_output_changing_while_the_command_runs(tmp_path, capsys, good, monkeypa
         assert out.is_symlink() and list((tmp_path / "elsewhere").iterdir()) == []
     else:
         assert "manifest.json" in snapshot(out) and len(snapshot(out)) >= 2
+
+
+# ------------------------------------------------------------------------ design.json fuzzing
+
+FUZZ_FIELDS = [("kind",), ("units",), ("n_joints",), ("metrics", "n"),
+               ("metrics", "alignability"), ("params", "target"), ("collapse", "shape"),
+               ("collapse", "points"), ("collapse", "normals"), ("collapse", "radius"),
+               ("lamellae", 0, "id"), ("lamellae", 0, "family"), ("lamellae", 0, "joints"),
+               ("lamellae", 0, "joint_s"), ("lamellae", 0, "length"),
+               ("lamellae", 0, "collapse_s"), ("version",)]
+FUZZ_VALUES = [None, "x", 1e308, [[1]], True]
+FUZZ = [(f, v) for f in FUZZ_FIELDS for v in FUZZ_VALUES]
+
+
+@pytest.mark.parametrize("field, value", FUZZ,
+                         ids=[f"{'.'.join(map(str, f))}={v!r}" for f, v in FUZZ])
+def test_design_json_fields_of_any_type(tmp_path, capsys, good, field, value):
+    """Any JSON value in any field of a CNC design.json: each bundle command exits 0, 2 or 4
+    (verify: a figure fails), never with a traceback, and a refusal changes nothing."""
+    b = tmp_path / "bundle"
+    shutil.copytree(good["cnc"], b)
+    d = json.loads((b / "design.json").read_text())
+    t = d
+    for k in field[:-1]:
+        t = t[k]
+    t[field[-1]] = value
+    (b / "design.json").write_text(json.dumps(d))
+    for argv in (["verify", str(b)],
+                 ["fabricate", str(b), "-o", str(tmp_path / "fab"), "--no-plan", "--force"],
+                 ["render", str(b), "--no-sequence", "--size", "64", "64"]):
+        before = snapshot(tmp_path)
+        code = main([*argv, "-q"])
+        cap = capsys.readouterr()
+        assert "Traceback" not in cap.err and code in (0, 2, 4), (argv[0], code, cap.err)
+        if code == 2 and "error:" in cap.err:
+            assert len(cap.err.strip().splitlines()) == 1 and snapshot(tmp_path) == before
+        shutil.rmtree(tmp_path / "fab", ignore_errors=True)
