@@ -19,7 +19,7 @@ from typing import Any, Callable
 import numpy as np
 
 from gridshell.atomic import atomic_dir
-from gridshell.bundle import DesignBundle, read_bundle
+from gridshell.bundle import DesignBundle, finite_json, read_bundle
 from gridshell.errors import InputError, OutputError
 from gridshell.manifest import MANIFEST, refusal
 
@@ -164,7 +164,8 @@ def fabricate(bundle: str | Path | DesignBundle, out_dir: str | Path,
             say("drawing the assembly plan")
             write_plan(tmp / "plan.png", tmp / "plan.svg", bundle.net,
                        title=f"{bundle.kind} gridshell: lamella ids (blue family 1, red family 3)")
-        (tmp / REPORT).write_text(json.dumps(report, indent=1, default=_json_default),
+        (tmp / REPORT).write_text(json.dumps(finite_json(report), indent=1, allow_nan=False,
+                                             default=_json_default),
                                   encoding="utf-8")
     report["out"] = str(out)
     return report

@@ -167,7 +167,26 @@ def write_bundle(path: str | Path, bundle: DesignBundle,
                 content(target)
             else:
                 target.write_bytes(content)
+        _check_obj_orientation(tmp)
     return path
+
+
+def _check_obj_orientation(directory: Path) -> None:
+    """:class:`GridshellError` (a bug) if an OBJ under ``directory`` (``extra`` files given as
+    bytes included) has inconsistently oriented faces: every OBJ of a bundle passes its own
+    readers (:func:`gridshell.quadmesh.orientation_problem`, combinatorial, so collapsed
+    loops pass)."""
+    from .errors import GridshellError
+    from .quadmesh import orientation_problem, read_configuration
+
+    for f in sorted(directory.rglob("*.obj")):
+        V, P, sizes = read_configuration(f)
+        if len(P) == 0 or f.name == "axes.obj":
+            continue
+        problem = orientation_problem(P, len(V))
+        if problem is not None:
+            raise GridshellError(f"refusing to write {f.relative_to(directory)}: {problem}; "
+                                 "this is a bug, please report it")
 
 
 def read_design_json(path: str | Path) -> dict:
@@ -199,6 +218,10 @@ def read_design_json(path: str | Path) -> dict:
     if not isinstance(d["lamellae"], list) or not all(isinstance(r, dict) for r in d["lamellae"]):
         raise InputError(f"{f}: 'lamellae' must be a list of lamella records; re-run the design "
                          "command")
+    for key in ("metrics", "params", "collapse"):
+        if key in d and d[key] is not None and not isinstance(d[key], dict):
+            raise InputError(f"{f}: '{key}' must be a record (a JSON object), got "
+                             f"{type(d[key]).__name__}; re-run the design command")
     return d
 
 
@@ -229,7 +252,7 @@ def lamellae_from_design(d: dict, axes: list[np.ndarray], where: str | Path) -> 
                                           f"field '{key}'")
             out.append(Lamella(id=int(r["id"]), family=int(r["family"]), joints=r["joints"],
                                joint_s=r["joint_s"], axis=ax))
-        except (KeyError, TypeError, ValueError) as exc:
+        except (KeyError, TypeError, ValueError, OverflowError) as exc:
             if isinstance(exc, InputError):
                 raise
             what = f"lacks {exc}" if isinstance(exc, KeyError) else f"is malformed ({exc})"
@@ -246,6 +269,16 @@ def lamellae_from_design(d: dict, axes: list[np.ndarray], where: str | Path) -> 
     return out
 
 
+def check_counts(d: dict, n_joints: int, n_loops: int, where: str | Path) -> None:
+    """:class:`InputError` naming the field if the counts stored at the top of design.json
+    ``d`` (``n_joints``, ``n_loops``) differ from net.obj's."""
+    for key, real in (("n_joints", n_joints), ("n_loops", n_loops)):
+        if key in d and not (type(d[key]) is int and d[key] == real):
+            raise InputError(f"{where}: design.json, field '{key}' is {d[key]!r} but net.obj has "
+                             f"{real}; the bundle was changed after the design - re-run the "
+                             "design command")
+
+
 def check_collapse(d: dict, where: str | Path) -> None:
     """:class:`InputError` naming the field unless the collapse curve of design.json ``d`` (if
     any) has finite ``points`` and ``normals`` and a finite positive ``radius`` (or none)."""
@@ -256,8 +289,12 @@ def check_collapse(d: dict, where: str | Path) -> None:
         raise InputError(f"{where}: design.json, field 'collapse' must be a record; re-run the "
                          "design command")
     for key in ("points", "normals", "radius"):
-        if c.get(key) is not None:
+        if key in c and (c[key] is not None or key != "radius"):
             _finite_field(c[key], f"{where}: design.json, field 'collapse.{key}'")
+    for key in ("points", "normals"):
+        if key in c and not (np.ndim(c[key]) == 2 and np.shape(c[key])[1] == 2):
+            raise InputError(f"{where}: design.json, field 'collapse.{key}' must be a list of "
+                             "[x, y] pairs; re-run the design command")
     r = c.get("radius")
     if r is not None and not (isinstance(r, (int, float)) and r > 0):
         raise InputError(f"{where}: design.json, field 'collapse.radius' must be a positive "
@@ -269,7 +306,7 @@ def _finite_field(value: Any, what: str) -> None:
     numbers."""
     try:
         a = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise InputError(f"{what} is not a list of numbers; re-run the design command") from None
     if not np.all(np.isfinite(a)):
         raise InputError(f"{what} holds {int((~np.isfinite(a)).sum())} non-finite values (NaN "
@@ -291,6 +328,7 @@ def read_bundle(path: str | Path) -> DesignBundle:
     if aligned.shape != net_mesh.V.shape:
         raise InputError(f"{path}: aligned.obj has {len(aligned)} vertices but net.obj "
                          f"{len(net_mesh.V)}; re-run the design command")
+    check_counts(d, len(net_mesh.V), len(net_mesh.F), path)
     axes = read_polylines(path / "axes.obj")
     lamellae = lamellae_from_design(d, axes, path)
     net = Net(joints=net_mesh.V, loops=net_mesh.F, lamellae=lamellae)

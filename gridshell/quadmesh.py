@@ -809,9 +809,10 @@ def check_coordinates(V: np.ndarray, name: str, what: str = "vertex") -> None:
     if big.any():
         i = int(np.flatnonzero(big)[0])
         x, y, z = V[i]
-        raise MeshError(f"{name}: {int(big.sum())} coordinates are out of range ({what} {i} at "
-                        f"({x:.3g}, {y:.3g}, {z:.3g}) m, beyond +-{EXTENT_RANGE[1]:g} m); "
-                        "coordinates are read as metres - rescale the mesh or repair the file")
+        raise MeshError(f"{name}: {int(big.sum())} points have coordinates out of range ({what} "
+                        f"{i} at ({x:.3g}, {y:.3g}, {z:.3g}) m, beyond +-{EXTENT_RANGE[1]:g} m: "
+                        "the mesh spans more than a gridshell can); coordinates are read as "
+                        "metres - rescale the mesh or repair the file")
 
 
 def read_mesh(path: str | os.PathLike, kind: str = "any",
@@ -879,7 +880,8 @@ def _index_text(prefix: str, F: np.ndarray, offset: int) -> str:
 
 
 def orientation_problem(F: np.ndarray, n_vertices: int) -> str | None:
-    """Why the faces ``F (m,k)`` are not consistently oriented, or None.
+    """Why the faces ``F (m,k)`` (rows padded with -1 for smaller faces) are not consistently
+    oriented, or None.
 
     Purely combinatorial (each directed edge ``(F[i, j], F[i, j+1])`` at most once, so the two
     faces of an interior edge run it in opposite directions), so it holds for a collapsed net
@@ -888,7 +890,7 @@ def orientation_problem(F: np.ndarray, n_vertices: int) -> str | None:
     F = np.asarray(F, dtype=np.int64)
     if F.size == 0:
         return None
-    src, dst = F.ravel(), np.roll(F, -1, axis=1).ravel()
+    src, dst, _ = _face_edges(F)  # rows padded with -1 (faces of mixed sizes) allowed
     directed = src * np.int64(max(n_vertices, 1)) + dst
     u, c = np.unique(directed, return_counts=True)
     if np.any(c > 1):

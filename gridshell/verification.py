@@ -58,6 +58,8 @@ def _aligned_figures(Va: np.ndarray, d: dict) -> dict[str, Any]:
         "max": 100 * float(np.abs(dist).max()) / span}}
     curve = d.get("collapse") or {}
     design_r, n = curve.get("radius"), (d.get("metrics") or {}).get("n")
+    if not (isinstance(n, (int, float)) and not isinstance(n, bool) and np.isfinite(n)):
+        n = None  # the stored normal curvature is not a number: no figure against it
     if d["kind"] == "CNC":
         A2 = (Va - c) @ basis.T
         centre, R = fit_circle(A2)
@@ -167,7 +169,7 @@ def verify_bundle(path: str | Path) -> dict[str, Any]:
     ``mismatch`` against :data:`GG_STORED`. Both: the stored counts (``n_joints``,
     ``n_loops``, ``n_lamellae``) against the files.
 
-    The verdict: ``gates`` (:func:`gridshell.quality.design_gates` of the recomputed figures,
+    The verdict: ``required`` (the figures and files this kind needs), ``gates`` (:func:`gridshell.quality.design_gates` of the recomputed figures,
     as dicts), ``checks`` (their pass / FAIL lines), ``problems`` (a file of
     :data:`FIGURE_FILES` missing, a figure not computed, a mismatch) and ``ok``: every gate
     holds and there is no problem. A bundle whose net.obj, axes.obj, surface.obj or
@@ -256,6 +258,7 @@ def verify_bundle(path: str | Path) -> dict[str, Any]:
                         + " (the bundle was changed after the design)")
     gates = design_gates(d["kind"], out)
     bad = failing(gates)
+    out["required"] = {"figures": [g.name for g in gates], "files": list(FIGURE_FILES[d["kind"]])}
     out["gates"] = [g.as_dict() for g in gates]
     out["checks"] = [g.line() for g in gates]
     out["problems"] = problems

@@ -174,3 +174,15 @@ def test_design_json_geometry_must_be_finite(tmp_path):
     write_bundle(tmp_path / "b", b)  # an unmeasured figure is stored as null
     m = json.loads((tmp_path / "b" / "design.json").read_text())["metrics"]
     assert m == {"coverage": None, "alignability": {"mean": None, "max": 1.0}}
+
+
+def test_rhino_export_refuses_non_finite_geometry(tmp_path):
+    from gridshell.export.rhino import export_3dm
+
+    b = make_bundle("GG")
+    b.net.lamellae[1].axis[2, 0] = np.nan
+    with pytest.raises(GridshellError, match="lamella 1 axis"):
+        export_3dm(b, tmp_path / "m.3dm")
+    assert list(tmp_path.iterdir()) == []
+    export_3dm(make_bundle("GG"), tmp_path / "m.3dm")
+    assert (tmp_path / "m.3dm").stat().st_size > 0

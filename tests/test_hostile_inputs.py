@@ -294,13 +294,25 @@ TAMPER = {
                  ["unknown design kind"]),
     "format other": ("gg", _edit_design(lambda d: d.__setitem__("format", "x")), (2, 2, 2),
                      ["not a gridshell design file"]),
-    "n_joints 5": ("gg", _edit_design(lambda d: d.__setitem__("n_joints", 5)), (2, 2, None),
+    "n_joints 5": ("gg", _edit_design(lambda d: d.__setitem__("n_joints", 5)), (2, 2, 2),
                    ["n_joints"]),
-    "n_loops 0": ("gg", _edit_design(lambda d: d.__setitem__("n_loops", 0)), (2, 2, None),
+    "n_loops 0": ("gg", _edit_design(lambda d: d.__setitem__("n_loops", 0)), (2, 2, 2),
                   ["n_loops"]),
+    "n_joints text": ("gg", _edit_design(lambda d: d.__setitem__("n_joints", "20")), (2, 2, 2),
+                      ["n_joints"]),
     "metrics faked": ("gg", _edit_design(lambda d: d.__setitem__(
         "metrics", {"alignability": {"mean": 0.5, "max": 0.9}})), (2, 2, None),
         ["alignability"]),
+    "params a list": ("gg", _edit_design(lambda d: d.__setitem__("params", [1, 2])), (2, 2, 2),
+                      ["params"]),
+    "metrics a string": ("gg", _edit_design(lambda d: d.__setitem__("metrics", "good")),
+                         (2, 2, 2), ["metrics"]),
+    "collapse a list": ("cnc", _edit_design(lambda d: d.__setitem__("collapse", [1])),
+                        (2, 2, 2), ["collapse"]),
+    "joints text": ("gg", _lam("joints", "abc"), (2, 2, 2), ["lamella record 0"]),
+    "joints nested": ("gg", _lam("joints", [[0, 1], [2, 3]]), (2, 2, 2), ["lamella"]),
+    "design.json huge number": ("gg", _lam("joint_s", [0.0, 1e400, 2e400, 3e400, 4e400]),
+                                (2, 2, 2), ["joint_s"]),
     "net.obj NaN": ("gg", _text("net.obj", _first_v("nan 0 0")), (2, 2, 2), ["net.obj", "nan"]),
     "net.obj 1e300": ("gg", _text("net.obj", _first_v("1e300 0 0")), (2, 2, 2),
                       ["net.obj", "out of range"]),
@@ -523,3 +535,104 @@ def test_exit_codes_have_one_table():
     readme = (Path(__file__).parents[1] / "README.md").read_text()
     for code in errors.EXIT_CODES:
         assert f"\n| {code} |" in readme
+
+
+# ------------------------------------------------------------------------ output-path races
+
+RACES = ["appears", "appears empty", "gains a file", "gains a subdirectory", "file changed",
+         "replaced by a symlink"]
+
+
+@pytest.mark.parametrize("race", RACES)
+@pytest.mark.parametrize("command", ["gg", "fabricate"])
+def test_output_changing_while_the_command_runs(tmp_path, capsys, good, monkeypatch, command,
+                                                race):
+    """Whatever happens at ``-o`` while the command computes is checked at the rename: the
+    command either replaces an empty directory or refuses (exit 5) and leaves it as it is."""
+    import fabrication.pipeline as fab
+    import gridshell.gg.pipeline as gg
+
+    out = tmp_path / "out"
+    if race not in ("appears", "appears empty"):
+        _foreign_manifest(out, command)  # an earlier output of this command
+
+    def meddle():
+        if race == "appears":
+            out.mkdir()
+            (out / "arrived.txt").write_text("meanwhile")
+        elif race == "appears empty":
+            out.mkdir()
+        elif race == "gains a file":
+            (out / "notes.txt").write_text("meanwhile")
+        elif race == "gains a subdirectory":
+            (out / "photos").mkdir()
+        elif race == "file changed":
+            (out / "a.txt").write_text("z")
+        else:
+            shutil.rmtree(out)
+            (tmp_path / "elsewhere").mkdir()
+            out.symlink_to(tmp_path / "elsewhere")
+
+    module, name = (gg, "design_gg") if command == "gg" else (fab, "plan_parts")
+    real = getattr(module, name)
+
+    def racing(*args, **kwargs):
+        res = real(*args, **kwargs)
+        meddle()
+        return res
+
+    monkeypatch.setattr(module, name, racing)
+    src = str(good["gg"]) if command == "fabricate" else str(_target(tmp_path))
+    argv = [command, src, "-o", str(out), *(["--no-plan"] if command == "fabricate" else GG)]
+    code = main([*argv, "-q"])
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    if race == "appears empty":
+        assert code == 0 and (out / "manifest.json").is_file()
+        return
+    assert code == 5 and len(err.strip().splitlines()) == 1, err
+    after = snapshot(tmp_path)
+    assert not [k for k in after if k.startswith(".") or "/." in k]  # no temporaries left
+    if race == "appears":
+        assert snapshot(out) == {"arrived.txt": b"meanwhile"}
+    elif race == "replaced by a symlink":
+        assert out.is_symlink() and list((tmp_path / "elsewhere").iterdir()) == []
+    else:
+        assert "manifest.json" in snapshot(out) and len(snapshot(out)) >= 2
+
+
+# ------------------------------------------------------------------------ design.json fuzzing
+
+FUZZ_FIELDS = [("kind",), ("units",), ("n_joints",), ("metrics", "n"),
+               ("metrics", "alignability"), ("params", "target"), ("collapse", "shape"),
+               ("collapse", "points"), ("collapse", "normals"), ("collapse", "radius"),
+               ("lamellae", 0, "id"), ("lamellae", 0, "family"), ("lamellae", 0, "joints"),
+               ("lamellae", 0, "joint_s"), ("lamellae", 0, "length"),
+               ("lamellae", 0, "collapse_s"), ("version",)]
+FUZZ_VALUES = [None, "x", 1e308, [[1]], True]
+FUZZ = [(f, v) for f in FUZZ_FIELDS for v in FUZZ_VALUES]
+
+
+@pytest.mark.parametrize("field, value", FUZZ,
+                         ids=[f"{'.'.join(map(str, f))}={v!r}" for f, v in FUZZ])
+def test_design_json_fields_of_any_type(tmp_path, capsys, good, field, value):
+    """Any JSON value in any field of a CNC design.json: each bundle command exits 0, 2 or 4
+    (verify: a figure fails), never with a traceback, and a refusal changes nothing."""
+    b = tmp_path / "bundle"
+    shutil.copytree(good["cnc"], b)
+    d = json.loads((b / "design.json").read_text())
+    t = d
+    for k in field[:-1]:
+        t = t[k]
+    t[field[-1]] = value
+    (b / "design.json").write_text(json.dumps(d))
+    for argv in (["verify", str(b)],
+                 ["fabricate", str(b), "-o", str(tmp_path / "fab"), "--no-plan", "--force"],
+                 ["render", str(b), "--no-sequence", "--size", "64", "64"]):
+        before = snapshot(tmp_path)
+        code = main([*argv, "-q"])
+        cap = capsys.readouterr()
+        assert "Traceback" not in cap.err and code in (0, 2, 4), (argv[0], code, cap.err)
+        if code == 2 and "error:" in cap.err:
+            assert len(cap.err.strip().splitlines()) == 1 and snapshot(tmp_path) == before
+        shutil.rmtree(tmp_path / "fab", ignore_errors=True)

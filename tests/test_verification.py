@@ -204,3 +204,29 @@ def test_write_mesh_refuses_non_finite_vertices(tmp_path, bad):
     with pytest.raises(GridshellError, match="not finite"):
         write_mesh(tmp_path / "m.obj", V, [[0, 1, 2, 3]])
     assert list(tmp_path.iterdir()) == []
+
+
+def test_bundle_writer_checks_every_obj_it_holds(tmp_path):
+    """An OBJ handed to write_bundle as bytes (``extra``) is checked too; mixed face sizes."""
+    b = make_bundle("GG", **FLAT)
+    bad = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 -1 0\nf 1 2 3 4\nf 1 2 5\n"
+    with pytest.raises(GridshellError, match="frame_000.obj.*inconsistently oriented"):
+        write_bundle(tmp_path / "b", b, extra={"sequence/frame_000.obj": bad.encode()})
+    assert list(tmp_path.iterdir()) == []
+    good = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 -1 0\nf 1 2 3 4\nf 2 1 5\n"
+    write_bundle(tmp_path / "b", b, extra={"sequence/frame_000.obj": good.encode()})
+    assert orientation_problem([[0, 1, 2, 3], [0, 1, 4, -1]], 5) is not None
+    assert orientation_problem([[0, 1, 2, 3], [1, 0, 4, -1]], 5) is None
+
+
+def test_fabricate_summary_says_what_was_checked(tmp_path, capsys):
+    good = _write(tmp_path / "good", **FLAT)
+    assert main(["fabricate", str(good), "-o", str(tmp_path / "f1"), "--no-plan", "-q",
+                 "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["design checks"] == \
+        "all 4 figures within the paper's thresholds"
+    bad = _write(tmp_path / "bad")
+    assert main(["fabricate", str(bad), "-o", str(tmp_path / "f2"), "--no-plan", "-q", "--json",
+                 "--force"]) == 0
+    line = json.loads(capsys.readouterr().out)["design checks"]
+    assert line.startswith("cut with --force: 4 of 4 figures fail") and "Delta_a max" in line

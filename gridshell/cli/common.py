@@ -41,8 +41,11 @@ def choice_help(descriptions: Mapping[str, str], choices: Iterable[str], default
 
 def print_summary(args: Any, title: str, summary: dict[str, Any]) -> None:
     """One-screen summary on stdout, or JSON with ``--json``."""
-    if getattr(args, "json", False):
-        print(json.dumps({"ok": True, **summary}, indent=1, default=_default))
+    if getattr(args, "json", False):  # strict JSON: a figure not measured is null, not NaN
+        from ..bundle import finite_json
+
+        print(json.dumps(finite_json({"ok": True, **summary}), indent=1, default=_default,
+                         allow_nan=False))
         return
     print(title)
     width = max((len(k) for k in summary), default=0)

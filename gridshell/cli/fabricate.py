@@ -105,9 +105,15 @@ def run(args: Any) -> int:
     if not verdict["ok"]:
         progress("warning: the design fails its checks; cut anyway (--force)")
     rep = fabricate(args.bundle, out, params, progress=progress.callback, plan=not args.no_plan)
+    from ..quality import Gate, gate_summary
+
+    gates = [Gate(g["name"], g["label"], g["value"], g["limit"]) for g in verdict["gates"]]
     summary = {
         "output": str(out),
         "design": f"{rep['kind']} ({rep['shape']} strips)",
+        "design checks": (gate_summary(gates) if verdict["ok"] else
+                          "cut with --force: " + "; ".join(
+                              [gate_summary(gates)] + verdict["problems"])),
         "strips / pieces": f"{rep['n_strips']} / {rep['n_pieces']}",
         "joint marks": rep["n_joint_marks"],
         "sheets": f"{rep['n_sheets']} x {params.sheet[0]:g} x {params.sheet[1]:g} mm "

@@ -113,6 +113,20 @@ def bundle_to_3dm(bundle, name: str = ""):
     return model
 
 
+def _check_finite(bundle) -> None:
+    """:class:`GridshellError` (a bug: bundles are validated when read) unless every coordinate
+    that goes into the .3dm file is finite: nothing non-finite is ever written."""
+    from ..errors import GridshellError
+
+    arrays = {"net joints": bundle.net.joints, "aligned joints": bundle.aligned,
+              "surface": bundle.surface_V}
+    arrays.update({f"lamella {lam.id} axis": lam.axis for lam in bundle.net.lamellae})
+    for what, a in arrays.items():
+        if not np.all(np.isfinite(np.asarray(a, float))):
+            raise GridshellError(f"refusing to write the .3dm file: the {what} are not finite; "
+                                 "this is a bug, please report it")
+
+
 def export_3dm(bundle_dir, path: str | os.PathLike, *,
                progress: Callable[[str], None] | None = None) -> Path:
     """Write the net, surface and lamellae of a design bundle to a Rhino ``.3dm`` file
@@ -139,6 +153,7 @@ def export_3dm(bundle_dir, path: str | os.PathLike, *,
         bundle, name = read_bundle(bundle_dir), Path(bundle_dir).resolve().name
     else:
         bundle, name = bundle_dir, ""
+    _check_finite(bundle)
     if progress is not None:
         progress(f"writing {path}")
     model = bundle_to_3dm(bundle, name)
