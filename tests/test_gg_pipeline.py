@@ -212,3 +212,39 @@ def test_a_design_missing_the_figures_is_refused_naming_them():
     assert bad and all(g["value"] >= g["limit"] for g in bad)
     assert bundle.metrics["alignability"]["max"] == pytest.approx(
         next(g["value"] for g in q["gates"] if g["name"] == "delta_a_max"))
+
+
+def _same_direction_edges(F):
+    F = np.asarray(F)
+    e = np.stack([F.ravel(), np.roll(F, -1, axis=1).ravel()], axis=1)
+    _, count = np.unique(e, axis=0, return_counts=True)
+    return int(np.sum(count - 1))
+
+
+@pytest.mark.parametrize("meridians, triangles", [("cols", False), ("rows", False),
+                                                  ("cols", True)])
+def test_every_obj_of_a_gg_bundle_is_consistently_oriented(tmp_path, meridians, triangles):
+    # regression (issue 13): on a surface-of-revolution quad grid with meridians = columns the
+    # bundle's net.obj had edges run in the same direction by both faces; verify and
+    # fabricate refused it
+    from gg_cases import sphere
+
+    from gridshell.quadmesh import read_mesh
+
+    P = revolution_grid(sphere(1.0), np.linspace(0.3, 1.6, 14), np.linspace(0.0, 1.2, 12))
+    V, F = _mesh(P)
+    if triangles:
+        F = np.concatenate([F[:, [0, 1, 2]], F[:, [0, 2, 3]]])
+    bundle, report = design_gg((V, F), meridians=meridians, frames=2,
+                               grid=(14, 12) if triangles else None)
+    assert bundle.params["quality"]["ok"]
+    out = write_gg(tmp_path / "b", bundle, preview=False, sequence=report["sequence"])
+    objs = [out / n for n in ("net.obj", "aligned.obj", "surface.obj", "revolution.obj")]
+    objs += sorted((out / "sequence").glob("frame_*.obj"))
+    assert len(objs) == 7
+    for path in objs:
+        # the faces as written (aligned.obj is a collapsed, degenerate mesh: read it raw)
+        F = [[int(t.split("/")[0]) for t in ln.split()[1:]]
+             for ln in path.read_text().splitlines() if ln.startswith("f ")]
+        assert len(F) > 0 and _same_direction_edges(F) == 0, path.name
+    assert len(read_mesh(out / "net.obj", kind="any").F) == len(bundle.net.loops)
