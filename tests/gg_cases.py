@@ -57,3 +57,19 @@ def helicoid_grid(R: int, C: int, c: float = 0.5, u=(-1.0, 1.0), v=(0.0, 2.0)) -
     vv = np.linspace(*v, C)
     U, W = np.meshgrid(uu, vv, indexing="ij")
     return np.stack([U * np.cos(W), U * np.sin(W), c * W], axis=-1)
+
+
+def hill_grid(R: int = 30, C: int = 20, size: float = 12.0, rot_deg: float = 30.0,
+              shift=(0.0, 0.0, 0.0)) -> np.ndarray:
+    """A freeform hill, no surface of revolution: ``z = 2.5 exp(-(x^2/16 + y^2/9))`` plus an
+    off-centre bump, over ``[-6, 6] x [-4, 4]`` scaled to ``size`` metres along x, turned by
+    ``rot_deg`` about z and shifted; ``P (R, C, 3)`` with rows along x."""
+    x, y = np.linspace(-6, 6, R), np.linspace(-4, 4, C)
+    X, Y = np.meshgrid(x, y, indexing="ij")
+    Z = 2.5 * np.exp(-(X ** 2 / 16.0 + Y ** 2 / 9.0))
+    Z = Z + 0.25 * np.sin(0.7 * X + 0.3) * np.cos(0.9 * Y - 0.5) * np.exp(
+        -((X - 1) ** 2 + (Y + 1) ** 2) / 8)
+    P = np.stack([X, Y, Z], axis=-1) * (size / 12.0)
+    th = np.radians(rot_deg)
+    Rz = np.array([[np.cos(th), -np.sin(th), 0], [np.sin(th), np.cos(th), 0], [0, 0, 1]])
+    return P @ Rz.T + np.asarray(shift, float)

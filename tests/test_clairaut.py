@@ -98,7 +98,9 @@ def test_geodesic_net_families_are_symmetric_and_cover_the_domain():
     assert len(net.curves1) > 6  # extra curves reach the corners
     for cv in net.curves1:
         assert np.all(np.diff(cv[:, 1]) > 0)
-        assert np.all((cv[:, 1] >= -1e-12) & (cv[:, 1] <= rev.total_angle + 1e-12))
+        # within the domain up to its relative margin (clairaut.BOUNDARY_MARGIN = 1e-9)
+        eps = 1.01e-9 * rev.total_angle
+        assert np.all((cv[:, 1] >= -eps) & (cv[:, 1] <= rev.total_angle + eps))
     for cv in net.curves3:
         assert np.all(np.diff(cv[:, 1]) < 0)
     # crossing angle on the reference parallel: 2 * (90 deg - xi)

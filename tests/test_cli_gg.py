@@ -29,7 +29,11 @@ def test_gg_then_verify(tmp_path, capsys):
                  "-q", "--json"])
     assert code == 0
     summary = json.loads(capsys.readouterr().out)
-    assert summary["ok"]
+    assert summary["ok"] and summary["verdict"].startswith("PASS")
+    # the paper's figures as gates, one per figure (quality.design_gates)
+    assert [g["name"] for g in summary["gates"]] == ["delta_a_mean", "delta_a_max",
+                                                     "delta_a_arc_mean", "delta_a_arc_max"]
+    assert all(g["ok"] and g["value"] < g["limit"] for g in summary["gates"])
     b = read_bundle(out)
     assert b.kind == "GG" and len(b.net.loops) > 0 and (out / "preview.png").is_file()
     assert b.revolution_V is not None
@@ -132,6 +136,10 @@ def test_gg_prints_progress_on_stderr_and_a_one_screen_summary(tmp_path, capsys)
                 "alignment sequence"):
         assert any(k.startswith(key) for k in body), key
     assert "mean=" in next(ln for k, ln in body.items() if k.startswith("Delta_a straight"))
+    # the summary ends with one pass/fail line per figure and the verdict
+    assert lines[-1].strip().startswith("verdict: PASS")
+    gate_lines = [ln.strip() for ln in lines if ln.strip().startswith(("pass  ", "FAIL  "))]
+    assert len(gate_lines) == 4 and all(ln.startswith("pass  Delta_a") for ln in gate_lines)
     cov = float(next(ln for k, ln in body.items() if k.startswith("coverage")).split()[-1])
     assert cov == pytest.approx(100.0, abs=1.0)       # the helicoid grid is its own design
     assert (out / "alignment.gif").is_file() and len(list(out.glob("sequence/frame_*.obj"))) == 4

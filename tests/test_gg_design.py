@@ -155,6 +155,20 @@ def test_freeform_triangle_dome_has_no_odd_even_ripples():
 
 # ----------------------------------------------------------------------------- initial grid
 
+def test_a_large_quad_grid_target_is_resampled_by_default():
+    from gridshell.gg.initial import MAX_DEFAULT_GRID
+
+    P = _dome_grid(130, 90)
+    P0 = initial_grid(*_quads(P))
+    assert P0.shape == (MAX_DEFAULT_GRID, 44, 3)
+    # the corners stay, the samples stay on the target (a paraboloid: z = -(x^2/2 + y^2/2.2))
+    np.testing.assert_allclose(P0[[0, 0, -1, -1], [0, -1, 0, -1]], P[[0, 0, -1, -1], [0, -1, 0, -1]])
+    z = -(P0[..., 0] ** 2 / 2.0 + P0[..., 1] ** 2 / 2.2)
+    assert np.abs(P0[..., 2] - z).max() < 1e-3
+    # an explicit grid is kept
+    assert initial_grid(*_quads(P), grid=(100, 70)).shape == (100, 70, 3)
+
+
 def test_initial_grid_from_a_structured_quad_grid():
     P = _dome_grid(9, 7)
     mesh = QuadMesh(*_quads(P))

@@ -7,7 +7,8 @@ the meridian; meridians are ``P0[:, j]``, parallels ``P0[i, :]``.
   grid ``G (R0, C0)``) is used as it is: ``meridians="cols"`` makes the grid's columns
   ``G[:, j]`` the meridians (``P0 = V[G]``), ``meridians="rows"`` its rows ``G[i, :]``
   (``P0 = V[G.T]``). For a mesh written from ``P`` with ``grid_quads(R, C)`` (vertex
-  ``i*C + j``), ``"cols"`` gives back ``P``. A different ``grid=(R, C)`` resamples it
+  ``i*C + j``), ``"cols"`` gives back ``P``. A different ``grid=(R, C)`` (by default: a grid
+  longer than :data:`MAX_DEFAULT_GRID` along a side) resamples it
   bilinearly in the grid's index space.
 - A **triangle mesh** target is parameterized (:func:`gridshell.igl_adapter.parameterize_disk`,
   LSCM) and the parameter domain turned so that the meridian ``direction`` runs along its first
@@ -37,6 +38,11 @@ from ..errors import InputError, MeshError
 __all__ = ["initial_grid"]
 
 _MIN = 4
+
+#: a quad-grid target with more vertices than this along a side is resampled to this many by
+#: default (proportionally fewer along the other side): the net has a few dozen lamellae, and a
+#: 120 x 80 design took four times as long as a 64 x 43 one for the same figures
+MAX_DEFAULT_GRID = 64
 
 #: boundary vertices with a smaller angle (degrees) between their boundary edges are corners
 _CORNER_ANGLE = 135.0
@@ -354,7 +360,8 @@ def initial_grid(target: Any, F: Any = None, *, meridians: str = "cols",
         meridians (the geodesics of the designed surface); see the module docstring.
     grid : (R, C), optional
         Number of parallels ``R`` and meridians ``C``, each >= 4. Default: the target grid's
-        own size (quads), about ``sqrt(n_vertices)`` (8..40) along the longer side (triangles).
+        own size (quads; resampled to :data:`MAX_DEFAULT_GRID` along its longer side if it is
+        larger), about ``sqrt(n_vertices)`` (8..40) along the longer side (triangles).
     direction : float or (3,) float, optional
         Triangle targets: meridian direction, an angle in degrees in the parameter plane
         (0: the longest extent of the parameter domain) or a 3D vector, mapped into it by the
@@ -400,6 +407,9 @@ def initial_grid(target: Any, F: Any = None, *, meridians: str = "cols",
                             "built by parameterization, or remesh it as a structured grid") from None
         _check_size(*G.shape, "the target grid")
         P = mesh.V[G] if meridians == "cols" else mesh.V[G.T]
+        if grid is None and max(P.shape[:2]) > MAX_DEFAULT_GRID:
+            k = MAX_DEFAULT_GRID / max(P.shape[:2])
+            grid = tuple(max(_MIN, int(round(n * k))) for n in P.shape[:2])
         if grid is not None and grid != P.shape[:2]:
             P = _resample(P, *grid)
         return np.array(P, dtype=float)

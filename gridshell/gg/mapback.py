@@ -331,7 +331,10 @@ def _axis_with_joints(inet: IntrinsicNet, family: int, ci: int, pos: np.ndarray,
     if len(pos):
         dist = np.min(np.abs(sig[:, None] - pos[None, :]), axis=1)
         keep = dist > min_gap
-        keep[[0, -1]] |= dist[[0, -1]] > 1e-12 * max(1.0, abs(sig[-1] - sig[0]))
+        # the ends stay unless a joint is on them (a joint on the boundary lies within the
+        # tracing's 1e-9 domain margin of the curve's end: no sliver segment to it)
+        end_gap = max(1e-9 * abs(sig[-1] - sig[0]), 1e-3 * min_gap)
+        keep[[0, -1]] |= dist[[0, -1]] > end_gap
     else:
         keep = np.ones(len(sig), bool)
     t_all = np.concatenate([sig[keep], pos])
