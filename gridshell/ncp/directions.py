@@ -364,8 +364,8 @@ def no_net_error(g: dict[str, np.ndarray], n_rows: np.ndarray, u: np.ndarray, v:
     gap = abs(b - a) / max(abs(a), abs(b), 1e-300)
     parts = [f"the net of normal curvature n has no real direction at {describe_region(bad, u, v)}"
              f" (eq. 4.10: n must lie in [kappa_I, kappa_II], sin^2 beta = (n - kappa_I) / "
-             f"(kappa_II - kappa_I) in [0, 1]); e.g. at {_sample(u, v, i, j)}: n = {n0:.4g}, "
-             f"kappa_I = {a:.4g}, kappa_II = {b:.4g} 1/m, sin^2 beta = "
+             f"(kappa_II - kappa_I) in [0, 1]); e.g. at {_sample(u, v, i, j)}: n = {n0:.6g}, "
+             f"kappa_I = {a:.6g}, kappa_II = {b:.6g} 1/m, sin^2 beta = "
              f"{(n0 - a) / (b - a) if b != a else float('nan'):.4g}"]
     if gap < 0.05:
         parts.append(f"; there |kappa_II - kappa_I| is only {100 * gap:.2g} % of the curvature "
