@@ -84,10 +84,14 @@ def grid_curvature(surf: BSplineSurface, u: np.ndarray, v: np.ndarray,
 
 
 def row_normal_curvature(K: np.ndarray, H: np.ndarray, mode: Mode = "phlw",
-                         n: float | None = None) -> np.ndarray:
+                         n: float | None = None, kI: np.ndarray | None = None,
+                         kII: np.ndarray | None = None) -> np.ndarray:
     """Normal curvature ``n_u (a,)`` of every u-row of ``K, H (a, b)`` (linear fit of eq. 4.8).
 
     ``phlw``: one line ``K = 2 n H - (n^2 + t^2)`` per row (:func:`gridshell.ncp.phlw.fit_rows`);
+    with the principal curvatures ``kI, kII (a, b)`` a row's ``n`` outside the range common
+    to its samples' ``[kappa_I, kappa_II]`` (where the net has a direction at every sample of
+    the row) is moved :data:`CNC_MARGIN` of that range inside it, if the range is not empty;
     ``cnc``: the given constant ``n``, else one slope fitted over all rows (on a subsampled grid
     of at most :data:`CNC_FIT_SAMPLES` squared samples); ``aa``: ``n = 0``.
     """
@@ -107,7 +111,19 @@ def row_normal_curvature(K: np.ndarray, H: np.ndarray, mode: Mode = "phlw",
         return np.full(R, float(n))
     if mode != "phlw":
         raise InputError(f"unknown mode {mode!r}; use 'phlw', 'cnc' or 'aa'")
-    return fit_rows(K, H, "phlw").n
+    nr = fit_rows(K, H, "phlw").n
+    if kI is None or kII is None:
+        return nr
+    kI, kII = np.atleast_2d(kI), np.atleast_2d(kII)
+    c = classify_samples(kI, kII, nr[:, None])
+    keep = ~c["umbilic"]
+    lo = np.where(keep, np.minimum(kI, kII), -np.inf).max(axis=1)
+    hi = np.where(keep, np.maximum(kI, kII), np.inf).min(axis=1)
+    fix = np.isfinite(lo) & np.isfinite(hi) & (lo < hi) & ((nr < lo) | (nr > hi))
+    nr = nr.copy()
+    m = CNC_MARGIN * (hi[fix] - lo[fix])
+    nr[fix] = np.clip(nr[fix], lo[fix] + m, hi[fix] - m)
+    return nr
 
 
 def net_angle(kI: np.ndarray, kII: np.ndarray, n: np.ndarray,
@@ -438,7 +454,7 @@ def net_directions(surf: BSplineSurface, u: np.ndarray, v: np.ndarray, *, mode: 
             if cnc.get("note"):
                 notes.append(cnc["note"])
     if n is None:
-        n_rows = row_normal_curvature(g["K"], g["H"], mode)
+        n_rows = row_normal_curvature(g["K"], g["H"], mode, kI=g["kI"], kII=g["kII"])
     else:
         n_rows = np.broadcast_to(np.asarray(n, float).reshape(-1), (len(u),)).copy()
     cls = classify_samples(g["kI"], g["kII"], n_rows[:, None], floor=floor)
