@@ -238,3 +238,17 @@ def test_a_phlw_step_that_leaves_no_net_is_a_convergence_failure(monkeypatch):
     # the same reference in mode aa (K > 0 everywhere): no net, before any optimization
     with pytest.raises(NoNetError, match="K > 0 at all"):
         design_ncp(ref, mode="aa", curves=6, phlw_options=opts)
+
+
+def test_aa_on_a_developable_reference_is_no_net_before_the_phlw_step():
+    """A ridge z = h exp(-y^2 / w^2) + c x is developable (K = 0 everywhere): there is no AA
+    net on it or near it (exit 3, K < 0 nowhere), found before any optimization. Before, the
+    PHLW step ran for 20 s and the no-net answer came from its result."""
+    from gridshell.grid import grid_quads
+
+    x, y = np.meshgrid(np.linspace(-5, 5, 20), np.linspace(-5, 5, 20), indexing="ij")
+    P = np.stack([x, y, 1.5 * np.exp(-y ** 2 / 4) + 0.05 * x], -1)
+    ref = (P.reshape(-1, 3), grid_quads(20, 20))
+    with pytest.raises(NoNetError, match="K < 0 nowhere") as exc:
+        design_ncp(ref, mode="aa", curves=6, phlw_options={"ctrl": (6, 6), "samples": (7, 7)})
+    assert "K = 0 at" in str(exc.value) and "developable" in str(exc.value)

@@ -505,9 +505,14 @@ def reference_net_check(surf: BSplineSurface, mode: str, samples: tuple[int, int
             "PHLW / CNC / PK net can start from it; give a reference with distinct principal "
             "curvatures (e.g. a saddle or a torus patch), or design a geodesic gridshell "
             "(gridshell gg)")
-    if mode == "aa" and np.all(K > 0):
+    flat = np.abs(K) <= UMBILIC_TOL * local * local
+    if mode == "aa" and np.all((K > 0) | flat):
+        what = (f"K > 0 at all {K.size} samples (smallest K {float(K.min()):.4g} 1/m^2: it "
+                "bends like a dome)" if not flat.any() else
+                f"K > 0 at {int(np.sum(~flat))} and K = 0 at {int(flat.sum())} of {K.size} "
+                "samples (developable there: the two asymptotic directions coincide), K < 0 "
+                "nowhere")
         raise NoNetError(
-            f"the reference has K > 0 at all {K.size} samples (smallest K {float(K.min()):.4g} "
-            "1/m^2: it bends like a dome), and asymptotic directions exist only where K < 0, so "
+            f"the reference has {what}, and asymptotic directions exist only where K < 0, so "
             "no AA net (n = 0) exists on it or near it; use mode 'phlw' or 'cnc', or a reference "
             "with K < 0 (e.g. a saddle)")
