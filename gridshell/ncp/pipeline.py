@@ -234,7 +234,9 @@ def design_ncp(source: Any, *, mode: str = "phlw", curves: int | tuple[int, int]
             "the PHLW step did not converge within its iteration limits (phlw_options outer x "
             "max_iter; --phlw-outer, --phlw-max-iter); raise them, or run without strict to "
             "continue from the unconverged surface")
-    from_phlw = "phlw_converged" in info
+    # a no-net answer on the PHLW step's surface is the step's failure, unless the user's n
+    # is the reason
+    from_phlw = "phlw_converged" in info and n is None
 
     def guarded(stage: Callable[[], Any]) -> Any:
         """A stage's no-net answer on a surface of the PHLW step is the step's failure."""
