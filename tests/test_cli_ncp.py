@@ -48,7 +48,16 @@ def test_cli_from_a_mesh_runs_the_phlw_step(tmp_path, capsys):
     d = json.loads((out / "design.json").read_text())
     assert d["kind"] == "CNC" and d["collapse"]["shape"] == "circle"
     assert not (out / "alignment.gif").exists()
-    assert "CNC design" in capsys.readouterr().out
+    text = capsys.readouterr().out
+    assert "CNC design" in text
+    # the summary ends with one pass / FAIL line per figure: Delta_a mean, max, Delta_l,
+    # Delta_n, collapse error; design.json says the same
+    last = [ln.strip() for ln in text.strip().splitlines()[-5:]]
+    assert [ln.split("  ")[1].split(" ")[0:2] for ln in last] == [
+        ["Delta_a", "mean"], ["Delta_a", "max"], ["Delta_l", "max"], ["Delta_n", "max"],
+        ["collapse", "error"]]
+    assert all(ln.startswith("pass  ") for ln in last)
+    assert d["metrics"]["quality"]["ok"] is True
     assert main(["verify", str(out)]) == 0
     v = json.loads(capsys.readouterr().out)
     assert v["kind"] == "CNC" and v["mismatch"] == []

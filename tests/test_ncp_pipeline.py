@@ -198,3 +198,71 @@ def test_phlw_surface_of_the_phlw_issue_meets_the_acceptance():
     _acceptance(bundle.metrics)
     n = report["state"].collapse.n_rows
     assert np.ptp(n) > 0                                   # a genuine PHLW: n varies per row
+
+
+# --------------------------------------------------------------------------- quality gates
+
+def _oriented(F):
+    """Every interior edge of the polygons ``F (m, k)`` is run in opposite directions by its
+    two faces (consistent orientation), and no edge by more than two faces."""
+    F = np.asarray(F)
+    half = np.stack([F, np.roll(F, -1, axis=1)], -1).reshape(-1, 2)
+    key = {tuple(h) for h in half.tolist()}
+    return len(key) == len(half)        # a repeated directed edge: two faces run it alike
+
+
+def test_every_obj_of_a_bundle_is_consistently_oriented(aa_bundle, cnc_bundle):
+    from gridshell.quadmesh import read_mesh
+
+    for _, _, out in (aa_bundle, cnc_bundle):
+        names = ["net.obj", "surface.obj", "aligned.obj"] + sorted(
+            p.relative_to(out).as_posix() for p in (out / "sequence").glob("*.obj"))
+        for name in names:
+            F = [ln.split()[1:] for ln in (out / name).read_text().splitlines()
+                 if ln.startswith("f ")]
+            F = np.array([[int(t.split("/")[0]) for t in f] for f in F])
+            assert len(F) and _oriented(F), name
+        assert read_mesh(out / "net.obj").F.shape[1] == 4
+
+
+def test_bundles_pass_verify_and_fabricate_with_the_defaults(aa_bundle, cnc_bundle, tmp_path,
+                                                             capsys):
+    from gridshell.cli.main import main
+
+    for k, (bundle, _, out) in enumerate((aa_bundle, cnc_bundle)):
+        assert bundle.metrics["quality"]["ok"]
+        assert main(["verify", str(out)]) == 0
+        assert json.loads(capsys.readouterr().out)["ok"] is True
+        assert main(["fabricate", str(out), "-o", str(tmp_path / f"fab{k}"), "-q"]) == 0
+        capsys.readouterr()
+        assert any((tmp_path / f"fab{k}").rglob("*.dxf"))
+
+
+def test_a_design_missing_the_figures_is_refused_unless_allowed():
+    """Torus zone, CNC, without a post-optimization round: Delta_a and the collapse miss
+    their thresholds. design_ncp raises ConvergenceError naming the failing gates; with
+    allow_unconverged it returns the design with metrics["quality"]["ok"] False."""
+    from gridshell.errors import ConvergenceError
+    from gridshell.quality import THRESHOLDS
+
+    kw = dict(mode="cnc", curves=6, frames=2, postopt_rounds=0, collapse_samples=(200, 200),
+              samples=(24, 24))
+    with pytest.raises(ConvergenceError) as exc:
+        design_ncp(torus(), **kw)
+    msg = str(exc.value)
+    assert "misses the paper's figures" in msg and "--allow-unconverged" in msg
+    bundle, report = design_ncp(torus(), allow_unconverged=True, **kw)
+    q = bundle.metrics["quality"]
+    assert q["ok"] is False and bundle.params["allow_unconverged"] is True
+    names = [g["name"] for g in q["gates"]]
+    assert names == ["delta_a_mean", "delta_a_max", "delta_l_max", "delta_n_max",
+                     "collapse_error"]
+    m = bundle.metrics
+    values = {"delta_a_mean": m["delta_a_after"]["mean"], "delta_a_max": m["delta_a_after"]["max"],
+              "delta_l_max": m["delta_l"]["max"], "delta_n_max": m["delta_n"]["max"],
+              "collapse_error": m["aligned_radius_error"]}
+    for g in q["gates"]:
+        assert g["value"] == values[g["name"]]
+        assert g["ok"] == (values[g["name"]] < THRESHOLDS[g["name"]][1])
+        assert (g["line"] in msg) or g["ok"] or g["line"].split("  ", 1)[1] in msg
+    assert not all(g["ok"] for g in q["gates"])

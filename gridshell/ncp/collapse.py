@@ -20,6 +20,7 @@ Everything is vectorized: the sampling is evaluated in blocks of rows with
 """
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from typing import Literal
 
@@ -73,10 +74,13 @@ class CollapseResult:
 
 def collapse_chords(S: np.ndarray, inv_cos: np.ndarray) -> np.ndarray:
     """Eq. 4.14 on a block of rows: ``S (a, b, 3)`` points, ``inv_cos (a, b)`` = 1/cos beta;
-    returns ``(a-1,)`` chords."""
+    returns ``(a-1,)`` chords. Samples with ``inv_cos`` NaN (no net direction) are left out
+    of the mean; a chord without any sample is NaN."""
     d = np.linalg.norm(np.diff(S, axis=0), axis=2)
     w = 0.5 * (inv_cos[:-1] + inv_cos[1:])
-    return np.mean(d * w, axis=1)
+    with np.errstate(invalid="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)     # a row without any direction
+        return np.nanmean(d * w, axis=1)
 
 
 def integrate_collapse(chords: np.ndarray, n_rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -228,11 +232,11 @@ def collapse_curve(surf: BSplineSurface, *, mode: Literal["phlw", "cnc", "aa"] =
     for start in range(0, a, block):
         sl = slice(start, min(start + block, a))
         g = grid_curvature(surf, u[sl], v)
-        nr = row_normal_curvature(g["K"], g["H"], mode, n)
+        nr = row_normal_curvature(g["K"], g["H"], mode, n, kI=g["kI"], kII=g["kII"])
         n_rows[sl] = nr
         beta, valid = net_angle(g["kI"], g["kII"], nr[:, None], scale=floor)
         invalid += int(np.sum(~valid))
-        ic = 1.0 / np.cos(beta)
+        ic = np.where(valid, 1.0 / np.cos(beta), np.nan)
         S = g["S"]
         if prev_S is not None:
             S = np.concatenate([prev_S[None], S])
@@ -240,12 +244,17 @@ def collapse_curve(surf: BSplineSurface, *, mode: Literal["phlw", "cnc", "aa"] =
         c = collapse_chords(S, ic)
         first = sl.start - (1 if prev_S is not None else 0)
         chords[first:first + len(c)] = c
-        prev_S, prev_ic = g["S"][-1], (1.0 / np.cos(beta))[-1]
+        prev_S, prev_ic = g["S"][-1], np.where(valid, 1.0 / np.cos(beta), np.nan)[-1]
     if invalid > MAX_DROPPED * a * len(v):
         raise NoNetError(f"the net has no real direction at {invalid} of {a * len(v)} collapse "
                          f"samples ({100.0 * invalid / (a * len(v)):.3g} %, more than the "
                          f"{100 * MAX_DROPPED:g} % left out; n outside [kappa_I, kappa_II] or "
                          "umbilic, eq. 4.10); re-run the PHLW optimization or trim the surface")
+    gaps = ~np.isfinite(chords)
+    if gaps.any() and not gaps.all():
+        # rows without a net direction (at most MAX_DROPPED of the samples): interpolated
+        k = np.arange(len(chords))
+        chords[gaps] = np.interp(k[gaps], k[~gaps], chords[~gaps])
     P, N = integrate_collapse(chords, n_rows)
     s = np.concatenate([[0.0], np.cumsum(chords)])
     shape = {"cnc": "circle", "aa": "line"}.get(mode, "curve")

@@ -84,10 +84,14 @@ def grid_curvature(surf: BSplineSurface, u: np.ndarray, v: np.ndarray,
 
 
 def row_normal_curvature(K: np.ndarray, H: np.ndarray, mode: Mode = "phlw",
-                         n: float | None = None) -> np.ndarray:
+                         n: float | None = None, kI: np.ndarray | None = None,
+                         kII: np.ndarray | None = None) -> np.ndarray:
     """Normal curvature ``n_u (a,)`` of every u-row of ``K, H (a, b)`` (linear fit of eq. 4.8).
 
     ``phlw``: one line ``K = 2 n H - (n^2 + t^2)`` per row (:func:`gridshell.ncp.phlw.fit_rows`);
+    with the principal curvatures ``kI, kII (a, b)`` a row's ``n`` outside the range common
+    to its samples' ``[kappa_I, kappa_II]`` (where the net has a direction at every sample of
+    the row) is moved :data:`CNC_MARGIN` of that range inside it, if the range is not empty;
     ``cnc``: the given constant ``n``, else one slope fitted over all rows (on a subsampled grid
     of at most :data:`CNC_FIT_SAMPLES` squared samples); ``aa``: ``n = 0``.
     """
@@ -107,7 +111,19 @@ def row_normal_curvature(K: np.ndarray, H: np.ndarray, mode: Mode = "phlw",
         return np.full(R, float(n))
     if mode != "phlw":
         raise InputError(f"unknown mode {mode!r}; use 'phlw', 'cnc' or 'aa'")
-    return fit_rows(K, H, "phlw").n
+    nr = fit_rows(K, H, "phlw").n
+    if kI is None or kII is None:
+        return nr
+    kI, kII = np.atleast_2d(kI), np.atleast_2d(kII)
+    c = classify_samples(kI, kII, nr[:, None])
+    keep = ~c["umbilic"]
+    lo = np.where(keep, np.minimum(kI, kII), -np.inf).max(axis=1)
+    hi = np.where(keep, np.maximum(kI, kII), np.inf).min(axis=1)
+    fix = np.isfinite(lo) & np.isfinite(hi) & (lo < hi) & ((nr < lo) | (nr > hi))
+    nr = nr.copy()
+    m = CNC_MARGIN * (hi[fix] - lo[fix])
+    nr[fix] = np.clip(nr[fix], lo[fix] + m, hi[fix] - m)
+    return nr
 
 
 def net_angle(kI: np.ndarray, kII: np.ndarray, n: np.ndarray,
@@ -364,8 +380,8 @@ def no_net_error(g: dict[str, np.ndarray], n_rows: np.ndarray, u: np.ndarray, v:
     gap = abs(b - a) / max(abs(a), abs(b), 1e-300)
     parts = [f"the net of normal curvature n has no real direction at {describe_region(bad, u, v)}"
              f" (eq. 4.10: n must lie in [kappa_I, kappa_II], sin^2 beta = (n - kappa_I) / "
-             f"(kappa_II - kappa_I) in [0, 1]); e.g. at {_sample(u, v, i, j)}: n = {n0:.4g}, "
-             f"kappa_I = {a:.4g}, kappa_II = {b:.4g} 1/m, sin^2 beta = "
+             f"(kappa_II - kappa_I) in [0, 1]); e.g. at {_sample(u, v, i, j)}: n = {n0:.6g}, "
+             f"kappa_I = {a:.6g}, kappa_II = {b:.6g} 1/m, sin^2 beta = "
              f"{(n0 - a) / (b - a) if b != a else float('nan'):.4g}"]
     if gap < 0.05:
         parts.append(f"; there |kappa_II - kappa_I| is only {100 * gap:.2g} % of the curvature "
@@ -438,7 +454,7 @@ def net_directions(surf: BSplineSurface, u: np.ndarray, v: np.ndarray, *, mode: 
             if cnc.get("note"):
                 notes.append(cnc["note"])
     if n is None:
-        n_rows = row_normal_curvature(g["K"], g["H"], mode)
+        n_rows = row_normal_curvature(g["K"], g["H"], mode, kI=g["kI"], kII=g["kII"])
     else:
         n_rows = np.broadcast_to(np.asarray(n, float).reshape(-1), (len(u),)).copy()
     cls = classify_samples(g["kI"], g["kII"], n_rows[:, None], floor=floor)
@@ -489,9 +505,14 @@ def reference_net_check(surf: BSplineSurface, mode: str, samples: tuple[int, int
             "PHLW / CNC / PK net can start from it; give a reference with distinct principal "
             "curvatures (e.g. a saddle or a torus patch), or design a geodesic gridshell "
             "(gridshell gg)")
-    if mode == "aa" and np.all(K > 0):
+    flat = np.abs(K) <= UMBILIC_TOL * local * local
+    if mode == "aa" and np.all((K > 0) | flat):
+        what = (f"K > 0 at all {K.size} samples (smallest K {float(K.min()):.4g} 1/m^2: it "
+                "bends like a dome)" if not flat.any() else
+                f"K > 0 at {int(np.sum(~flat))} and K = 0 at {int(flat.sum())} of {K.size} "
+                "samples (developable there: the two asymptotic directions coincide), K < 0 "
+                "nowhere")
         raise NoNetError(
-            f"the reference has K > 0 at all {K.size} samples (smallest K {float(K.min()):.4g} "
-            "1/m^2: it bends like a dome), and asymptotic directions exist only where K < 0, so "
+            f"the reference has {what}, and asymptotic directions exist only where K < 0, so "
             "no AA net (n = 0) exists on it or near it; use mode 'phlw' or 'cnc', or a reference "
             "with K < 0 (e.g. a saddle)")

@@ -109,8 +109,10 @@ def _phlw_failure(info: dict, mode: str, exc: Exception) -> ConvergenceError:
     """The no-net answer ``exc`` on a surface the PHLW step produced, as the optimizer's
     failure: the reference passed :func:`reference_net_check`, so a net may exist near it."""
     e0, e1 = (info.get("phlw_energy") or [None, None])[:2]
-    energy = (f", E_PHLW {e0:.4g} -> {e1:.4g}" if isinstance(e0, (int, float)) and
-              isinstance(e1, (int, float)) else "")
+    energy = ""
+    if isinstance(e0, (int, float)) and isinstance(e1, (int, float)):
+        energy = f", E_PHLW {e0:.4g} -> {e1:.4g}" + (
+            ": the step diverged" if e1 > max(e0, 1e-12) * 10 else "")
     return ConvergenceError(
         f"the PHLW step (converged {info.get('phlw_converged')}{energy}, deviation "
         f"{info.get('phlw_deviation', float('nan')):.3g} % of the diagonal) left a surface "
@@ -232,7 +234,9 @@ def design_ncp(source: Any, *, mode: str = "phlw", curves: int | tuple[int, int]
             "the PHLW step did not converge within its iteration limits (phlw_options outer x "
             "max_iter; --phlw-outer, --phlw-max-iter); raise them, or run without strict to "
             "continue from the unconverged surface")
-    from_phlw = "phlw_converged" in info
+    # a no-net answer on the PHLW step's surface is the step's failure, unless the user's n
+    # is the reason
+    from_phlw = "phlw_converged" in info and n is None
 
     def guarded(stage: Callable[[], Any]) -> Any:
         """A stage's no-net answer on a surface of the PHLW step is the step's failure."""
@@ -260,9 +264,8 @@ def design_ncp(source: Any, *, mode: str = "phlw", curves: int | tuple[int, int]
         say(f"note: {note}")
 
     t0 = time.perf_counter()
-    traced = guarded(lambda: trace(surf, dirs, curves=curves, spacing=spacing,
-                                   n_ctrl=levelset_ctrl, degree=levelset_degree,
-                                   omega_f=omega_f, grid=trace_grid, progress=progress))
+    traced = trace(surf, dirs, curves=curves, spacing=spacing, n_ctrl=levelset_ctrl,
+                   degree=levelset_degree, omega_f=omega_f, grid=trace_grid, progress=progress)
     net = traced.net
     timings["tracing"] = time.perf_counter() - t0
     say(f"traced {len(net.lamellae)} lamellae, {len(net.joints)} joints, {len(net.loops)} loops")
