@@ -1,4 +1,4 @@
-"""FD cases of the PHLW surface-design terms (gridshell.ncp.phlw, paper 4.2.1).
+"""FD cases of the PHLW surface-design terms (gridshell.ncp.phlw_terms, paper 4.2.1).
 
 A small bi-cubic B-spline (5 x 4 control points, 3 x 4 samples) with random control points
 and random auxiliary variables near their consistent values, so every product term is active;
@@ -49,7 +49,7 @@ def _gliding(rng):
 MODE_TERMS = ("normal_eq", "first_form_eq", "delta_eq", "sqrt_delta_eq", "second_form_eq",
               "curvature_eq", "principal_eq", "phlw_target", "beta_fairness")
 
-CASES = {f"gridshell.ncp.phlw.{name}[{mode}]": _case(mode)
+CASES = {f"gridshell.ncp.phlw_terms.{name}[{mode}]": _case(mode)
          for name in MODE_TERMS for mode in P.MODES}
 # sample_gliding reads only the control points, at the same place in every mode
-CASES["gridshell.ncp.phlw.sample_gliding"] = _gliding
+CASES["gridshell.ncp.phlw_terms.sample_gliding"] = _gliding
