@@ -41,17 +41,21 @@ from typing import Any, Callable
 import numpy as np
 
 from ..bspline import BSplineSurface, uniform_params
-from ..errors import InputError, NoNetError
+from ..errors import ConvergenceError, InputError
 from ..solver import Layout, Problem, solve
 from ..solver import terms as T
 from .phlw_checks import (FLAT_CURVATURE, NEAR_UMBILIC, NetCheck, RowFit, _grid_geometry,
                           _regions, check_reference_net, fit_rows, net_direction_check,
-                          phlw_energy, principal_angle_error, row_relation_residual)
-from .phlw_terms import (MODES, Mode, SampleGliding, Samples, _check_mode, beta_fairness,
-                         curvature_eq, delta_eq, first_form_eq, init_auxiliary, init_curvature,
-                         init_delta, init_first_form, init_normal, init_second_form,
-                         make_layout, make_samples, normal_eq, phlw_target, principal_eq,
-                         sample_gliding, second_form_eq, sqrt_delta_eq)
+                          phlw_energy, principal_angle_error, row_relation_residual,
+                          start_rows)
+from .phlw_terms import (MODES, Mode, Regularity, SampleGliding, Samples, UmbilicMargin,
+                         _check_mode, beta_fairness, boundary_inward, curvature_eq, delta_eq,
+                         first_form_eq, init_auxiliary, init_curvature, init_delta,
+                         init_first_form, init_normal, init_second_form, make_layout,
+                         make_samples, normal_eq, parametrization_guard, phlw_target,
+                         principal_eq, sample_gliding, second_form_eq, sqrt_delta_eq,
+                         umbilic_guard)
+from .reference import boundary_segments, closest_on_segments
 
 #: Default weights, on geometry scaled to a unit bounding-box diagonal. ``target`` and ``beta``
 #: are the paper's omega_t = 0.1 and omega_beta = 5e-4. The paper gives no omega_c, omega_g:
@@ -69,6 +73,8 @@ DEFAULT_WEIGHTS: dict[str, float] = {
     "beta": 5e-4,          # omega_beta
     "closeness": 1e-2,     # omega_c
     "gliding": 10.0,       # omega_g
+    "boundary": 1.0,       # boundary samples not inside the reference's boundary (not in the paper)
+    "umbilic": 1.0,        # half-gap of the principal curvatures >= a margin (not in the paper)
 }
 
 #: Levenberg-Marquardt settings of every round: initial damping (relative to the mean of
@@ -79,6 +85,30 @@ DEFAULT_WEIGHTS: dict[str, float] = {
 #: row relation (benchmarks/README.md).
 SOLVER_DAMPING = 1e-9
 SOLVER_TOL_REL = 1e-3
+
+#: Floor of ``E``, ``G`` and ``w = sqrt(delta)`` per sample, as a fraction of their values on
+#: the initial surface (:func:`~gridshell.ncp.phlw_terms.parametrization_guard`): the
+#: parameter speeds may halve, the area element fall to a quarter, never collapse.
+REGULAR_FLOOR = 0.25
+
+#: The optimized surface keeps ``(kappa_2 - kappa_1) / 2 >= UMBILIC_MARGIN *`` the reference's
+#: curvature scale (RMS over the samples of ``max |kappa_i|``) at every sample
+#: (:func:`~gridshell.ncp.phlw_terms.umbilic_guard`).
+UMBILIC_MARGIN = 0.05
+
+#: An outer round that lowers the true energy by less than this fraction ends the loop
+#: (stagnation); a solver step that raises it is halved up to BACKTRACK times, then rejected.
+ROUND_TOL_REL = 1e-3
+BACKTRACK = 6
+
+#: Acceptance (``converged``): max relative residual of eq. 4.8 at the samples, max angle of
+#: the parameter lines to the principal directions (degrees), max deviation from the reference
+#: (% of its bounding-box diagonal). E_PHLW at or below E_PHLW_FLOOR (unit-diagonal units)
+#: counts as held even when it did not fall (a reference that already is PHLW).
+RELATION_TOL = 1e-2
+ANGLE_TOL_DEG = 1.0
+DEVIATION_TOL = 5.0
+E_PHLW_FLOOR = 1e-10
 
 
 @dataclass
@@ -94,7 +124,12 @@ class PHLWResult:
         "terms", "time"}``
     report_before, report_after : per term ``{"weight", "energy", "rms", "max"}`` (scaled units),
         plus ``"E_PHLW"`` (:func:`phlw_energy`) and the acceptance figures
-    converged : the last round's solve met a tolerance
+    converged : every acceptance figure holds (:func:`acceptance_figures`): the energy and
+        E_PHLW fell, relation, principal angle and deviation within their tolerances and a
+        real net direction at every sample
+    figures : :func:`acceptance_figures`
+    energy_initial, energy_final : energy of the whole problem (auxiliaries exact) at the start
+        and at the end, on unit-diagonal geometry
     deviation : max distance of the surface (check sampling) to the reference, % of the
         reference's bounding-box diagonal
     diagnostics : human-readable lines (clamped rows, umbilic / no-net regions)
@@ -117,6 +152,9 @@ class PHLWResult:
     net_check: NetCheck | None = None
     weights: dict = field(default_factory=dict)
     reference_diagonal: float = float("nan")
+    figures: dict = field(default_factory=dict)
+    energy_initial: float = float("nan")
+    energy_final: float = float("nan")
 
 
 def _scaled_surface(surf: BSplineSurface, center: np.ndarray, scale: float) -> BSplineSurface:
@@ -152,6 +190,19 @@ def deviation_percent(surf: BSplineSurface, V: np.ndarray, F: np.ndarray,
     return float(100.0 * np.sqrt(d2.max()) / diag)
 
 
+def coverage_percent(surf: BSplineSurface, V: np.ndarray, F: np.ndarray,
+                     samples: tuple[int, int] = (60, 60)) -> float:
+    """Max distance of the mesh ``(V, F)``'s vertices to the surface (sampled ``samples`` and
+    triangulated), in % of the mesh's bounding-box diagonal: how much of the reference the
+    surface fails to cover (a shrunk surface scores high, :func:`deviation_percent` not)."""
+    from ..igl_adapter import closest_points
+
+    m = surf.sample(*samples)
+    d2, _, _ = closest_points(np.asarray(V, float), m.V, m.F)
+    diag = float(np.linalg.norm(V.max(0) - V.min(0)))
+    return float(100.0 * np.sqrt(d2.max()) / diag)
+
+
 def _acceptance(surf: BSplineSurface, n: np.ndarray, t: np.ndarray, u: np.ndarray, v: np.ndarray,
                 mode: str, omega_t: float, diag: float) -> dict[str, float]:
     rel = row_relation_residual(surf, u, v, n, t)
@@ -161,13 +212,16 @@ def _acceptance(surf: BSplineSurface, n: np.ndarray, t: np.ndarray, u: np.ndarra
 
 
 def phlw_problem(s0: BSplineSurface, data: Samples, lay: Layout, weights: dict[str, float],
-                 reference: tuple[np.ndarray, np.ndarray], mode: Mode = "phlw"
-                 ) -> tuple[Problem, np.ndarray, RowFit]:
-    """The PHLW problem of one round (eqs. 4.2-4.8, E_beta, closeness, gliding) and its start.
+                 reference: tuple[np.ndarray, np.ndarray], mode: Mode = "phlw",
+                 scale: float = 1.0) -> tuple[Problem, np.ndarray, RowFit]:
+    """The PHLW problem of one round (eqs. 4.2-4.8, E_beta, closeness, gliding, boundary, the
+    parametrization and umbilic guards) and its start.
 
-    ``s0`` and ``reference = (V, F)`` are in unit-diagonal coordinates; ``weights`` are all
-    of :data:`DEFAULT_WEIGHTS`. The auxiliary variables start exact on ``s0`` and the row
-    coefficients from :func:`fit_rows`; closest points on the reference are computed here.
+    ``s0`` and ``reference = (V, F)`` are in unit-diagonal coordinates (``scale``: the
+    diagonal in metres, for messages); ``weights`` are all of :data:`DEFAULT_WEIGHTS`. The
+    auxiliary variables start exact on ``s0`` and the row coefficients from
+    :func:`start_rows` (``n`` inside the principal range); closest points on the reference
+    are computed here.
     Raises :class:`InputError` for a singular parametrization and :class:`NoNetError` where
     no net of ``mode`` exists (:func:`check_reference_net`).
 
@@ -182,8 +236,8 @@ def phlw_problem(s0: BSplineSurface, data: Samples, lay: Layout, weights: dict[s
     if not np.all(aux["delta"] > 0):
         raise InputError("the initial surface has a singular parametrization (S_u x S_v = 0) at "
                          f"{int(np.sum(~(aux['delta'] > 0)))} samples; refit the reference")
-    check_reference_net(aux["K"], aux["H"], mode)
-    fit = fit_rows(aux["K"].reshape(R, -1), aux["H"].reshape(R, -1), mode)
+    check_reference_net(aux["K"], aux["H"], mode, scale=scale)
+    fit = start_rows(aux["K"].reshape(R, -1), aux["H"].reshape(R, -1), mode)
     vals = {"C": s0.ctrl.reshape(-1, 3), **aux, "t": fit.t}
     if mode == "phlw":
         vals["n"] = fit.n
@@ -202,12 +256,60 @@ def phlw_problem(s0: BSplineSurface, data: Samples, lay: Layout, weights: dict[s
     prob.add("second form (4.5)", c, second_form_eq, data)
     prob.add("curvature (4.6)", c, curvature_eq)
     prob.add("principal (4.7)", c, principal_eq)
+    prob.add("regularity", c, parametrization_guard,
+             Regularity(REGULAR_FLOOR * aux["E"], REGULAR_FLOOR * aux["G"],
+                        REGULAR_FLOOR * aux["w"]))
+    prob.add("umbilic", weights["umbilic"], umbilic_guard, UmbilicMargin(umbilic_margin(aux["K"], aux["H"]) ** 2))
     prob.add("target (4.8)", weights["target"], phlw_target, data)
     prob.add("beta", weights["beta"], beta_fairness, data)
     prob.add("closeness", weights["closeness"], T.linear, T.Linear("C", data.ops["S"], foot))
     prob.add("gliding", weights["gliding"], sample_gliding,
              SampleGliding(data.ops["S"], foot, nrm))
+    if weights.get("boundary", 0.0) > 0 and len(boundary_segments(reference[1])):
+        prob.add("boundary", weights["boundary"], boundary_inward,
+                 boundary_gliding(s0.ctrl.reshape(-1, 3), boundary_operator(s0, data), reference))
     return prob, x, fit
+
+
+def umbilic_margin(K: np.ndarray, H: np.ndarray) -> float:
+    """Least half-gap ``(kappa_2 - kappa_1) / 2`` the optimization keeps (units of ``H``):
+    :data:`UMBILIC_MARGIN` times the RMS of ``max |kappa_i|`` over the samples."""
+    r = np.sqrt(np.maximum(H * H - K, 0.0))
+    return float(UMBILIC_MARGIN * np.sqrt(np.mean((np.abs(H) + r) ** 2)))
+
+
+def boundary_operator(surf: BSplineSurface, data: Samples) -> Any:
+    """``S`` at the boundary of the domain (``u = 0, 1`` and ``v = 0, 1``, at the sample
+    parameters of the other direction): COO ``(4 m, nc)`` on the control points."""
+    R = int(data.row.max()) + 1
+    u, v = uniform_params(surf, (R, data.row.size // R))
+    ub = np.concatenate([u, u, np.zeros(len(v)), np.ones(len(v))])
+    vb = np.concatenate([np.zeros(len(u)), np.ones(len(u)), v, v])
+    return surf.operator(ub, vb, 0, 0).tocoo()
+
+
+def boundary_gliding(ctrl: np.ndarray, op: Any, reference: tuple[np.ndarray, np.ndarray]
+                     ) -> SampleGliding:
+    """Data of the boundary term (:func:`~gridshell.ncp.phlw_terms.boundary_inward`): the
+    surface's boundary samples ``op @ ctrl``, their closest points on the reference's
+    boundary edges and the outward in-surface normal there (``T x n``, pointing away from
+    the edge's face). Without it the optimizer shrinks the surface away from the regions where
+    no net exists (a 12 x 8 m hill came back 7.7 x 5.3 m); closeness and gliding hold the
+    samples only where they are, and the patch of a principal parametrization is bounded by
+    principal lines, which a rectangle's edges are not (so the boundary may overhang)."""
+    from ..igl_adapter import closest_points_with_normals
+
+    V, F = reference
+    seg, face = boundary_segments(F, return_faces=True)
+    A, B = V[seg[:, 0]], V[seg[:, 1]]
+    Sb = np.asarray(op @ ctrl)
+    foot, j = closest_on_segments(Sb, A, B)
+    _, nrm = closest_points_with_normals(foot, V, F)
+    m = np.cross(B[j] - A[j], nrm)
+    m /= np.maximum(np.linalg.norm(m, axis=1), 1e-300)[:, None]
+    inner = V[np.asarray(F)[face[j]]].mean(axis=1) - foot
+    m *= np.where(np.einsum("ij,ij->i", m, inner) > 0, -1.0, 1.0)[:, None]
+    return SampleGliding(op, foot, m)
 
 
 def optimize_phlw(surf: BSplineSurface, reference: Any, *, mode: Mode = "phlw",
@@ -263,35 +365,44 @@ def optimize_phlw(surf: BSplineSurface, reference: Any, *, mode: Mode = "phlw",
     data = make_samples(s0, u, v, mode)
     lay = make_layout(s0.n_ctrl, R * len(v), R, mode)
 
-    prob, x, fit = phlw_problem(s0, data, lay, w, (Vs, Fr), mode)
+    prob, x, fit = phlw_problem(s0, data, lay, w, (Vs, Fr), mode, scale=diag)
+    op_b = boundary_operator(s0, data)
     diagnostics: list[str] = []
     if len(fit.clamped):
-        diagnostics.append(f"initial fit: t_u^2 < 0 (b^2 - 4ac > 0) on rows {fit.clamped.tolist()}"
-                           "; restarted there from n_u = mean H (net angle pi/4)")
+        diagnostics.append(f"initial fit: rows {fit.clamped.tolist()} had t_u^2 < 0 (b^2 - 4ac > 0) "
+                           "or n_u outside [kappa_1, kappa_2]; started there from n_u inside "
+                           "the principal range")
 
     before = {"terms": prob.report(x), **_acceptance(surf, fit.n / diag, fit.t / diag, u, v,
                                                      mode, w["target"], diag)}
+    energy_initial = prob.energy(x)
     history: list[dict] = []
-    sol = None
     t0 = time.perf_counter()
     for rnd in range(int(outer)):
         if rnd > 0:
-            # re-project: auxiliaries exact from the control points, closest points refreshed
-            x = lay.pack({**lay.unpack(x), **init_auxiliary(lay.view(x, "C"), data)})
+            # a new problem: closest points refreshed at the accepted state (auxiliaries exact)
             S = np.asarray(data.ops["S"] @ lay.view(x, "C"))
             foot, nrm = closest_points_with_normals(S, Vs, Fr)
             prob.set_data("closeness", T.Linear("C", data.ops["S"], foot))
             prob.set_data("gliding", SampleGliding(data.ops["S"], foot, nrm))
-        sol = solve(prob, x, method="lm", max_iter=int(max_iter), damping=SOLVER_DAMPING,
-                    tol_rel=SOLVER_TOL_REL)
-        x = sol.x
-        history.append({"round": rnd + 1, "iterations": sol.iterations, "energy0": sol.energy0,
-                        "energy": sol.energy, "message": sol.message,
-                        "terms": {k: v_["energy"] for k, v_ in sol.report.items()},
+            if any(e.name == "boundary" for e in prob.entries):
+                prob.set_data("boundary", boundary_gliding(lay.view(x, "C"), op_b, (Vs, Fr)))
+        step = _round(prob, lay, data, x, int(max_iter))
+        history.append({"round": rnd + 1, **{k: v_ for k, v_ in step.items() if k != "x"},
                         "time": time.perf_counter() - t0})
         if progress is not None:
-            progress(f"round {rnd + 1}/{outer}: energy {sol.energy0:.3e} -> {sol.energy:.3e} "
-                     f"in {sol.iterations} iterations ({sol.message})")
+            progress(f"round {rnd + 1}/{outer}: energy {step['energy0']:.3e} -> "
+                     f"{step['energy']:.3e} in {step['iterations']} iterations "
+                     f"({step['message']})")
+        if not step["accepted"]:
+            break
+        x = step["x"]
+        if step["energy0"] - step["energy"] <= ROUND_TOL_REL * step["energy0"]:
+            break
+    energy_final = float(prob.energy(x))
+    if not np.isfinite(energy_final):
+        raise ConvergenceError(f"the {mode.upper()} optimization produced a non-finite energy; "
+                               "refit the reference with fewer control points or more smoothing")
 
     ctrl = lay.view(x, "C").reshape(s0.shape[0], s0.shape[1], 3) * diag + center
     out_surf = BSplineSurface(surf.degree_u, surf.degree_v, surf.knots_u.copy(),
@@ -310,18 +421,98 @@ def optimize_phlw(surf: BSplineSurface, reference: Any, *, mode: Mode = "phlw",
                                 (n_rows[:1] if mode == "cnc" else None),
                                 u_rows=u, u_samples=u, v_samples=v)
     diagnostics += check.messages
-    if np.all(check.umbilic | check.out_of_range):
-        raise NoNetError(
-            f"after the optimization the net has no real direction at any of the "
-            f"{check.umbilic.size} samples ({check.messages[0]}); the reference is too far from "
-            f"a {mode.upper()} surface: give the optimizer more rounds / iterations, a smaller "
-            "closeness or gliding weight, or another mode")
     dev = deviation_percent(out_surf, V, Fr, check_samples)
+    cov = coverage_percent(out_surf, V, Fr, check_samples)
+    figures = acceptance_figures(before, after, dev, check, energy_initial, energy_final, cov)
+    if not any(h["accepted"] for h in history):
+        raise ConvergenceError(
+            f"the {mode.upper()} optimization could not lower its energy from "
+            f"{energy_initial:.4g}: every round made the surface worse (true energy "
+            f"{history[0]['energy_true']:.4g} after round 1) and was rejected; try more control "
+            "points, a denser reference or another mode")
     return PHLWResult(surface=out_surf, mode=mode, u_rows=u, v_samples=v, n_rows=n_rows,
                       t_rows=t_rows, abc=abc, history=history, report_before=before,
-                      report_after=after, converged=bool(sol.converged), deviation=dev,
-                      diagnostics=diagnostics, net_check=check, weights=w,
-                      reference_diagonal=diag)
+                      report_after=after, converged=all(f["ok"] for f in figures.values()),
+                      deviation=dev, diagnostics=diagnostics, net_check=check, weights=w,
+                      reference_diagonal=diag, figures=figures,
+                      energy_initial=float(energy_initial), energy_final=energy_final)
+
+
+def _reprojected(lay: Layout, data: Samples, x: np.ndarray) -> np.ndarray:
+    """``x`` with every auxiliary variable exact on its control points (:func:`init_auxiliary`)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return lay.pack({**lay.unpack(x), **init_auxiliary(lay.view(x, "C"), data)})
+
+
+def _true_energy(prob: Problem, lay: Layout, data: Samples, x: np.ndarray
+                 ) -> tuple[float, np.ndarray]:
+    """Energy of ``prob`` at ``x`` re-projected (auxiliaries exact: what the surface itself
+    scores, not the solver's relaxed auxiliaries); ``inf`` where it is not finite."""
+    xr = _reprojected(lay, data, x)
+    if not np.all(np.isfinite(xr)):
+        return math.inf, xr
+    E = float(prob.energy(xr))
+    return (E if math.isfinite(E) else math.inf), xr
+
+
+def _round(prob: Problem, lay: Layout, data: Samples, x: np.ndarray, max_iter: int) -> dict:
+    """One outer round from the accepted state ``x`` (auxiliaries exact).
+
+    The solver's end point is judged by its *true* energy (auxiliaries re-projected from the
+    control points, same problem, same closest points): the solver minimizes with relaxed
+    auxiliaries, and its energy can fall while the surface's own rises (the 1e12 jumps of
+    issue 13). If the true energy did not fall, the step in ``C, n, t`` is halved up to
+    :data:`BACKTRACK` times; if none of these lowers it, the round is rejected and ``x`` kept.
+    """
+    E0, x = _true_energy(prob, lay, data, x)
+    sol = solve(prob, x, method="lm", max_iter=max_iter, damping=SOLVER_DAMPING,
+                tol_rel=SOLVER_TOL_REL)
+    E1, x1 = _true_energy(prob, lay, data, sol.x)
+    out = {"iterations": sol.iterations, "energy0": E0, "energy_solver": float(sol.energy),
+           "energy_true": E1, "step": 1.0, "message": sol.message}
+    alpha = 1.0
+    for _ in range(BACKTRACK):
+        if E1 < E0:
+            break
+        alpha *= 0.5
+        E1, x1 = _true_energy(prob, lay, data, x + alpha * (sol.x - x))
+    if E1 < E0:
+        out.update(energy=E1, step=alpha, accepted=True, x=x1)
+        if alpha < 1.0:
+            out["message"] += f"; step cut to {alpha:g} (the full step raised the true energy)"
+    else:
+        out.update(energy=E0, step=0.0, accepted=False, x=x,
+                   message=sol.message + f"; rejected (true energy {E0:.3e} -> {out['energy_true']:.3e})")
+    return out
+
+
+def acceptance_figures(before: dict, after: dict, deviation: float, check: NetCheck | None,
+                       energy_initial: float, energy_final: float,
+                       coverage: float = 0.0) -> dict[str, dict]:
+    """The figures that decide ``converged``: ``{name: {"value", "limit", "ok"}}``.
+
+    ``energy``: final / initial energy of the whole problem (< 1); ``E_PHLW``: after / before
+    (< 1, or already below :data:`E_PHLW_FLOOR`); ``relation``: max relative residual of eq. 4.8
+    at the samples; ``angle``: max principal angle error (degrees); ``deviation``: % of the
+    reference's diagonal; ``coverage``: max distance of the reference to the surface, same
+    units (a shrunk surface); ``net``: samples without a real net direction or umbilic (0).
+    """
+    def fig(value: float, limit: float, ok: bool | None = None) -> dict:
+        value = float(value)
+        return {"value": value, "limit": float(limit),
+                "ok": bool(math.isfinite(value) and (value < limit if ok is None else ok))}
+
+    e0, e1 = before["E_PHLW"]["total"], after["E_PHLW"]["total"]
+    bad = int(np.sum(check.umbilic | check.out_of_range)) if check is not None else 0
+    return {
+        "energy": fig(energy_final / energy_initial if energy_initial > 0 else 0.0, 1.0),
+        "E_PHLW": fig(e1 / e0 if e0 > 0 else 0.0, 1.0, e1 < e0 or e1 <= E_PHLW_FLOOR),
+        "relation": fig(after["relation_max_rel"], RELATION_TOL),
+        "angle": fig(after["angle_max_deg"], ANGLE_TOL_DEG),
+        "deviation": fig(deviation, DEVIATION_TOL),
+        "coverage": fig(coverage, DEVIATION_TOL),
+        "net": fig(bad, 0.5),
+    }
 
 
 # ============================================================================ output
@@ -343,6 +534,8 @@ def result_summary(res: PHLWResult) -> dict[str, Any]:
 
     return clean({
         "mode": res.mode, "converged": res.converged, "deviation_percent": res.deviation,
+        "figures": res.figures, "energy_initial": res.energy_initial,
+        "energy_final": res.energy_final,
         "reference_diagonal_m": res.reference_diagonal, "weights": res.weights,
         "samples": [len(res.u_rows), len(res.v_samples)],
         "control_points": list(res.surface.shape),

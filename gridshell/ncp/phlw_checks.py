@@ -101,6 +101,59 @@ def fit_rows(K: np.ndarray, H: np.ndarray, mode: Mode = "phlw", rtol: float = 1e
     return RowFit(n, np.sqrt(np.maximum(t2, 0.0)), clamped)
 
 
+def _inside_principal(k1: np.ndarray, k2: np.ndarray, prefer: float) -> float:
+    """The ``n`` nearest to ``prefer`` that lies in every ``[k1_s, k2_s]``, or, where these
+    intervals have no common point, the ``n`` minimizing ``sum dist(n, [k1_s, k2_s])^2``."""
+    lo, hi = float(np.max(k1)), float(np.min(k2))
+    if lo <= hi:
+        return float(np.clip(prefer, lo, hi))
+    # convex, piecewise quadratic: its minimum lies between the largest k2 and smallest k1
+    # below and above it; a few bisection-free Newton-like passes on the active set suffice
+    from scipy.optimize import minimize_scalar
+
+    cost = lambda n: float(np.sum(np.maximum(0.0, k1 - n) ** 2 + np.maximum(0.0, n - k2) ** 2))  # noqa: E731
+    return float(minimize_scalar(cost, bounds=(hi, lo), method="bounded",
+                                 options={"xatol": 1e-12 * max(abs(lo), abs(hi), 1e-300)}).x)
+
+
+def start_rows(K: np.ndarray, H: np.ndarray, mode: Mode = "phlw") -> RowFit:
+    """Row coefficients to start the optimization from: :func:`fit_rows`, with every ``n``
+    moved inside the principal range ``[kappa_1, kappa_2]`` of its samples.
+
+    A real net of normal curvature ``n`` exists at a sample exactly when
+    ``kappa_1 <= n <= kappa_2`` (eq. 4.10); a least-squares line of a row (or, in ``cnc``, one
+    slope for the whole surface) need not satisfy it (a hill whose curvatures are all
+    negative can get ``n > 0``). ``n`` is clipped to the common range of the row's samples
+    (``cnc``: of all samples), or, where these ranges have no common point, set to the value
+    nearest to all of them (least squares); then ``t^2 = mean (kappa_r^2 - (n - H)^2)`` per row
+    (eq. 4.8 with ``kappa_r = sqrt(H^2 - K)``), at least a ``1e-3`` of ``kappa_r^2``.
+    Signs follow the normal ``U``: a surface bending away from ``U`` everywhere gets ``n < 0``.
+
+    Returns
+    -------
+    RowFit : ``clamped`` lists the rows whose ``n`` was moved or whose ``t^2`` was negative.
+    """
+    fit = fit_rows(K, H, mode)
+    if mode == "aa":
+        return fit
+    K = np.atleast_2d(np.asarray(K, float))
+    H = np.atleast_2d(np.asarray(H, float))
+    r2 = np.maximum(H * H - K, 0.0)
+    k1, k2 = H - np.sqrt(r2), H + np.sqrt(r2)
+    n = fit.n.copy()
+    if mode == "cnc":
+        n[:] = _inside_principal(k1.ravel(), k2.ravel(), float(fit.n[0]))
+    else:
+        for i in range(len(n)):
+            n[i] = _inside_principal(k1[i], k2[i], float(fit.n[i]))
+    t2 = np.mean(r2 - (n[:, None] - H) ** 2, axis=1)
+    t2 = np.maximum(t2, 1e-3 * np.mean(r2, axis=1))
+    moved = np.flatnonzero(~np.isclose(n, fit.n, rtol=1e-9, atol=0.0))
+    clamped = np.union1d(fit.clamped, moved).astype(int)
+    t = np.where(np.isin(np.arange(len(n)), clamped), np.sqrt(t2), fit.t)
+    return RowFit(n, t, clamped)
+
+
 # ============================================================================ evaluation helpers
 
 def _grid_geometry(surf: BSplineSurface, u: np.ndarray, v: np.ndarray) -> dict[str, np.ndarray]:
@@ -291,23 +344,29 @@ def net_direction_check(surf: BSplineSurface, n_rows: np.ndarray | None,
 
 # ============================================================================ optimization
 
-def check_reference_net(K: np.ndarray, H: np.ndarray, mode: str) -> None:
+def check_reference_net(K: np.ndarray, H: np.ndarray, mode: str, scale: float = 1.0) -> None:
     """Raise :class:`NoNetError` if a surface with curvatures ``K, H`` at its samples (unit
     bounding-box diagonal) admits no net of ``mode`` anywhere: umbilic at every sample (no
     principal directions), or, in mode ``aa``, ``K > 0`` at every sample (no asymptotic
-    directions)."""
+    directions). ``scale`` (the diagonal in metres) converts the figures of the message to
+    1/m and 1/m^2."""
     K, H = np.asarray(K, float), np.asarray(H, float)
     d = np.sqrt(np.maximum(H * H - K, 0.0))
-    scale = np.maximum(np.abs(H) + d, FLAT_CURVATURE)
-    if np.all(2 * d <= NEAR_UMBILIC * scale):
+    curv = np.maximum(np.abs(H) + d, FLAT_CURVATURE)
+    if np.all(2 * d <= NEAR_UMBILIC * curv):
+        i = int(np.argmax(2 * d / curv))
         raise NoNetError(
-            f"the reference is umbilic at all {K.size} samples (kappa_I = kappa_II within "
-            f"{100 * NEAR_UMBILIC:g} %, as on a plane or a sphere): it has no principal "
-            "directions, so no PHLW / CNC / PK net can start from it; give a reference with "
-            "distinct principal curvatures (e.g. a saddle or a torus patch), or design a "
-            "geodesic gridshell (gridshell gg)")
+            f"the reference is umbilic at all {K.size} samples over the whole patch (u, v in "
+            f"[0, 1]): kappa_2 - kappa_1 is at most {100 * 2 * d.flat[i] / curv.flat[i]:.3g} % "
+            f"of |kappa| (limit {100 * NEAR_UMBILIC:g} %; e.g. {2 * d.flat[i] / scale:.4g} 1/m "
+            f"against {curv.flat[i] / scale:.4g} 1/m), as on a plane or a sphere: it has no "
+            "principal directions, so no PHLW / CNC / PK net can start from it; give a "
+            "reference with distinct principal curvatures (e.g. a saddle or a torus patch), or "
+            "design a geodesic gridshell (gridshell gg)")
     if mode == "aa" and np.all(K > 0):
         raise NoNetError(
-            f"the reference has K > 0 at all {K.size} samples (it bends like a dome), and "
-            "asymptotic directions exist only where K <= 0, so no AA net (n = 0) exists near "
-            "it; use mode 'phlw' or 'cnc', or a reference with K < 0 (e.g. a saddle)")
+            f"the reference has K > 0 at all {K.size} samples over the whole patch (u, v in "
+            f"[0, 1]; K from {K.min() / scale ** 2:.4g} to {K.max() / scale ** 2:.4g} 1/m^2): "
+            "it bends like a dome, and asymptotic directions exist only where K <= 0, so no "
+            "AA net (n = 0) exists near it; use mode 'phlw' or 'cnc', or a reference with "
+            "K < 0 (e.g. a saddle)")

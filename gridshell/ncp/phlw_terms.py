@@ -302,6 +302,22 @@ def sample_gliding(x: np.ndarray, layout: Layout, data: SampleGliding) -> TermRe
     return result(r, rr, cc, vv)
 
 
+@term
+def boundary_inward(x: np.ndarray, layout: Layout, data: SampleGliding) -> TermResult:
+    """``min(0, <S(u, v) - S_c^b, m^b>)`` with ``S = A C``: boundary samples may glide along the
+    reference's boundary or overhang it, never move inside (``m^b`` the outward in-surface
+    normal of the reference boundary at the closest point ``S_c^b``)."""
+    C = layout.view(x, "C")
+    S = np.asarray(data.A @ C)
+    N = np.asarray(data.normal, float)
+    d = np.einsum("ij,ij->i", S - data.foot, N)
+    inside = d < 0
+    k = len(d)
+    rr, cc, vv = _cjac(data.A, layout.indices("C"), (N * inside[:, None])[:, None, :],
+                       np.arange(k)[:, None])
+    return result(np.where(inside, d, 0.0), rr, cc, vv)
+
+
 # ============================================================================ initialization
 
 def init_auxiliary(ctrl: np.ndarray, data: Samples) -> dict[str, np.ndarray]:
@@ -313,3 +329,58 @@ def init_auxiliary(ctrl: np.ndarray, data: Samples) -> dict[str, np.ndarray]:
     out.update(init_second_form(D["Suu"], D["Suv"], D["Svv"], out["U"], out["w"]))
     out.update(init_curvature(out["E"], out["F"], out["G"], out["L"], out["M"], out["N"]))
     return out
+
+
+class Regularity(NamedTuple):
+    """Data of :func:`parametrization_guard`: floors of ``E, G, w`` per sample, ``(k,)`` each
+    (positive; typically a fraction of their values on the initial surface)."""
+
+    E: np.ndarray
+    G: np.ndarray
+    w: np.ndarray
+
+
+@term
+def parametrization_guard(x: np.ndarray, layout: Layout, data: Regularity) -> TermResult:
+    """Keeps the parametrization regular: ``max(0, 1 - X / X_min)`` for ``X = E, G, w``
+    (rows: E block, G block, w block; zero while every ``X >= X_min``).
+
+    The constraints 4.3-4.6 are multiplied out (``L w = <S_uu, U>``, ``K delta = LN - M^2``):
+    where ``E``, ``G`` or ``w = sqrt(delta)`` collapse they stop tying ``L, M, N, K, H`` to the
+    surface and ``F = M = 0`` holds trivially, and ``w`` may cross zero to the other root of
+    ``w^2 = delta`` (flipping ``L, M, N, H``). Measured on a freeform hill (cnc): ``G`` fell
+    from 0.27 to 1e-6 and ``w`` to -0.2 in one round, the true E_PHLW rose to 1e12.
+    """
+    k = len(data.E)
+    rs, parts = [], []
+    for b, name in enumerate(("E", "G", "w")):
+        X, lo = layout.view(x, name), np.asarray(getattr(data, name), float)
+        active = X < lo
+        rs.append(np.where(active, 1.0 - X / lo, 0.0))
+        parts.append((b * k + np.arange(k), layout.indices(name), np.where(active, -1.0 / lo, 0.0)))
+    return _assemble(np.concatenate(rs), parts)
+
+
+class UmbilicMargin(NamedTuple):
+    """Data of :func:`umbilic_guard`: the least ``H^2 - K = ((kappa_2 - kappa_1) / 2)^2`` per
+    sample, ``(k,)`` or a scalar (positive, in the units of the optimized geometry)."""
+
+    r2_min: np.ndarray | float
+
+
+@term
+def umbilic_guard(x: np.ndarray, layout: Layout, data: UmbilicMargin) -> TermResult:
+    """Keeps the surface away from umbilics: ``max(0, 1 - (H^2 - K) / r2_min)`` per sample.
+
+    ``H^2 - K`` is the squared half-gap of the principal curvatures; at an umbilic it is zero,
+    the principal directions are undefined and eq. 4.8 forces ``t_u = 0`` (a degenerate net).
+    Measured on a saddle (cnc, before this term and the round guards): the optimization drove
+    288 of 324 samples to umbilics.
+    """
+    K, H = layout.view(x, "K"), layout.view(x, "H")
+    lo = np.broadcast_to(np.asarray(data.r2_min, float), K.shape)
+    active = H * H - K < lo
+    ar = np.arange(len(K))
+    r = np.where(active, 1.0 - (H * H - K) / lo, 0.0)
+    return _assemble(r, [(ar, layout.indices("H"), np.where(active, -2 * H / lo, 0.0)),
+                         (ar, layout.indices("K"), np.where(active, 1.0 / lo, 0.0))])
