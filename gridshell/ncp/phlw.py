@@ -29,14 +29,24 @@ where ``n = 0``) and ``t (rows,)``.
 Energy (paper): ``E_PHLW + E_beta + E_c + E_g`` with ``E_PHLW = sum chi_i^2 + omega_t chi_t^2``
 (constraints 4.2-4.7 weight 1, target 4.8 weight ``omega_t = 0.1``), ``E_beta = omega_beta
 sum (n_u - H)^2`` (``omega_beta = 5e-4``), closeness ``E_c`` and gliding ``E_g`` to the
-reference surface with closest points refreshed every outer round.
+reference surface with closest points refreshed every outer round. Added here (issue 13):
+guards of the parametrization (``E, G, w`` may not collapse) and of umbilics (the half-gap of
+the principal curvatures stays above a margin), and a one-sided boundary term.
+
+Rounds: the solver works with relaxed auxiliary variables; each round is judged by the
+surface's *true* energy (auxiliaries re-projected from the control points, same problem) and
+halved or rejected if that rose (:func:`_round`). ``converged`` means the figures hold
+(:func:`acceptance_figures`), not that a solver tolerance was met.
+
+Module layout: the terms live in :mod:`.phlw_terms`, row fits and checks in
+:mod:`.phlw_checks`; their public names are re-exported here.
 """
 from __future__ import annotations
 
 import math
 import time
 from dataclasses import dataclass, field
-from typing import Any, Callable
+from typing import Any, Callable, NamedTuple
 
 import numpy as np
 
@@ -276,10 +286,36 @@ def phlw_problem(s0: BSplineSurface, data: Samples, lay: Layout, weights: dict[s
     prob.add("closeness", weights["closeness"], T.linear, T.Linear("C", data.ops["S"], foot))
     prob.add("gliding", weights["gliding"], sample_gliding,
              SampleGliding(data.ops["S"], foot, nrm))
-    if weights.get("boundary", 0.0) > 0 and len(boundary_segments(reference[1])):
+    bd = reference_boundary(*reference)
+    if weights.get("boundary", 0.0) > 0 and len(bd.A):
         prob.add("boundary", weights["boundary"], boundary_inward,
-                 boundary_gliding(s0.ctrl.reshape(-1, 3), boundary_operator(s0, data), reference))
+                 boundary_gliding(s0.ctrl.reshape(-1, 3), boundary_operator(s0, data), reference,
+                                  bd))
     return prob, x, fit
+
+
+def principal_range_notes(K: np.ndarray, H: np.ndarray, u: np.ndarray, mode: str,
+                          scale: float = 1.0) -> list[str]:
+    """Lines saying where the reference admits no net of ``mode`` as it is: ``cnc``, the
+    principal ranges ``[kappa_1, kappa_2]`` of all samples have no common ``n``; ``phlw``, those
+    of a row have none (``K, H (rows, cols)`` on unit-diagonal geometry, ``scale`` metres)."""
+    if mode == "aa":
+        return []
+    r = np.sqrt(np.maximum(H * H - K, 0.0))
+    k1, k2 = (H - r) / scale, (H + r) / scale
+    if mode == "cnc":
+        lo, hi = float(k1.max()), float(k2.min())
+        if lo <= hi:
+            return []
+        return [f"no single n lies in [kappa_1, kappa_2] at every sample of the reference: "
+                f"max kappa_1 = {lo:.4g} 1/m > min kappa_2 = {hi:.4g} 1/m; no CNC net exists on "
+                "it as it is, so the optimization has to move the surface (deviation)"]
+    bad = np.flatnonzero(k1.max(axis=1) > k2.min(axis=1))
+    if not len(bad):
+        return []
+    return [f"on {len(bad)} of {len(u)} rows (u in [{u[bad].min():.3f}, {u[bad].max():.3f}]) no "
+            "n_u lies in [kappa_1, kappa_2] at every sample of the row; no PHLW net exists "
+            "there as the reference is, so the optimization has to move the surface"]
 
 
 def umbilic_margin(K: np.ndarray, H: np.ndarray) -> float:
@@ -299,27 +335,41 @@ def boundary_operator(surf: BSplineSurface, data: Samples) -> Any:
     return surf.operator(ub, vb, 0, 0).tocoo()
 
 
-def boundary_gliding(ctrl: np.ndarray, op: Any, reference: tuple[np.ndarray, np.ndarray]
-                     ) -> SampleGliding:
+class ReferenceBoundary(NamedTuple):
+    """The boundary edges ``A (m, 3) -> B (m, 3)`` of a reference mesh and a point inside the
+    face of each, ``inner (m, 3)`` (:func:`reference_boundary`)."""
+
+    A: np.ndarray
+    B: np.ndarray
+    inner: np.ndarray
+
+
+def reference_boundary(V: np.ndarray, F: np.ndarray) -> ReferenceBoundary:
+    """:class:`ReferenceBoundary` of the mesh ``(V, F)`` (empty arrays for a closed mesh)."""
+    seg, face = boundary_segments(F, return_faces=True)
+    return ReferenceBoundary(V[seg[:, 0]], V[seg[:, 1]],
+                             V[np.asarray(F)[face]].mean(axis=1))
+
+
+def boundary_gliding(ctrl: np.ndarray, op: Any, reference: tuple[np.ndarray, np.ndarray],
+                     boundary: ReferenceBoundary | None = None) -> SampleGliding:
     """Data of the boundary term (:func:`~gridshell.ncp.phlw_terms.boundary_inward`): the
     surface's boundary samples ``op @ ctrl``, their closest points on the reference's
     boundary edges and the outward in-surface normal there (``T x n``, pointing away from
-    the edge's face). Without it the optimizer shrinks the surface away from the regions where
-    no net exists (a 12 x 8 m hill came back 7.7 x 5.3 m); closeness and gliding hold the
-    samples only where they are, and the patch of a principal parametrization is bounded by
-    principal lines, which a rectangle's edges are not (so the boundary may overhang)."""
+    the edge's face). Without it the optimizer may shrink the surface away from the regions
+    where no net exists (a 12 x 8 m hill came back 7.7 x 5.3 m); closeness and gliding hold
+    the samples only where they are, and the patch of a principal parametrization is bounded
+    by principal lines, which a rectangle's edges are not (so the boundary may overhang)."""
     from ..igl_adapter import closest_points_with_normals
 
     V, F = reference
-    seg, face = boundary_segments(F, return_faces=True)
-    A, B = V[seg[:, 0]], V[seg[:, 1]]
+    bd = reference_boundary(V, F) if boundary is None else boundary
     Sb = np.asarray(op @ ctrl)
-    foot, j = closest_on_segments(Sb, A, B)
+    foot, j = closest_on_segments(Sb, bd.A, bd.B)
     _, nrm = closest_points_with_normals(foot, V, F)
-    m = np.cross(B[j] - A[j], nrm)
+    m = np.cross(bd.B[j] - bd.A[j], nrm)
     m /= np.maximum(np.linalg.norm(m, axis=1), 1e-300)[:, None]
-    inner = V[np.asarray(F)[face[j]]].mean(axis=1) - foot
-    m *= np.where(np.einsum("ij,ij->i", m, inner) > 0, -1.0, 1.0)[:, None]
+    m *= np.where(np.einsum("ij,ij->i", m, bd.inner[j] - foot) > 0, -1.0, 1.0)[:, None]
     return SampleGliding(op, foot, m)
 
 
@@ -378,11 +428,14 @@ def optimize_phlw(surf: BSplineSurface, reference: Any, *, mode: Mode = "phlw",
 
     prob, x, fit = phlw_problem(s0, data, lay, w, (Vs, Fr), mode, scale=diag)
     op_b = boundary_operator(s0, data)
+    bd = reference_boundary(Vs, Fr)
     diagnostics: list[str] = []
     if len(fit.clamped):
         diagnostics.append(f"initial fit: rows {fit.clamped.tolist()} had t_u^2 < 0 (b^2 - 4ac > 0) "
                            "or n_u outside [kappa_1, kappa_2]; started there from n_u inside "
                            "the principal range")
+    diagnostics += principal_range_notes(lay.view(x, "K").reshape(R, -1),
+                                         lay.view(x, "H").reshape(R, -1), u, mode, diag)
 
     before = {"terms": prob.report(x), **_acceptance(surf, fit.n / diag, fit.t / diag, u, v,
                                                      mode, w["target"], diag)}
@@ -397,7 +450,8 @@ def optimize_phlw(surf: BSplineSurface, reference: Any, *, mode: Mode = "phlw",
             prob.set_data("closeness", T.Linear("C", data.ops["S"], foot))
             prob.set_data("gliding", SampleGliding(data.ops["S"], foot, nrm))
             if any(e.name == "boundary" for e in prob.entries):
-                prob.set_data("boundary", boundary_gliding(lay.view(x, "C"), op_b, (Vs, Fr)))
+                prob.set_data("boundary", boundary_gliding(lay.view(x, "C"), op_b, (Vs, Fr),
+                                                           bd))
         step = _round(prob, lay, data, x, int(max_iter))
         history.append({"round": rnd + 1, **{k: v_ for k, v_ in step.items() if k != "x"},
                         "time": time.perf_counter() - t0})

@@ -105,8 +105,9 @@ def boundary_segments(F: np.ndarray, return_faces: bool = False
     face only (faces ``(f, 3|4)``), and with ``return_faces`` the ``(m,)`` face of each."""
     F = np.asarray(F, np.int64)
     E = np.stack([F, np.roll(F, -1, axis=1)], -1).reshape(-1, 2)
-    key = np.sort(E, axis=1)
-    _, inv, cnt = np.unique(key, axis=0, return_inverse=True, return_counts=True)
+    n = int(E.max()) + 1 if E.size else 1
+    key = E.min(axis=1) * n + E.max(axis=1)          # one int64 per undirected edge
+    _, inv, cnt = np.unique(key, return_inverse=True, return_counts=True)
     keep = cnt[inv.reshape(-1)] == 1
     if return_faces:
         return E[keep], np.repeat(np.arange(len(F)), F.shape[1])[keep]
