@@ -197,3 +197,21 @@ def test_aa_on_a_dome_says_early_that_no_net_exists():
     assert "K > 0 at all 100 samples" in msg and "u, v in [0, 1]" in msg
     lo, hi = (float(v) for v in msg.split("K from ")[1].split(" 1/m^2")[0].split(" to "))
     assert K.min() * 0.95 < lo < hi < K.max() * 1.05
+
+
+def test_an_optimizer_that_only_makes_things_worse_raises_convergence_error(monkeypatch):
+    """Every round's end point scores worse than its start: nothing is accepted, the
+    reference's figures do not hold, so ConvergenceError (exit 4), not a silent result."""
+    from types import SimpleNamespace
+
+    from gridshell.errors import ConvergenceError
+
+    def worse(prob, x, **kw):
+        lay = prob.layout
+        bad = lay.pack({**lay.unpack(x), "C": lay.view(x, "C") * 1.5})
+        return SimpleNamespace(x=bad, iterations=1, energy=0.0, message="test")
+
+    monkeypatch.setattr(P, "solve", worse)
+    V, F = height_mesh(random_saddle(3), 16, 12, 16, 12)
+    with pytest.raises(ConvergenceError, match="every round made the surface worse"):
+        run(V, F, "cnc", samples=6, outer=2, max_iter=3)
