@@ -390,15 +390,26 @@ def optimize_phlw(surf: BSplineSurface, reference: Any, *, mode: Mode = "phlw",
         "aa" ``n = 0`` (PK surface, asymptotic net)
     samples : (rows, cols) optimization samples (paper: 18 x 18)
     weights : overrides of :data:`DEFAULT_WEIGHTS` (keys ``constraints``, ``target``, ``beta``,
-        ``closeness``, ``gliding``); in mode ``aa`` ``beta`` defaults to 0 (see the code)
-    outer : rounds of (refresh closest points, Levenberg-Marquardt solve)
+        ``closeness``, ``gliding``, ``boundary``, ``umbilic``); in mode ``aa`` ``beta``
+        defaults to 0 (see the code)
+    outer : at most this many rounds of (refresh closest points, Levenberg-Marquardt solve,
+        accept / halve / reject by the true energy); the loop ends early when a round is
+        rejected or lowers the energy by less than :data:`ROUND_TOL_REL`
     max_iter : solver iterations per round
     check_samples : sampling for the deviation figure
     progress : called with one line per round
 
     Returns
     -------
-    PHLWResult
+    PHLWResult : ``converged`` when every figure of :func:`acceptance_figures` holds
+
+    Raises
+    ------
+    InputError : bad arguments or a singular initial parametrization
+    NoNetError : no net of ``mode`` can exist near the reference (umbilic everywhere; ``aa``
+        with ``K > 0`` everywhere), before any optimization
+    ConvergenceError : no round could improve the surface and its figures fail, or the
+        energy became non-finite
     """
     from ..igl_adapter import closest_points_with_normals
 
