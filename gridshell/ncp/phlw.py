@@ -29,26 +29,43 @@ where ``n = 0``) and ``t (rows,)``.
 Energy (paper): ``E_PHLW + E_beta + E_c + E_g`` with ``E_PHLW = sum chi_i^2 + omega_t chi_t^2``
 (constraints 4.2-4.7 weight 1, target 4.8 weight ``omega_t = 0.1``), ``E_beta = omega_beta
 sum (n_u - H)^2`` (``omega_beta = 5e-4``), closeness ``E_c`` and gliding ``E_g`` to the
-reference surface with closest points refreshed every outer round.
+reference surface with closest points refreshed every outer round. Added here (issue 13):
+guards of the parametrization (``E, G, w`` may not collapse) and of umbilics (the half-gap of
+the principal curvatures stays above a margin), and a one-sided boundary term.
+
+Rounds: the solver works with relaxed auxiliary variables; each round is judged by the
+surface's *true* energy (auxiliaries re-projected from the control points, same problem) and
+halved or rejected if that rose (:func:`_round`). ``converged`` means the figures hold
+(:func:`acceptance_figures`), not that a solver tolerance was met.
+
+Module layout: the terms live in :mod:`.phlw_terms`, row fits and checks in
+:mod:`.phlw_checks`; their public names are re-exported here.
 """
 from __future__ import annotations
 
 import math
 import time
 from dataclasses import dataclass, field
-from typing import Any, Callable, Literal, NamedTuple
+from typing import Any, Callable, NamedTuple
 
 import numpy as np
-import scipy.sparse as sp
 
 from ..bspline import BSplineSurface, uniform_params
-from ..diffgeo import curvatures, fundamental_forms, principal_directions
-from ..errors import InputError, NoNetError
-from ..solver import Layout, Problem, TermResult, result, solve, term
+from ..errors import ConvergenceError, InputError
+from ..solver import Layout, Problem, solve
 from ..solver import terms as T
-
-Mode = Literal["phlw", "cnc", "aa"]
-MODES = ("phlw", "cnc", "aa")
+from .phlw_checks import (FLAT_CURVATURE, NEAR_UMBILIC, NetCheck, RowFit, _grid_geometry,
+                          _regions, check_reference_net, fit_rows, net_direction_check,
+                          phlw_energy, principal_angle_error, row_relation_residual,
+                          start_rows)
+from .phlw_terms import (MODES, Mode, Regularity, SampleGliding, Samples, UmbilicMargin,
+                         _check_mode, beta_fairness, boundary_inward, curvature_eq, delta_eq,
+                         first_form_eq, init_auxiliary, init_curvature, init_delta,
+                         init_first_form, init_normal, init_second_form, make_layout,
+                         make_samples, normal_eq, parametrization_guard, phlw_target,
+                         principal_eq, sample_gliding, second_form_eq, sqrt_delta_eq,
+                         umbilic_guard)
+from .reference import boundary_segments, closest_on_segments
 
 #: Default weights, on geometry scaled to a unit bounding-box diagonal. ``target`` and ``beta``
 #: are the paper's omega_t = 0.1 and omega_beta = 5e-4. The paper gives no omega_c, omega_g:
@@ -60,12 +77,20 @@ MODES = ("phlw", "cnc", "aa")
 #: trades constraint violation for target (the auxiliary K, H drift from the surface's true
 #: curvature: measured E_PHLW of the true surface 1e4x above the solver's). Weighting them
 #: 100 keeps the auxiliaries on the surface (re-projected exactly every outer round as well).
+#: ``boundary`` (one-sided: boundary samples may not move inside the reference's boundary) is
+#: a trade: a principal patch cannot both cover a rectangle whose edges are not principal
+#: lines and stay on it. Measured on a 10 x 10 m hyperbolic paraboloid (phlw): weight 0 trims
+#: the corners (coverage 4.5 %, deviation 0.08 %, 38 s), 0.1 overhangs (2.1 %, 1.2 %, 11 s),
+#: 0.01 between (0.6 %, 2.9 %, 18 s). ``umbilic`` weights :func:`umbilic_guard`, a hinge of
+#: size 1 per sample: 100 pulled a hill's umbilics away at the cost of E_PHLW rising.
 DEFAULT_WEIGHTS: dict[str, float] = {
     "constraints": 100.0,  # eqs. 4.2-4.7
     "target": 0.1,         # omega_t, eq. 4.8
     "beta": 5e-4,          # omega_beta
     "closeness": 1e-2,     # omega_c
     "gliding": 10.0,       # omega_g
+    "boundary": 0.01,      # boundary samples not inside the reference's boundary (not in the paper)
+    "umbilic": 1.0,        # half-gap of the principal curvatures >= a margin (not in the paper)
 }
 
 #: Levenberg-Marquardt settings of every round: initial damping (relative to the mean of
@@ -77,587 +102,35 @@ DEFAULT_WEIGHTS: dict[str, float] = {
 SOLVER_DAMPING = 1e-9
 SOLVER_TOL_REL = 1e-3
 
-#: The reference is (nearly) umbilic at a sample if ``|kappa_2 - kappa_1|`` is at most this
-#: fraction of ``max(|kappa_1|, |kappa_2|, FLAT_CURVATURE)`` (unit-diagonal units). A
-#: reference umbilic at every sample (a plane, a sphere patch: up to 2.7 % measured on a 5 x 5
-#: control-point fit of a sphere) has no principal directions to start the PHLW net from.
-NEAR_UMBILIC = 0.05
-#: Curvatures below this, on unit-diagonal geometry (radius above 1000 diagonals), are flat.
-FLAT_CURVATURE = 1e-3
-
-_OPS = {"S": (0, 0), "Su": (1, 0), "Sv": (0, 1), "Suu": (2, 0), "Suv": (1, 1), "Svv": (0, 2)}
-_SCALARS = ("E", "F", "G", "delta", "w", "L", "M", "N", "K", "H")
-
-
-# ============================================================================ samples and layout
-
-class Samples(NamedTuple):
-    """Data shared by the PHLW terms.
-
-    ops : derivative operators ``"S", "Su", "Sv", "Suu", "Suv", "Svv"`` -> COO ``(k, nc)``
-        acting on the control block ``C``
-    row : (k,) int, u-row of every sample
-    n_index : (k,) int index into block ``"n"`` per sample, or None (mode ``aa``: ``n = 0``)
-    """
-
-    ops: dict[str, sp.coo_matrix]
-    row: np.ndarray
-    n_index: np.ndarray | None
-
-
-
-def make_samples(surf: BSplineSurface, u: np.ndarray, v: np.ndarray,
-                 mode: Mode = "phlw") -> Samples:
-    """Operators of the tensor sample grid ``u (rows,) x v (cols,)`` (sample ``i * cols + j``)."""
-    _check_mode(mode)
-    uu, vv = np.meshgrid(np.asarray(u, float), np.asarray(v, float), indexing="ij")
-    uf, vf = uu.ravel(), vv.ravel()
-    ops = {k: surf.operator(uf, vf, du, dv).tocoo() for k, (du, dv) in _OPS.items()}
-    row = np.repeat(np.arange(len(u)), len(v))
-    n_index = {"phlw": row, "cnc": np.zeros_like(row), "aa": None}[mode]
-    return Samples(ops, row, n_index)
-
-
-def make_layout(n_ctrl: int, k: int, rows: int, mode: Mode = "phlw") -> Layout:
-    """The variable blocks of the PHLW problem (see the module docstring)."""
-    _check_mode(mode)
-    lay = Layout([("C", (n_ctrl, 3)), ("U", (k, 3))] + [(s, k) for s in _SCALARS])
-    if mode == "phlw":
-        lay.add("n", rows)
-    elif mode == "cnc":
-        lay.add("n", 1)
-    lay.add("t", rows)
-    return lay
-
-
-def _check_mode(mode: str) -> None:
-    if mode not in MODES:
-        raise InputError(f"unknown mode {mode!r}; use one of {', '.join(MODES)}")
-
-
-# ============================================================================ Jacobian helpers
-
-def _derivs(x: np.ndarray, layout: Layout, data: Samples, names: tuple[str, ...]
-            ) -> list[np.ndarray]:
-    C = layout.view(x, "C")
-    return [np.asarray(data.ops[nm] @ C) for nm in names]
-
-
-def _cjac(op: sp.coo_matrix, Cidx: np.ndarray, coef: np.ndarray,
-          rowmap: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Triplets of ``d r / d C`` where ``r[rowmap[s, m]]`` depends on ``X = op @ C`` through
-    ``coef[s, m, j] = d r[rowmap[s, m]] / d X[s, j]``; ``coef (k, m, 3)``, ``rowmap (k, m)``."""
-    s, p, a = op.row, op.col, op.data
-    m = coef.shape[1]
-    rows = np.broadcast_to(rowmap[s][:, :, None], (len(s), m, 3))
-    cols = np.broadcast_to(Cidx[p][:, None, :], (len(s), m, 3))
-    vals = a[:, None, None] * coef[s]
-    return rows.ravel(), cols.ravel(), vals.ravel()
-
-
-def _assemble(r: np.ndarray, parts: list[tuple[np.ndarray, np.ndarray, np.ndarray]]
-              ) -> TermResult:
-    rows = np.concatenate([np.asarray(p[0]).ravel() for p in parts])
-    cols = np.concatenate([np.asarray(p[1]).ravel() for p in parts])
-    vals = np.concatenate([np.broadcast_to(p[2], np.shape(p[0])).ravel() for p in parts])
-    return result(r, rows, cols, vals)
-
-
-def _skew(a: np.ndarray) -> np.ndarray:
-    """``[a]_x (k, 3, 3)`` with ``[a]_x b = a x b``."""
-    z = np.zeros(len(a))
-    return np.stack([np.stack([z, -a[:, 2], a[:, 1]], 1),
-                     np.stack([a[:, 2], z, -a[:, 0]], 1),
-                     np.stack([-a[:, 1], a[:, 0], z], 1)], 1)
-
-
-# ============================================================================ terms (eqs. 4.2-4.8)
-
-@term
-def normal_eq(x: np.ndarray, layout: Layout, data: Samples) -> TermResult:
-    """Eq. 4.2: ``U - S_u x S_v = 0`` per sample (3 rows each)."""
-    Su, Sv = _derivs(x, layout, data, ("Su", "Sv"))
-    U = layout.view(x, "U")
-    k = len(U)
-    r = (U - np.cross(Su, Sv)).ravel()
-    rowmap = np.arange(3 * k).reshape(k, 3)
-    Cidx = layout.indices("C")
-    parts = [(rowmap, layout.indices("U"), np.ones((k, 3))),
-             _cjac(data.ops["Su"], Cidx, _skew(Sv), rowmap),      # d(-Su x Sv)/dSu = [Sv]x
-             _cjac(data.ops["Sv"], Cidx, -_skew(Su), rowmap)]     # d(-Su x Sv)/dSv = -[Su]x
-    return _assemble(r, parts)
-
-
-def init_normal(Su: np.ndarray, Sv: np.ndarray) -> np.ndarray:
-    """Initial ``U = S_u x S_v`` (eq. 4.2)."""
-    return np.cross(Su, Sv)
-
-
-@term
-def first_form_eq(x: np.ndarray, layout: Layout, data: Samples) -> TermResult:
-    """Eq. 4.3: ``E - <S_u,S_u>``, ``F - <S_u,S_v>``, ``G - <S_v,S_v>`` (rows: E block, F, G)."""
-    Su, Sv = _derivs(x, layout, data, ("Su", "Sv"))
-    E, F, G = (layout.view(x, s) for s in "EFG")
-    k = len(E)
-    dot = lambda a, b: np.einsum("ij,ij->i", a, b)  # noqa: E731
-    r = np.concatenate([E - dot(Su, Su), F - dot(Su, Sv), G - dot(Sv, Sv)])
-    ar = np.arange(k)
-    Cidx = layout.indices("C")
-    parts = [(ar, layout.indices("E"), 1.0), (k + ar, layout.indices("F"), 1.0),
-             (2 * k + ar, layout.indices("G"), 1.0)]
-    # Su feeds rows E (-2 Su) and F (-Sv); Sv feeds rows F (-Su) and G (-2 Sv).
-    parts.append(_cjac(data.ops["Su"], Cidx, np.stack([-2 * Su, -Sv], 1),
-                       np.stack([ar, k + ar], 1)))
-    parts.append(_cjac(data.ops["Sv"], Cidx, np.stack([-Su, -2 * Sv], 1),
-                       np.stack([k + ar, 2 * k + ar], 1)))
-    return _assemble(r, parts)
-
-
-def init_first_form(Su: np.ndarray, Sv: np.ndarray) -> dict[str, np.ndarray]:
-    """Initial ``E, F, G`` (eq. 4.3)."""
-    return {"E": np.einsum("ij,ij->i", Su, Su), "F": np.einsum("ij,ij->i", Su, Sv),
-            "G": np.einsum("ij,ij->i", Sv, Sv)}
-
-
-@term
-def delta_eq(x: np.ndarray, layout: Layout, data: Any = None) -> TermResult:
-    """Eq. 4.4: ``delta - (E G - F^2) = 0``."""
-    E, F, G, d = (layout.view(x, s) for s in ("E", "F", "G", "delta"))
-    ar = np.arange(len(E))
-    r = d - (E * G - F * F)
-    return _assemble(r, [(ar, layout.indices("delta"), 1.0), (ar, layout.indices("E"), -G),
-                         (ar, layout.indices("G"), -E), (ar, layout.indices("F"), 2 * F)])
-
-
-@term
-def sqrt_delta_eq(x: np.ndarray, layout: Layout, data: Any = None) -> TermResult:
-    """Auxiliary ``w = sqrt(delta)`` of eq. 4.5: ``w^2 - delta = 0``."""
-    w, d = layout.view(x, "w"), layout.view(x, "delta")
-    ar = np.arange(len(w))
-    return _assemble(w * w - d, [(ar, layout.indices("w"), 2 * w),
-                                 (ar, layout.indices("delta"), -1.0)])
-
-
-def init_delta(E: np.ndarray, F: np.ndarray, G: np.ndarray) -> dict[str, np.ndarray]:
-    """Initial ``delta = EG - F^2`` (eq. 4.4) and ``w = sqrt(delta)``."""
-    d = E * G - F * F
-    return {"delta": d, "w": np.sqrt(np.maximum(d, 0.0))}
-
-
-@term
-def second_form_eq(x: np.ndarray, layout: Layout, data: Samples) -> TermResult:
-    """Eq. 4.5 times ``w = sqrt(delta)``: ``L w - <S_uu, U>``, ``M w - <S_uv, U>``,
-    ``N w - <S_vv, U>`` (rows: L block, M, N)."""
-    Suu, Suv, Svv = _derivs(x, layout, data, ("Suu", "Suv", "Svv"))
-    U, w = layout.view(x, "U"), layout.view(x, "w")
-    k = len(w)
-    ar = np.arange(k)
-    Cidx, Uidx, widx = layout.indices("C"), layout.indices("U"), layout.indices("w")
-    rs, parts = [], []
-    for b, (nm, D, op) in enumerate((("L", Suu, "Suu"), ("M", Suv, "Suv"), ("N", Svv, "Svv"))):
-        X = layout.view(x, nm)
-        rs.append(X * w - np.einsum("ij,ij->i", D, U))
-        rr = b * k + ar
-        parts += [(rr, layout.indices(nm), w), (rr, widx, X),
-                  (np.repeat(rr, 3).reshape(k, 3), Uidx, -D),
-                  _cjac(data.ops[op], Cidx, -U[:, None, :], rr[:, None])]
-    return _assemble(np.concatenate(rs), parts)
-
-
-def init_second_form(Suu: np.ndarray, Suv: np.ndarray, Svv: np.ndarray, U: np.ndarray,
-                     w: np.ndarray) -> dict[str, np.ndarray]:
-    """Initial ``L, M, N = <S_.., U> / sqrt(delta)`` (eq. 4.5)."""
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return {nm: np.einsum("ij,ij->i", D, U) / w
-                for nm, D in (("L", Suu), ("M", Suv), ("N", Svv))}
-
-
-@term
-def curvature_eq(x: np.ndarray, layout: Layout, data: Any = None) -> TermResult:
-    """Eq. 4.6 times ``delta``: ``K delta - (LN - M^2)``, ``2 H delta - (LG - 2MF + NE)``
-    (rows: K block, H block; ``+ NE``, see the module docstring)."""
-    v = {s: layout.view(x, s) for s in ("E", "F", "G", "delta", "L", "M", "N", "K", "H")}
-    i = {s: layout.indices(s) for s in v}
-    k = len(v["K"])
-    ar, ar2 = np.arange(k), k + np.arange(k)
-    E, F, G, d, L, M, N, K, H = (v[s] for s in ("E", "F", "G", "delta", "L", "M", "N", "K", "H"))
-    r = np.concatenate([K * d - (L * N - M * M), 2 * H * d - (L * G - 2 * M * F + N * E)])
-    parts = [(ar, i["K"], d), (ar, i["delta"], K), (ar, i["L"], -N), (ar, i["N"], -L),
-             (ar, i["M"], 2 * M),
-             (ar2, i["H"], 2 * d), (ar2, i["delta"], 2 * H), (ar2, i["L"], -G), (ar2, i["G"], -L),
-             (ar2, i["M"], 2 * F), (ar2, i["F"], 2 * M), (ar2, i["N"], -E), (ar2, i["E"], -N)]
-    return _assemble(r, parts)
-
-
-def init_curvature(E, F, G, L, M, N) -> dict[str, np.ndarray]:
-    """Initial ``K``, ``H`` (eq. 4.6, ``+ NE``)."""
-    K, H, _, _ = curvatures(E, F, G, L, M, N)
-    return {"K": K, "H": H}
-
-
-@term
-def principal_eq(x: np.ndarray, layout: Layout, data: Any = None) -> TermResult:
-    """Eq. 4.7: ``F = 0``, ``M = 0`` (principal parametrization; rows: F block, M block)."""
-    F, M = layout.view(x, "F"), layout.view(x, "M")
-    k = len(F)
-    ar = np.arange(2 * k)
-    return _assemble(np.concatenate([F, M]),
-                     [(ar, np.concatenate([layout.indices("F"), layout.indices("M")]), 1.0)])
-
-
-def _row_n(x: np.ndarray, layout: Layout, data: Samples) -> tuple[np.ndarray, np.ndarray | None]:
-    """``n`` per sample and its column (None in mode aa, where n = 0)."""
-    k = len(data.row)
-    if data.n_index is None:
-        return np.zeros(k), None
-    return layout.view(x, "n")[data.n_index], layout.indices("n")[data.n_index]
-
-
-@term
-def phlw_target(x: np.ndarray, layout: Layout, data: Samples) -> TermResult:
-    """Eq. 4.8: ``K - 2 n_u H + n_u^2 + t_u^2 = 0`` with ``(n_u, t_u)`` of the sample's u-row."""
-    K, H = layout.view(x, "K"), layout.view(x, "H")
-    t = layout.view(x, "t")[data.row]
-    n, ncol = _row_n(x, layout, data)
-    ar = np.arange(len(K))
-    r = K - 2 * n * H + n * n + t * t
-    parts = [(ar, layout.indices("K"), 1.0), (ar, layout.indices("H"), -2 * n),
-             (ar, layout.indices("t")[data.row], 2 * t)]
-    if ncol is not None:
-        parts.append((ar, ncol, 2 * n - 2 * H))
-    return _assemble(r, parts)
-
-
-@term
-def beta_fairness(x: np.ndarray, layout: Layout, data: Samples) -> TermResult:
-    """E_beta: ``n_u - H`` (the net angle beta is pi/4 where ``n_u = H``)."""
-    H = layout.view(x, "H")
-    n, ncol = _row_n(x, layout, data)
-    ar = np.arange(len(H))
-    parts = [(ar, layout.indices("H"), -1.0)]
-    if ncol is not None:
-        parts.append((ar, ncol, 1.0))
-    return _assemble(n - H, parts)
-
-
-class SampleGliding(NamedTuple):
-    """Data of :func:`sample_gliding`: B-spline samples ``A @ C`` glide on the tangent planes
-    ``(foot (k,3), normal (k,3))`` of the reference."""
-
-    A: sp.coo_matrix
-    foot: np.ndarray
-    normal: np.ndarray
-
-
-@term
-def sample_gliding(x: np.ndarray, layout: Layout, data: SampleGliding) -> TermResult:
-    """E_g: ``<S(u, v) - S_c^r, n_c^r>`` with ``S = A C`` (metres)."""
-    C = layout.view(x, "C")
-    S = np.asarray(data.A @ C)
-    N = np.asarray(data.normal, float)
-    r = np.einsum("ij,ij->i", S - data.foot, N)
-    k = len(r)
-    rr, cc, vv = _cjac(data.A, layout.indices("C"), N[:, None, :], np.arange(k)[:, None])
-    return result(r, rr, cc, vv)
-
-
-# ============================================================================ initialization
-
-def init_auxiliary(ctrl: np.ndarray, data: Samples) -> dict[str, np.ndarray]:
-    """Every per-sample auxiliary variable computed exactly from control points ``(nc, 3)``."""
-    D = {k: np.asarray(op @ ctrl) for k, op in data.ops.items()}
-    out: dict[str, np.ndarray] = {"U": init_normal(D["Su"], D["Sv"])}
-    out.update(init_first_form(D["Su"], D["Sv"]))
-    out.update(init_delta(out["E"], out["F"], out["G"]))
-    out.update(init_second_form(D["Suu"], D["Suv"], D["Svv"], out["U"], out["w"]))
-    out.update(init_curvature(out["E"], out["F"], out["G"], out["L"], out["M"], out["N"]))
-    return out
-
-
-class RowFit(NamedTuple):
-    """Per-row coefficients of eq. 4.8 from linear fitting, and rows whose ``t^2 < 0``."""
-
-    n: np.ndarray
-    t: np.ndarray
-    clamped: np.ndarray
-
-
-def fit_rows(K: np.ndarray, H: np.ndarray, mode: Mode = "phlw", rtol: float = 1e-4) -> RowFit:
-    """Least-squares fit of ``K = 2 n H - (n^2 + t^2)`` per u-row (rows of ``K, H (rows, cols)``).
-
-    ``phlw``: a line ``K = alpha H + beta`` per row, ``n = alpha / 2``, ``t^2 = -beta - n^2``;
-    a row whose ``H`` hardly varies (e.g. a parallel of a surface of revolution) has no
-    defined slope and gets ``n = mean H`` (the net angle pi/4, as E_beta prefers).
-    ``cnc``: one slope for all rows, one intercept per row. ``aa``: ``n = 0``,
-    ``t^2 = -mean K``. Rows where the fitted line has ``t^2 < 0`` (``b^2 - 4ac > 0``: a
-    secant of the parabola ``K = H^2``, no net) are listed in ``clamped``; in ``phlw`` mode
-    they restart from ``n = mean H`` (net angle pi/4) with ``t^2 = (mean H)^2 - mean K``,
-    elsewhere ``t = 0``.
-
-    Returns
-    -------
-    RowFit : ``n (rows,)`` (all equal in cnc, zero in aa), ``t (rows,) >= 0``, ``clamped``
-        indices of rows whose ``t^2`` was negative.
-    """
-    _check_mode(mode)
-    K = np.atleast_2d(np.asarray(K, float))
-    H = np.atleast_2d(np.asarray(H, float))
-    if K.shape != H.shape:
-        raise InputError(f"K and H must have the same (rows, cols) shape, got {K.shape} and "
-                         f"{H.shape}")
-    if not (np.all(np.isfinite(K)) and np.all(np.isfinite(H))):
-        raise InputError("curvatures are not finite at some samples (singular "
-                         "parametrization); check the initial surface")
-    R, m = K.shape
-    scale = max(float(np.max(np.abs(H))), math.sqrt(float(np.max(np.abs(K)))), 1e-300)
-    if mode == "aa":
-        n = np.zeros(R)
-        beta = K.mean(axis=1)
-    elif mode == "phlw":
-        n, beta = np.empty(R), np.empty(R)
-        for i in range(R):
-            h, kk = H[i], K[i]
-            if np.std(h) <= rtol * scale:
-                n[i] = h.mean()
-                beta[i] = np.mean(kk - 2 * n[i] * h)
-            else:
-                alpha, beta[i] = np.polyfit(h, kk, 1)
-                n[i] = alpha / 2
-    else:  # cnc: K_ij = 2 n H_ij + beta_i
-        A = sp.hstack([sp.csr_matrix(2 * H.reshape(-1, 1)),
-                       sp.kron(sp.identity(R), np.ones((m, 1)))]).toarray()
-        Hc = H - H.mean(axis=1, keepdims=True)
-        if np.linalg.norm(Hc) <= rtol * scale * math.sqrt(H.size):
-            n0 = float(H.mean())
-            n = np.full(R, n0)
-            beta = (K - 2 * n0 * H).mean(axis=1)
-        else:
-            sol = np.linalg.lstsq(A, K.ravel(), rcond=None)[0]
-            n, beta = np.full(R, sol[0]), sol[1:]
-    t2 = -beta - n * n
-    clamped = np.flatnonzero(t2 < 0)
-    if mode == "phlw":
-        # t = 0 would start from a degenerate net (beta = 0); start at beta = pi/4 instead:
-        # n = mean H and the best intercept for it, t^2 = (mean H)^2 - mean K
-        for i in clamped:
-            n[i] = H[i].mean()
-            t2[i] = n[i] ** 2 - K[i].mean()
-    elif mode == "cnc" and len(clamped):
-        n[:] = H.mean()
-        t2 = (2 * n[:, None] * H - K).mean(axis=1) - n * n
-    return RowFit(n, np.sqrt(np.maximum(t2, 0.0)), clamped)
-
-
-# ============================================================================ evaluation helpers
-
-def _grid_geometry(surf: BSplineSurface, u: np.ndarray, v: np.ndarray) -> dict[str, np.ndarray]:
-    """Fundamental forms and curvatures on the grid ``u x v``, each ``(rows, cols)``."""
-    D = surf.derivatives_grid(u, v)
-    R, Cn = len(u), len(v)
-    flat = {k: a.reshape(-1, 3) for k, a in D.items()}
-    ff = fundamental_forms(flat["Su"], flat["Sv"], flat["Suu"], flat["Suv"], flat["Svv"])
-    K, H, k1, k2 = curvatures(ff["E"], ff["F"], ff["G"], ff["L"], ff["M"], ff["N"])
-    _, _, d1, _ = principal_directions(flat["Su"], flat["Sv"], ff["E"], ff["F"], ff["G"],
-                                       ff["L"], ff["M"], ff["N"])
-    with np.errstate(divide="ignore", invalid="ignore"):
-        kI, kII = ff["L"] / ff["E"], ff["N"] / ff["G"]
-        cos1 = np.abs(np.einsum("ij,ij->i", flat["Su"], d1)) / np.sqrt(ff["E"])
-    ang = np.degrees(np.arccos(np.clip(cos1, 0.0, 1.0)))
-    ang = np.minimum(ang, 90.0 - ang)           # S_u may follow either principal direction
-    with np.errstate(divide="ignore", invalid="ignore"):
-        ortho = np.degrees(np.abs(np.arcsin(np.clip(ff["F"] / np.sqrt(ff["E"] * ff["G"]),
-                                                    -1, 1))))
-    out = {"S": D["S"], "K": K, "H": H, "k1": k1, "k2": k2, "kI": kI, "kII": kII,
-           "E": ff["E"], "F": ff["F"], "G": ff["G"], "M": ff["M"],
-           "angle": np.maximum(ang, ortho)}
-    return {k: (a.reshape(R, Cn) if k != "S" else a) for k, a in out.items()}
-
-
-def row_relation_residual(surf: BSplineSurface, u_samples: np.ndarray, v_samples: np.ndarray,
-                          n_rows: np.ndarray | None = None, t_rows: np.ndarray | None = None,
-                          mode: Mode = "phlw") -> np.ndarray:
-    """Relative residual of eq. 4.8 on the grid ``u_samples x v_samples``: ``(rows, cols)``.
-
-    ``|K - 2 n H + n^2 + t^2| / max(|K|, |2 n H|, n^2 + t^2)``, i.e. the violation relative to
-    the largest term of the relation (for ``n = 0`` this is ``|K - K_row| / |K|``). Without
-    ``n_rows``/``t_rows`` they are fitted per row (:func:`fit_rows` with ``mode``), as paper
-    4.2.2 does on a sampling other than the optimization's.
-    """
-    u = np.atleast_1d(np.asarray(u_samples, float))
-    v = np.atleast_1d(np.asarray(v_samples, float))
-    g = _grid_geometry(surf, u, v)
-    K, H = g["K"], g["H"]
-    if n_rows is None or t_rows is None:
-        fit = fit_rows(K, H, mode)
-        n_rows = fit.n if n_rows is None else n_rows
-        t_rows = fit.t if t_rows is None else t_rows
-    n = np.broadcast_to(np.asarray(n_rows, float).reshape(-1), (len(u),))[:, None]
-    t = np.broadcast_to(np.asarray(t_rows, float).reshape(-1), (len(u),))[:, None]
-    num = np.abs(K - 2 * n * H + n * n + t * t)
-    den = np.maximum.reduce([np.abs(K), np.abs(2 * n * H), np.broadcast_to(n * n + t * t, K.shape)])
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return num / np.maximum(den, 1e-300)
-
-
-def principal_angle_error(surf: BSplineSurface, u_samples: np.ndarray,
-                          v_samples: np.ndarray) -> np.ndarray:
-    """Degrees by which the parameter lines miss the principal directions, ``(rows, cols)``:
-    the larger of the angle between ``S_u`` and its nearest principal direction and the
-    deviation of the angle between ``S_u`` and ``S_v`` from 90 degrees."""
-    return _grid_geometry(surf, np.atleast_1d(u_samples), np.atleast_1d(v_samples))["angle"]
-
-
-def phlw_energy(surf: BSplineSurface, n_rows: np.ndarray | None, t_rows: np.ndarray,
-                samples: tuple[int, int] = (18, 18), *, omega_t: float = 0.1,
-                scale: float | None = None) -> dict[str, float]:
-    """E_PHLW (paper 4.2.1) of a surface with its auxiliary variables exact.
-
-    With every auxiliary variable computed from the surface the residuals of eqs. 4.2-4.6
-    vanish and ``E_PHLW = sum (F^2 + M^2) + omega_t sum chi_t^2`` over the samples. Evaluated
-    on geometry scaled by ``1 / scale`` (default: the bounding-box diagonal of the samples)
-    so that it is dimensionless.
-
-    Returns
-    -------
-    dict : ``total``, ``principal`` (the ``F, M`` part), ``target`` (``omega_t * sum chi_t^2``),
-        ``target_rms`` (RMS of ``chi_t`` in 1/m^2 of the scaled geometry).
-    """
-    u, v = uniform_params(surf, samples)
-    g = _grid_geometry(surf, u, v)
-    if scale is None:
-        S = g["S"].reshape(-1, 3)
-        scale = float(np.linalg.norm(S.max(0) - S.min(0))) or 1.0
-    n = np.zeros(len(u)) if n_rows is None else \
-        np.broadcast_to(np.asarray(n_rows, float).reshape(-1), (len(u),))
-    t = np.asarray(t_rows, float).reshape(-1)
-    # scale lengths by 1/scale: E, F, G by 1/scale^2 (param speeds), M by 1/scale, K by scale^2
-    F = g["F"] / scale ** 2
-    M = g["M"] / scale
-    chi = (g["K"] - 2 * n[:, None] * g["H"] + (n * n + t * t)[:, None]) * scale ** 2
-    Ep = float(np.sum(F * F) + np.sum(M * M))
-    Et = float(omega_t * np.sum(chi * chi))
-    return {"total": Ep + Et, "principal": Ep, "target": Et,
-            "target_rms": float(np.sqrt(np.mean(chi * chi)))}
-
-
-# ============================================================================ diagnostics
-
-def _regions(mask: np.ndarray, u: np.ndarray, v: np.ndarray) -> list[dict[str, Any]]:
-    """Connected regions of a boolean sample grid as parameter boxes."""
-    from scipy import ndimage
-
-    lab, nlab = ndimage.label(mask)
-    out = []
-    for sl in ndimage.find_objects(lab):
-        su, sv = sl
-        cnt = int(np.sum(lab[sl] > 0))
-        out.append({"u": (float(u[su.start]), float(u[su.stop - 1])),
-                    "v": (float(v[sv.start]), float(v[sv.stop - 1])), "samples": cnt})
-    return out
-
-
-@dataclass
-class NetCheck:
-    """Outcome of :func:`net_direction_check` on a ``rows x cols`` grid.
-
-    sin2beta : (rows, cols) ``(n - kappa_I) / (kappa_II - kappa_I)`` (eq. 4.10), NaN at umbilics
-    umbilic, out_of_range : (rows, cols) bool
-    regions : list of ``{"kind": "umbilic" | "no-net", "u": (u0, u1), "v": (v0, v1), "samples"}``
-    messages : one human-readable line per region
-    """
-
-    u: np.ndarray
-    v: np.ndarray
-    sin2beta: np.ndarray
-    umbilic: np.ndarray
-    out_of_range: np.ndarray
-    regions: list[dict[str, Any]] = field(default_factory=list)
-    messages: list[str] = field(default_factory=list)
-
-    @property
-    def ok(self) -> bool:
-        return not self.regions
-
-
-def net_direction_check(surf: BSplineSurface, n_rows: np.ndarray | None,
-                        u_rows: np.ndarray | None = None, *,
-                        samples: tuple[int, int] | None = None,
-                        u_samples: np.ndarray | None = None, v_samples: np.ndarray | None = None,
-                        umbilic_tol: float = 1e-3) -> NetCheck:
-    """Where the net of normal curvature ``n_u`` has a real direction (eq. 4.10).
-
-    ``sin^2 beta = (n_u - kappa_I) / (kappa_II - kappa_I)`` with ``kappa_I = L / E``,
-    ``kappa_II = N / G`` (normal curvatures along ``S_u``, ``S_v``: the principal ones on a
-    principal parametrization). Umbilics (``|kappa_II - kappa_I| <= umbilic_tol *`` the
-    surface's curvature scale) leave ``beta`` undefined; ``sin^2 beta`` outside ``[0, 1]``
-    (``n_u`` outside ``[kappa_I, kappa_II]``) means no real net direction.
-
-    Parameters
-    ----------
-    surf : the (optimized) surface
-    n_rows : (len(u_rows),) ``n_u`` per row, a single value (cnc) or None (aa: ``n = 0``)
-    u_rows : (len(n_rows),) u values of ``n_rows``; default: the uniform sampling of
-        ``len(n_rows)`` rows. ``n_u`` is interpolated linearly onto the check rows.
-    samples : (rows, cols) check grid (default: ``len(n_rows) x len(n_rows)``), or explicit
-        ``u_samples`` / ``v_samples``.
-    """
-    if u_samples is None or v_samples is None:
-        if samples is None:
-            m = 18 if n_rows is None or np.size(n_rows) == 1 else int(np.size(n_rows))
-            samples = (m, m)
-        u_samples, v_samples = uniform_params(surf, samples)
-    u = np.asarray(u_samples, float)
-    v = np.asarray(v_samples, float)
-    if n_rows is None:
-        n = np.zeros(len(u))
-    elif np.size(n_rows) == 1:
-        n = np.full(len(u), float(np.ravel(n_rows)[0]))
-    else:
-        nr = np.asarray(n_rows, float).ravel()
-        ur = uniform_params(surf, (len(nr), 2))[0] if u_rows is None else np.asarray(u_rows, float)
-        n = np.interp(u, ur, nr)
-    g = _grid_geometry(surf, u, v)
-    kI, kII = g["kI"], g["kII"]
-    scale = float(np.nanmax(np.maximum(np.abs(kI), np.abs(kII))))
-    gap = kII - kI
-    umb = ~(np.abs(gap) > umbilic_tol * max(scale, 1e-300))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        s2 = np.where(umb, np.nan, (n[:, None] - kI) / gap)
-    bad = ~umb & ~((s2 >= 0) & (s2 <= 1))
-    regions, msgs = [], []
-    for kind, mask, what in (("umbilic", umb, "umbilic (kappa_I = kappa_II: net angle undefined)"),
-                             ("no-net", bad, "n_u outside [kappa_I, kappa_II]: no real net "
-                                             "direction (eq. 4.10)")):
-        for reg in _regions(mask, u, v):
-            reg = {"kind": kind, **reg}
-            regions.append(reg)
-            msgs.append(f"{what} at u in [{reg['u'][0]:.3f}, {reg['u'][1]:.3f}], v in "
-                        f"[{reg['v'][0]:.3f}, {reg['v'][1]:.3f}] ({reg['samples']} samples)")
-    return NetCheck(u, v, s2, umb, bad, regions, msgs)
-
-
-# ============================================================================ optimization
-
-def check_reference_net(K: np.ndarray, H: np.ndarray, mode: str) -> None:
-    """Raise :class:`NoNetError` if a surface with curvatures ``K, H`` at its samples (unit
-    bounding-box diagonal) admits no net of ``mode`` anywhere: umbilic at every sample (no
-    principal directions), or, in mode ``aa``, ``K > 0`` at every sample (no asymptotic
-    directions)."""
-    K, H = np.asarray(K, float), np.asarray(H, float)
-    d = np.sqrt(np.maximum(H * H - K, 0.0))
-    scale = np.maximum(np.abs(H) + d, FLAT_CURVATURE)
-    if np.all(2 * d <= NEAR_UMBILIC * scale):
-        raise NoNetError(
-            f"the reference is umbilic at all {K.size} samples (kappa_I = kappa_II within "
-            f"{100 * NEAR_UMBILIC:g} %, as on a plane or a sphere): it has no principal "
-            "directions, so no PHLW / CNC / PK net can start from it; give a reference with "
-            "distinct principal curvatures (e.g. a saddle or a torus patch), or design a "
-            "geodesic gridshell (gridshell gg)")
-    if mode == "aa" and np.all(K > 0):
-        raise NoNetError(
-            f"the reference has K > 0 at all {K.size} samples (it bends like a dome), and "
-            "asymptotic directions exist only where K <= 0, so no AA net (n = 0) exists near "
-            "it; use mode 'phlw' or 'cnc', or a reference with K < 0 (e.g. a saddle)")
+#: Floor of ``E``, ``G`` and ``w = sqrt(delta)`` per sample, as a fraction of their values on
+#: the initial surface (:func:`~gridshell.ncp.phlw_terms.parametrization_guard`): the
+#: parameter speeds may halve, the area element fall to a quarter, never collapse.
+REGULAR_FLOOR = 0.25
+
+#: The optimized surface keeps ``(kappa_2 - kappa_1) / 2 >= UMBILIC_MARGIN *`` the reference's
+#: curvature scale (RMS over the samples of ``max |kappa_i|``) at every sample
+#: (:func:`~gridshell.ncp.phlw_terms.umbilic_guard`).
+UMBILIC_MARGIN = 0.05
+
+#: An outer round that lowers the true energy by less than this fraction ends the loop
+#: (stagnation); a solver step that raises it is halved up to BACKTRACK times, then rejected.
+ROUND_TOL_REL = 1e-3
+BACKTRACK = 6
+
+#: Acceptance (``converged``): max relative residual of eq. 4.8 at the samples, max angle of
+#: the parameter lines to the principal directions (degrees), max deviation from the reference
+#: (% of its bounding-box diagonal). E_PHLW at or below E_PHLW_FLOOR (unit-diagonal units)
+#: counts as held even when it did not fall: a reference that already is PHLW (a torus zone in
+#: cnc starts at 1.9e-7 and ends at 1.4e-6 with relation 1.6e-4, while the total energy fell).
+RELATION_TOL = 1e-2
+ANGLE_TOL_DEG = 1.0
+DEVIATION_TOL = 5.0
+#: Acceptance: max distance of the reference to the surface (% of its diagonal). Looser than
+#: DEVIATION_TOL: a principal patch is bounded by principal lines and trims the corners of a
+#: reference whose edges are not principal lines; a shrunk surface (a 12 x 8 m hill returned
+#: 7.7 x 5.3 m: 15 %) fails.
+COVERAGE_TOL = 10.0
+E_PHLW_FLOOR = 1e-4
 
 
 @dataclass
@@ -673,7 +146,12 @@ class PHLWResult:
         "terms", "time"}``
     report_before, report_after : per term ``{"weight", "energy", "rms", "max"}`` (scaled units),
         plus ``"E_PHLW"`` (:func:`phlw_energy`) and the acceptance figures
-    converged : the last round's solve met a tolerance
+    converged : every acceptance figure holds (:func:`acceptance_figures`): the energy and
+        E_PHLW fell, relation, principal angle and deviation within their tolerances and a
+        real net direction at every sample
+    figures : :func:`acceptance_figures`
+    energy_initial, energy_final : energy of the whole problem (auxiliaries exact) at the start
+        and at the end, on unit-diagonal geometry
     deviation : max distance of the surface (check sampling) to the reference, % of the
         reference's bounding-box diagonal
     diagnostics : human-readable lines (clamped rows, umbilic / no-net regions)
@@ -696,6 +174,9 @@ class PHLWResult:
     net_check: NetCheck | None = None
     weights: dict = field(default_factory=dict)
     reference_diagonal: float = float("nan")
+    figures: dict = field(default_factory=dict)
+    energy_initial: float = float("nan")
+    energy_final: float = float("nan")
 
 
 def _scaled_surface(surf: BSplineSurface, center: np.ndarray, scale: float) -> BSplineSurface:
@@ -731,6 +212,19 @@ def deviation_percent(surf: BSplineSurface, V: np.ndarray, F: np.ndarray,
     return float(100.0 * np.sqrt(d2.max()) / diag)
 
 
+def coverage_percent(surf: BSplineSurface, V: np.ndarray, F: np.ndarray,
+                     samples: tuple[int, int] = (60, 60)) -> float:
+    """Max distance of the mesh ``(V, F)``'s vertices to the surface (sampled ``samples`` and
+    triangulated), in % of the mesh's bounding-box diagonal: how much of the reference the
+    surface fails to cover (a shrunk surface scores high, :func:`deviation_percent` not)."""
+    from ..igl_adapter import closest_points
+
+    m = surf.sample(*samples)
+    d2, _, _ = closest_points(np.asarray(V, float), m.V, m.F)
+    diag = float(np.linalg.norm(V.max(0) - V.min(0)))
+    return float(100.0 * np.sqrt(d2.max()) / diag)
+
+
 def _acceptance(surf: BSplineSurface, n: np.ndarray, t: np.ndarray, u: np.ndarray, v: np.ndarray,
                 mode: str, omega_t: float, diag: float) -> dict[str, float]:
     rel = row_relation_residual(surf, u, v, n, t)
@@ -740,13 +234,16 @@ def _acceptance(surf: BSplineSurface, n: np.ndarray, t: np.ndarray, u: np.ndarra
 
 
 def phlw_problem(s0: BSplineSurface, data: Samples, lay: Layout, weights: dict[str, float],
-                 reference: tuple[np.ndarray, np.ndarray], mode: Mode = "phlw"
-                 ) -> tuple[Problem, np.ndarray, RowFit]:
-    """The PHLW problem of one round (eqs. 4.2-4.8, E_beta, closeness, gliding) and its start.
+                 reference: tuple[np.ndarray, np.ndarray], mode: Mode = "phlw",
+                 scale: float = 1.0) -> tuple[Problem, np.ndarray, RowFit]:
+    """The PHLW problem of one round (eqs. 4.2-4.8, E_beta, closeness, gliding, boundary, the
+    parametrization and umbilic guards) and its start.
 
-    ``s0`` and ``reference = (V, F)`` are in unit-diagonal coordinates; ``weights`` are all
-    of :data:`DEFAULT_WEIGHTS`. The auxiliary variables start exact on ``s0`` and the row
-    coefficients from :func:`fit_rows`; closest points on the reference are computed here.
+    ``s0`` and ``reference = (V, F)`` are in unit-diagonal coordinates (``scale``: the
+    diagonal in metres, for messages); ``weights`` are all of :data:`DEFAULT_WEIGHTS`. The
+    auxiliary variables start exact on ``s0`` and the row coefficients from
+    :func:`start_rows` (``n`` inside the principal range); closest points on the reference
+    are computed here.
     Raises :class:`InputError` for a singular parametrization and :class:`NoNetError` where
     no net of ``mode`` exists (:func:`check_reference_net`).
 
@@ -761,8 +258,8 @@ def phlw_problem(s0: BSplineSurface, data: Samples, lay: Layout, weights: dict[s
     if not np.all(aux["delta"] > 0):
         raise InputError("the initial surface has a singular parametrization (S_u x S_v = 0) at "
                          f"{int(np.sum(~(aux['delta'] > 0)))} samples; refit the reference")
-    check_reference_net(aux["K"], aux["H"], mode)
-    fit = fit_rows(aux["K"].reshape(R, -1), aux["H"].reshape(R, -1), mode)
+    check_reference_net(aux["K"], aux["H"], mode, scale=scale)
+    fit = start_rows(aux["K"].reshape(R, -1), aux["H"].reshape(R, -1), mode)
     vals = {"C": s0.ctrl.reshape(-1, 3), **aux, "t": fit.t}
     if mode == "phlw":
         vals["n"] = fit.n
@@ -781,12 +278,100 @@ def phlw_problem(s0: BSplineSurface, data: Samples, lay: Layout, weights: dict[s
     prob.add("second form (4.5)", c, second_form_eq, data)
     prob.add("curvature (4.6)", c, curvature_eq)
     prob.add("principal (4.7)", c, principal_eq)
+    prob.add("regularity", c, parametrization_guard,
+             Regularity(REGULAR_FLOOR * aux["E"], REGULAR_FLOOR * aux["G"],
+                        REGULAR_FLOOR * aux["w"]))
+    prob.add("umbilic", weights["umbilic"], umbilic_guard, UmbilicMargin(umbilic_margin(aux["K"], aux["H"]) ** 2))
     prob.add("target (4.8)", weights["target"], phlw_target, data)
     prob.add("beta", weights["beta"], beta_fairness, data)
     prob.add("closeness", weights["closeness"], T.linear, T.Linear("C", data.ops["S"], foot))
     prob.add("gliding", weights["gliding"], sample_gliding,
              SampleGliding(data.ops["S"], foot, nrm))
+    bd = reference_boundary(*reference)
+    if weights.get("boundary", 0.0) > 0 and len(bd.A):
+        prob.add("boundary", weights["boundary"], boundary_inward,
+                 boundary_gliding(s0.ctrl.reshape(-1, 3), boundary_operator(s0, data), reference,
+                                  bd))
     return prob, x, fit
+
+
+def principal_range_notes(K: np.ndarray, H: np.ndarray, u: np.ndarray, mode: str,
+                          scale: float = 1.0) -> list[str]:
+    """Lines saying where the reference admits no net of ``mode`` as it is: ``cnc``, the
+    principal ranges ``[kappa_1, kappa_2]`` of all samples have no common ``n``; ``phlw``, those
+    of a row have none (``K, H (rows, cols)`` on unit-diagonal geometry, ``scale`` metres)."""
+    if mode == "aa":
+        return []
+    r = np.sqrt(np.maximum(H * H - K, 0.0))
+    k1, k2 = (H - r) / scale, (H + r) / scale
+    if mode == "cnc":
+        lo, hi = float(k1.max()), float(k2.min())
+        if lo <= hi:
+            return []
+        return [f"no single n lies in [kappa_1, kappa_2] at every sample of the reference: "
+                f"max kappa_1 = {lo:.4g} 1/m > min kappa_2 = {hi:.4g} 1/m; no CNC net exists on "
+                "it as it is, so the optimization has to move the surface (deviation)"]
+    bad = np.flatnonzero(k1.max(axis=1) > k2.min(axis=1))
+    if not len(bad):
+        return []
+    return [f"on {len(bad)} of {len(u)} rows (u in [{u[bad].min():.3f}, {u[bad].max():.3f}]) no "
+            "n_u lies in [kappa_1, kappa_2] at every sample of the row; no PHLW net exists "
+            "there as the reference is, so the optimization has to move the surface"]
+
+
+def umbilic_margin(K: np.ndarray, H: np.ndarray) -> float:
+    """Least half-gap ``(kappa_2 - kappa_1) / 2`` the optimization keeps (units of ``H``):
+    :data:`UMBILIC_MARGIN` times the RMS of ``max |kappa_i|`` over the samples."""
+    r = np.sqrt(np.maximum(H * H - K, 0.0))
+    return float(UMBILIC_MARGIN * np.sqrt(np.mean((np.abs(H) + r) ** 2)))
+
+
+def boundary_operator(surf: BSplineSurface, data: Samples) -> Any:
+    """``S`` at the boundary of the domain (``u = 0, 1`` and ``v = 0, 1``, at the sample
+    parameters of the other direction): COO ``(4 m, nc)`` on the control points."""
+    R = int(data.row.max()) + 1
+    u, v = uniform_params(surf, (R, data.row.size // R))
+    ub = np.concatenate([u, u, np.zeros(len(v)), np.ones(len(v))])
+    vb = np.concatenate([np.zeros(len(u)), np.ones(len(u)), v, v])
+    return surf.operator(ub, vb, 0, 0).tocoo()
+
+
+class ReferenceBoundary(NamedTuple):
+    """The boundary edges ``A (m, 3) -> B (m, 3)`` of a reference mesh and a point inside the
+    face of each, ``inner (m, 3)`` (:func:`reference_boundary`)."""
+
+    A: np.ndarray
+    B: np.ndarray
+    inner: np.ndarray
+
+
+def reference_boundary(V: np.ndarray, F: np.ndarray) -> ReferenceBoundary:
+    """:class:`ReferenceBoundary` of the mesh ``(V, F)`` (empty arrays for a closed mesh)."""
+    seg, face = boundary_segments(F, return_faces=True)
+    return ReferenceBoundary(V[seg[:, 0]], V[seg[:, 1]],
+                             V[np.asarray(F)[face]].mean(axis=1))
+
+
+def boundary_gliding(ctrl: np.ndarray, op: Any, reference: tuple[np.ndarray, np.ndarray],
+                     boundary: ReferenceBoundary | None = None) -> SampleGliding:
+    """Data of the boundary term (:func:`~gridshell.ncp.phlw_terms.boundary_inward`): the
+    surface's boundary samples ``op @ ctrl``, their closest points on the reference's
+    boundary edges and the outward in-surface normal there (``T x n``, pointing away from
+    the edge's face). Without it the optimizer may shrink the surface away from the regions
+    where no net exists (a 12 x 8 m hill came back 7.7 x 5.3 m); closeness and gliding hold
+    the samples only where they are, and the patch of a principal parametrization is bounded
+    by principal lines, which a rectangle's edges are not (so the boundary may overhang)."""
+    from ..igl_adapter import closest_points_with_normals
+
+    V, F = reference
+    bd = reference_boundary(V, F) if boundary is None else boundary
+    Sb = np.asarray(op @ ctrl)
+    foot, j = closest_on_segments(Sb, bd.A, bd.B)
+    _, nrm = closest_points_with_normals(foot, V, F)
+    m = np.cross(bd.B[j] - bd.A[j], nrm)
+    m /= np.maximum(np.linalg.norm(m, axis=1), 1e-300)[:, None]
+    m *= np.where(np.einsum("ij,ij->i", m, bd.inner[j] - foot) > 0, -1.0, 1.0)[:, None]
+    return SampleGliding(op, foot, m)
 
 
 def optimize_phlw(surf: BSplineSurface, reference: Any, *, mode: Mode = "phlw",
@@ -805,15 +390,26 @@ def optimize_phlw(surf: BSplineSurface, reference: Any, *, mode: Mode = "phlw",
         "aa" ``n = 0`` (PK surface, asymptotic net)
     samples : (rows, cols) optimization samples (paper: 18 x 18)
     weights : overrides of :data:`DEFAULT_WEIGHTS` (keys ``constraints``, ``target``, ``beta``,
-        ``closeness``, ``gliding``); in mode ``aa`` ``beta`` defaults to 0 (see the code)
-    outer : rounds of (refresh closest points, Levenberg-Marquardt solve)
+        ``closeness``, ``gliding``, ``boundary``, ``umbilic``); in mode ``aa`` ``beta``
+        defaults to 0 (see the code)
+    outer : at most this many rounds of (refresh closest points, Levenberg-Marquardt solve,
+        accept / halve / reject by the true energy); the loop ends early when a round is
+        rejected or lowers the energy by less than :data:`ROUND_TOL_REL`
     max_iter : solver iterations per round
     check_samples : sampling for the deviation figure
     progress : called with one line per round
 
     Returns
     -------
-    PHLWResult
+    PHLWResult : ``converged`` when every figure of :func:`acceptance_figures` holds
+
+    Raises
+    ------
+    InputError : bad arguments or a singular initial parametrization
+    NoNetError : no net of ``mode`` can exist near the reference (umbilic everywhere; ``aa``
+        with ``K > 0`` everywhere), before any optimization
+    ConvergenceError : no round could improve the surface and its figures fail, or the
+        energy became non-finite
     """
     from ..igl_adapter import closest_points_with_normals
 
@@ -842,35 +438,48 @@ def optimize_phlw(surf: BSplineSurface, reference: Any, *, mode: Mode = "phlw",
     data = make_samples(s0, u, v, mode)
     lay = make_layout(s0.n_ctrl, R * len(v), R, mode)
 
-    prob, x, fit = phlw_problem(s0, data, lay, w, (Vs, Fr), mode)
+    prob, x, fit = phlw_problem(s0, data, lay, w, (Vs, Fr), mode, scale=diag)
+    op_b = boundary_operator(s0, data)
+    bd = reference_boundary(Vs, Fr)
     diagnostics: list[str] = []
     if len(fit.clamped):
-        diagnostics.append(f"initial fit: t_u^2 < 0 (b^2 - 4ac > 0) on rows {fit.clamped.tolist()}"
-                           "; restarted there from n_u = mean H (net angle pi/4)")
+        diagnostics.append(f"initial fit: rows {fit.clamped.tolist()} had t_u^2 < 0 (b^2 - 4ac > 0) "
+                           "or n_u outside [kappa_1, kappa_2]; started there from n_u inside "
+                           "the principal range")
+    diagnostics += principal_range_notes(lay.view(x, "K").reshape(R, -1),
+                                         lay.view(x, "H").reshape(R, -1), u, mode, diag)
 
     before = {"terms": prob.report(x), **_acceptance(surf, fit.n / diag, fit.t / diag, u, v,
                                                      mode, w["target"], diag)}
+    energy_initial = prob.energy(x)
     history: list[dict] = []
-    sol = None
     t0 = time.perf_counter()
     for rnd in range(int(outer)):
         if rnd > 0:
-            # re-project: auxiliaries exact from the control points, closest points refreshed
-            x = lay.pack({**lay.unpack(x), **init_auxiliary(lay.view(x, "C"), data)})
+            # a new problem: closest points refreshed at the accepted state (auxiliaries exact)
             S = np.asarray(data.ops["S"] @ lay.view(x, "C"))
             foot, nrm = closest_points_with_normals(S, Vs, Fr)
             prob.set_data("closeness", T.Linear("C", data.ops["S"], foot))
             prob.set_data("gliding", SampleGliding(data.ops["S"], foot, nrm))
-        sol = solve(prob, x, method="lm", max_iter=int(max_iter), damping=SOLVER_DAMPING,
-                    tol_rel=SOLVER_TOL_REL)
-        x = sol.x
-        history.append({"round": rnd + 1, "iterations": sol.iterations, "energy0": sol.energy0,
-                        "energy": sol.energy, "message": sol.message,
-                        "terms": {k: v_["energy"] for k, v_ in sol.report.items()},
+            if any(e.name == "boundary" for e in prob.entries):
+                prob.set_data("boundary", boundary_gliding(lay.view(x, "C"), op_b, (Vs, Fr),
+                                                           bd))
+        step = _round(prob, lay, data, x, int(max_iter))
+        history.append({"round": rnd + 1, **{k: v_ for k, v_ in step.items() if k != "x"},
                         "time": time.perf_counter() - t0})
         if progress is not None:
-            progress(f"round {rnd + 1}/{outer}: energy {sol.energy0:.3e} -> {sol.energy:.3e} "
-                     f"in {sol.iterations} iterations ({sol.message})")
+            progress(f"round {rnd + 1}/{outer}: energy {step['energy0']:.3e} -> "
+                     f"{step['energy']:.3e} in {step['iterations']} iterations "
+                     f"({step['message']})")
+        if not step["accepted"]:
+            break
+        x = step["x"]
+        if step["energy0"] - step["energy"] <= ROUND_TOL_REL * step["energy0"]:
+            break
+    energy_final = float(prob.energy(x))
+    if not np.isfinite(energy_final):
+        raise ConvergenceError(f"the {mode.upper()} optimization produced a non-finite energy; "
+                               "refit the reference with fewer control points or more smoothing")
 
     ctrl = lay.view(x, "C").reshape(s0.shape[0], s0.shape[1], 3) * diag + center
     out_surf = BSplineSurface(surf.degree_u, surf.degree_v, surf.knots_u.copy(),
@@ -889,18 +498,105 @@ def optimize_phlw(surf: BSplineSurface, reference: Any, *, mode: Mode = "phlw",
                                 (n_rows[:1] if mode == "cnc" else None),
                                 u_rows=u, u_samples=u, v_samples=v)
     diagnostics += check.messages
-    if np.all(check.umbilic | check.out_of_range):
-        raise NoNetError(
-            f"after the optimization the net has no real direction at any of the "
-            f"{check.umbilic.size} samples ({check.messages[0]}); the reference is too far from "
-            f"a {mode.upper()} surface: give the optimizer more rounds / iterations, a smaller "
-            "closeness or gliding weight, or another mode")
     dev = deviation_percent(out_surf, V, Fr, check_samples)
+    cov = coverage_percent(out_surf, V, Fr, check_samples)
+    unchanged = not any(h["accepted"] for h in history)
+    figures = acceptance_figures(before, after, dev, check, energy_initial, energy_final, cov,
+                                 unchanged=unchanged)
+    if unchanged and not all(f["ok"] for f in figures.values()):
+        raise ConvergenceError(
+            f"the {mode.upper()} optimization could not lower its energy from "
+            f"{energy_initial:.4g}: every round made the surface worse (true energy "
+            f"{history[0]['energy_true']:.4g} after round 1) and was rejected; try more control "
+            "points, a denser reference or another mode")
     return PHLWResult(surface=out_surf, mode=mode, u_rows=u, v_samples=v, n_rows=n_rows,
                       t_rows=t_rows, abc=abc, history=history, report_before=before,
-                      report_after=after, converged=bool(sol.converged), deviation=dev,
-                      diagnostics=diagnostics, net_check=check, weights=w,
-                      reference_diagonal=diag)
+                      report_after=after, converged=all(f["ok"] for f in figures.values()),
+                      deviation=dev, diagnostics=diagnostics, net_check=check, weights=w,
+                      reference_diagonal=diag, figures=figures,
+                      energy_initial=float(energy_initial), energy_final=energy_final)
+
+
+def _reprojected(lay: Layout, data: Samples, x: np.ndarray) -> np.ndarray:
+    """``x`` with every auxiliary variable exact on its control points (:func:`init_auxiliary`)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return lay.pack({**lay.unpack(x), **init_auxiliary(lay.view(x, "C"), data)})
+
+
+def _true_energy(prob: Problem, lay: Layout, data: Samples, x: np.ndarray
+                 ) -> tuple[float, np.ndarray]:
+    """Energy of ``prob`` at ``x`` re-projected (auxiliaries exact: what the surface itself
+    scores, not the solver's relaxed auxiliaries); ``inf`` where it is not finite."""
+    xr = _reprojected(lay, data, x)
+    if not np.all(np.isfinite(xr)):
+        return math.inf, xr
+    E = float(prob.energy(xr))
+    return (E if math.isfinite(E) else math.inf), xr
+
+
+def _round(prob: Problem, lay: Layout, data: Samples, x: np.ndarray, max_iter: int) -> dict:
+    """One outer round from the accepted state ``x`` (auxiliaries exact).
+
+    The solver's end point is judged by its *true* energy (auxiliaries re-projected from the
+    control points, same problem, same closest points): the solver minimizes with relaxed
+    auxiliaries, and its energy can fall while the surface's own rises (the 1e12 jumps of
+    issue 13). If the true energy did not fall, the step in ``C, n, t`` is halved up to
+    :data:`BACKTRACK` times; if none of these lowers it, the round is rejected and ``x`` kept.
+    """
+    E0, x = _true_energy(prob, lay, data, x)
+    sol = solve(prob, x, method="lm", max_iter=max_iter, damping=SOLVER_DAMPING,
+                tol_rel=SOLVER_TOL_REL)
+    E1, x1 = _true_energy(prob, lay, data, sol.x)
+    out = {"iterations": sol.iterations, "energy0": E0, "energy_solver": float(sol.energy),
+           "energy_true": E1, "step": 1.0, "message": sol.message}
+    alpha = 1.0
+    for _ in range(BACKTRACK):
+        if E1 < E0:
+            break
+        alpha *= 0.5
+        E1, x1 = _true_energy(prob, lay, data, x + alpha * (sol.x - x))
+    if E1 < E0:
+        out.update(energy=E1, step=alpha, accepted=True, x=x1)
+        if alpha < 1.0:
+            out["message"] += f"; step cut to {alpha:g} (the full step raised the true energy)"
+    else:
+        out.update(energy=E0, step=0.0, accepted=False, x=x,
+                   message=sol.message + f"; rejected (true energy {E0:.3e} -> {out['energy_true']:.3e})")
+    return out
+
+
+def acceptance_figures(before: dict, after: dict, deviation: float, check: NetCheck | None,
+                       energy_initial: float, energy_final: float,
+                       coverage: float = 0.0, unchanged: bool = False) -> dict[str, dict]:
+    """The figures that decide ``converged``: ``{name: {"value", "limit", "ok"}}``.
+
+    ``energy``: final / initial energy of the whole problem (< 1); ``E_PHLW``: after / before
+    (< 1, or already below :data:`E_PHLW_FLOOR`); ``relation``: max relative residual of eq. 4.8
+    at the samples; ``angle``: max principal angle error (degrees); ``deviation``: % of the
+    reference's diagonal; with ``unchanged`` (no round accepted: the reference already is as
+    good as the optimizer gets it) the energy figures hold if they did not rise;
+    ``coverage``: max distance of the reference to the surface, same
+    units (a shrunk surface); ``net``: samples without a real net direction or umbilic (0).
+    """
+    def fig(value: float, limit: float, ok: bool | None = None) -> dict:
+        value = float(value)
+        return {"value": value, "limit": float(limit),
+                "ok": bool(math.isfinite(value) and (value < limit if ok is None else ok))}
+
+    e0, e1 = before["E_PHLW"]["total"], after["E_PHLW"]["total"]
+    bad = int(np.sum(check.umbilic | check.out_of_range)) if check is not None else 0
+    return {
+        "energy": fig(energy_final / energy_initial if energy_initial > 0 else 0.0, 1.0,
+                      energy_final < energy_initial or (unchanged and
+                                                        energy_final <= energy_initial)),
+        "E_PHLW": fig(e1 / e0 if e0 > 0 else 0.0, 1.0,
+                      e1 < e0 or e1 <= E_PHLW_FLOOR or (unchanged and e1 <= e0)),
+        "relation": fig(after["relation_max_rel"], RELATION_TOL),
+        "angle": fig(after["angle_max_deg"], ANGLE_TOL_DEG),
+        "deviation": fig(deviation, DEVIATION_TOL),
+        "coverage": fig(coverage, COVERAGE_TOL),
+        "net": fig(bad, 0.5),
+    }
 
 
 # ============================================================================ output
@@ -922,6 +618,8 @@ def result_summary(res: PHLWResult) -> dict[str, Any]:
 
     return clean({
         "mode": res.mode, "converged": res.converged, "deviation_percent": res.deviation,
+        "figures": res.figures, "energy_initial": res.energy_initial,
+        "energy_final": res.energy_final,
         "reference_diagonal_m": res.reference_diagonal, "weights": res.weights,
         "samples": [len(res.u_rows), len(res.v_samples)],
         "control_points": list(res.surface.shape),

@@ -97,3 +97,31 @@ def initial_surface(mesh: Any, F: np.ndarray | None = None, *, n_ctrl: tuple[int
     surf, rms = fit_points(V, UV[:, 0], UV[:, 1], nu, nv, du, dv,
                            smoothing=max(smoothing, 1e-4))
     return InitialFit(surf, rms, "parameterized", None)
+
+
+def boundary_segments(F: np.ndarray, return_faces: bool = False
+                      ) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
+    """Boundary edges of a polygon mesh: ``(m, 2)`` vertex indices of the edges used by one
+    face only (faces ``(f, 3|4)``), and with ``return_faces`` the ``(m,)`` face of each."""
+    F = np.asarray(F, np.int64)
+    E = np.stack([F, np.roll(F, -1, axis=1)], -1).reshape(-1, 2)
+    n = int(E.max()) + 1 if E.size else 1
+    key = E.min(axis=1) * n + E.max(axis=1)          # one int64 per undirected edge
+    _, inv, cnt = np.unique(key, return_inverse=True, return_counts=True)
+    keep = cnt[inv.reshape(-1)] == 1
+    if return_faces:
+        return E[keep], np.repeat(np.arange(len(F)), F.shape[1])[keep]
+    return E[keep]
+
+
+def closest_on_segments(P: np.ndarray, A: np.ndarray, B: np.ndarray
+                        ) -> tuple[np.ndarray, np.ndarray]:
+    """Closest points of ``P (k, 3)`` on the segments ``A (m, 3) -> B (m, 3)``: the foot points
+    ``(k, 3)`` and the index ``(k,)`` of the segment each lies on (brute force, ``k * m``)."""
+    P, A, B = (np.asarray(X, float) for X in (P, A, B))
+    D = B - A
+    dd = np.maximum(np.einsum("ij,ij->i", D, D), 1e-300)
+    s = np.clip(np.einsum("kmj,mj->km", P[:, None, :] - A[None], D) / dd, 0.0, 1.0)
+    Q = A[None] + s[..., None] * D[None]
+    j = np.argmin(np.einsum("kmj,kmj->km", Q - P[:, None, :], Q - P[:, None, :]), axis=1)
+    return Q[np.arange(len(P)), j], j

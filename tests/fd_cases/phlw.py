@@ -1,4 +1,4 @@
-"""FD cases of the PHLW surface-design terms (gridshell.ncp.phlw, paper 4.2.1).
+"""FD cases of the PHLW surface-design terms (gridshell.ncp.phlw_terms, paper 4.2.1).
 
 A small bi-cubic B-spline (5 x 4 control points, 3 x 4 samples) with random control points
 and random auxiliary variables near their consistent values, so every product term is active;
@@ -49,7 +49,46 @@ def _gliding(rng):
 MODE_TERMS = ("normal_eq", "first_form_eq", "delta_eq", "sqrt_delta_eq", "second_form_eq",
               "curvature_eq", "principal_eq", "phlw_target", "beta_fairness")
 
-CASES = {f"gridshell.ncp.phlw.{name}[{mode}]": _case(mode)
+CASES = {f"gridshell.ncp.phlw_terms.{name}[{mode}]": _case(mode)
          for name in MODE_TERMS for mode in P.MODES}
 # sample_gliding reads only the control points, at the same place in every mode
-CASES["gridshell.ncp.phlw.sample_gliding"] = _gliding
+CASES["gridshell.ncp.phlw_terms.sample_gliding"] = _gliding
+
+
+def _guard(mode):
+    def make(rng):
+        lay, x, data = _setup(rng, mode)
+        # floors at half or twice |X| (+ 0.01): about half the hinges active, none near its kink
+        lo = {nm: np.abs(lay.view(x, nm)) * rng.choice([0.5, 2.0], size=lay.view(x, nm).shape)
+              + 0.01 for nm in ("E", "G", "w")}
+        return lay, x, P.Regularity(lo["E"], lo["G"], lo["w"])
+    return make
+
+
+for _mode in P.MODES:
+    CASES[f"gridshell.ncp.phlw_terms.parametrization_guard[{_mode}]"] = _guard(_mode)
+
+
+def _umbilic(mode):
+    def make(rng):
+        lay, x, data = _setup(rng, mode)
+        H, K = lay.view(x, "H"), lay.view(x, "K")
+        # margins at half or twice H^2 - K (+ 0.01): both sides of the hinge, away from its kink
+        r2 = np.abs(H * H - K) * rng.choice([0.5, 2.0], size=H.shape) + 0.01
+        return lay, x, P.UmbilicMargin(r2)
+    return make
+
+
+for _mode in P.MODES:
+    CASES[f"gridshell.ncp.phlw_terms.umbilic_guard[{_mode}]"] = _umbilic(_mode)
+
+
+def _inward(rng):
+    lay, x, data = _gliding(rng)
+    # foot points shifted along the normals so that about half the samples are inside
+    S = np.asarray(data.A @ lay.view(x, "C"))
+    shift = rng.choice([-0.2, 0.2], size=len(S))[:, None] * data.normal
+    return lay, x, P.SampleGliding(data.A, S + shift, data.normal)
+
+
+CASES["gridshell.ncp.phlw_terms.boundary_inward"] = _inward
