@@ -473,11 +473,13 @@ def test_gg_unconverged_design_is_an_error_unless_allowed(tmp_path, capsys):
     ref, out = _write(tmp_path, "saddle.obj"), tmp_path / "out"
     opts = [*GG, "--rounds", "1", "--polish", "0"]
     assert_clean_failure(capsys, ["gg", str(ref), "-o", str(out), *opts], 4,
-                         ["did not converge", "more rounds"], [out])
+                         ["misses the paper's figures", "Delta_a", "--allow-unconverged"], [out])
     code, stdout, err = _run(capsys, ["gg", str(ref), "-o", str(out), *opts,
                                       "--allow-unconverged", "--json"])
     assert code == 0, err
-    assert "NOT converge" in json.loads(stdout)["surface optimization"]
+    payload = json.loads(stdout)
+    assert payload["ok"] is False and payload["verdict"].startswith("FAIL")
+    assert json.loads((out / "design.json").read_text())["params"]["quality"]["ok"] is False
 
 
 # --------------------------------------------------------------------------- unwritable output
