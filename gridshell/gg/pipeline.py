@@ -378,9 +378,10 @@ def design_gg(target: Any, *, meridians: str = "cols", grid: tuple[int, int] | N
         raise ConvergenceError(
             f"the GG design misses the paper's figures ({quality['summary']}; surface residuals: "
             f"geodesic {design.geodesic_residual_max:.2e} rad, edge-length spread "
-            f"{design.length_residual_rel_max:.2e}, polish stopped: {design.stop}). Try more "
-            "rounds (--rounds), a coarser grid, fewer lamellae, or a target closer to a surface "
-            "of revolution; --allow-unconverged writes the design anyway, marked as failing")
+            f"{design.length_residual_rel_max:.2e}, polish stopped: {design.stop}). Try a finer "
+            "grid (--grid R C: a coarse grid carries the net poorly), fewer lamellae "
+            "(--lamellae N), or a target closer to a surface of revolution; "
+            "--allow-unconverged writes the design anyway, marked as failing")
     seq = None
     if int(frames) > 0:
         _say(progress, f"alignment sequence: {int(frames)} steps from deployed to collapsed")
