@@ -57,7 +57,11 @@ def test_cli_progress_on_stderr_and_modes(tmp_path, capsys):
         # the summary ends with one pass / FAIL line per figure of the PHLW step
         last = cap.out.strip().splitlines()[-4:]
         assert all(ln.strip().startswith(("pass  ", "FAIL  ")) for ln in last), last
-        assert "FAIL  optimizer converged: no" in cap.out
+        # the converged gate agrees with the step's own record
+        rep = json.loads((tmp_path / mode / "report.json").read_text())
+        conv = next(g for g in rep["quality"]["gates"] if "converged" in g["label"])
+        word = "pass  optimizer converged: yes" if conv["ok"] else "FAIL  optimizer converged: no"
+        assert word in cap.out, cap.out
 
 
 def test_cli_bad_reference_exits_with_input_error(tmp_path, capsys):
