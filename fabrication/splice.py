@@ -16,9 +16,11 @@ sheet allows, by two kinds of lap splice:
   splice. It is labelled ``L<lamella>-S<n>`` on both pieces.
 
 A lamella that joint splices alone can cut is split as before (the farthest joint splice for
-each piece); any other is split preferring span splices, which lose the least material to
-overlaps (:func:`_plan`). What neither can cut (a strip whose shortest piece is wider than
-the sheet) is an :class:`InputError` naming the fix.
+each piece); any other by span splices alone (:func:`_span_plan`, exact: it finds a split
+whenever one exists), which lose the least material to overlaps; failing that (stretches of
+joints too close for a span overlap), by both, depth first (:func:`_plan`). What none can
+cut (a strip whose shortest piece is wider than the sheet) is an :class:`InputError` naming
+the fix.
 """
 from __future__ import annotations
 
@@ -124,7 +126,13 @@ def _span_splice(strip: Strip, params: FabParams, start: float,
         break
     if best is None:
         return None
-    i, c = best
+    return _span_note(strip, params, best[1], best[0])
+
+
+def _span_note(strip: Strip, params: FabParams, c: float, i: int) -> dict:
+    """The note of the span splice overlapping ``[c, c + overlap]`` in window ``i`` (between
+    stations ``i`` and ``i + 1`` of ``s0, joints, s1``)."""
+    ov = span_overlap(params)
     n = len(strip.joint_s)      # stations i, i+1 are joints i-1, i (0, n+1: the strip ends)
     where = ("before the first joint" if i == 0 else "after the last joint" if i == n
              else f"between joints {i - 1} and {i}")
@@ -169,14 +177,87 @@ def _plan(strip: Strip, params: FabParams, span: bool, budget: list[int]) -> lis
     return go(strip.s0, 0, None, strip.s0)
 
 
+def _windows(strip: Strip, params: FabParams) -> list[tuple[int, float, float]]:
+    """``(i, lo, hi)``: where a span overlap may start, one end margin clear of the
+    stations ``i`` and ``i + 1`` of ``s0, joints, s1``; non-empty ones, in order."""
+    m, ov = params.margin, span_overlap(params)
+    B = np.concatenate([[strip.s0], strip.joint_s, [strip.s1]])
+    return [(i, B[i] + m, B[i + 1] - m - ov) for i in range(len(B) - 1)
+            if B[i + 1] - m - ov >= B[i] + m]
+
+
+def _reach(strip: Strip, params: FabParams, x: float) -> float:
+    """The farthest end (mm along the axis) of a piece from ``x`` that fits the sheet."""
+    fits = lambda e: fits_sheet(strip.sub(x, e), params)  # noqa: E731
+    a, b = x, strip.s1
+    if fits(b):
+        return b
+    two = x + 2 * max(params.sheet)     # usually too long already: a shorter bracket
+    if two < b and not fits(two):
+        b = two
+    while b - a > 0.01:
+        mid = 0.5 * (a + b)
+        a, b = (mid, b) if fits(mid) else (a, mid)
+    return a
+
+
+def _span_plan(strip: Strip, params: FabParams) -> list[dict] | None:
+    """Span splices only, placed exactly: the set of overlap starts reachable with ``j``
+    pieces is propagated window by window (a union of intervals: a piece from ``c`` reaches
+    overlap starts ``[c + overlap + margin, reach(c) - overlap]``, monotone in ``c``) until
+    the rest of the strip fits one piece; then walked back, each overlap as far along as
+    the next allows. Finds a split whenever one by span splices exists (to 0.01 mm), where
+    the greedy choice of :func:`_plan` can strand the rest (short sheets)."""
+    m, ov = params.margin, span_overlap(params)
+    W = _windows(strip, params)
+    if not W:
+        return None
+
+    def clip(intervals):
+        out = []
+        for a, b in intervals:
+            for i, lo, hi in W:
+                lo2, hi2 = max(a, lo), min(b, hi)
+                if hi2 >= lo2:
+                    out.append((i, lo2, hi2))
+        return out
+
+    levels = [clip([(strip.s0 + m, _reach(strip, params, strip.s0) - ov)])]
+    limit = int(strip.length / (ov + m)) + 2
+    while levels[-1] and len(levels) <= limit:
+        top = max(hi for _, _, hi in levels[-1])
+        if fits_sheet(strip.sub(top, strip.s1), params):
+            break
+        levels.append(clip([(lo + ov + m, _reach(strip, params, hi) - ov)
+                            for _, lo, hi in levels[-1]]))
+    else:
+        return None
+    # walk back: the last overlap as far along as possible, then each one before it
+    c = max(hi for _, _, hi in levels[-1])
+    i = next(i for i, _, hi in levels[-1] if hi == c)
+    chosen = [(i, c)]
+    for level in levels[-2::-1]:
+        cand = [(i, min(hi, c - ov - m)) for i, lo, hi in level if lo <= c - ov - m]
+        if not cand:
+            return None
+        i, x = max(cand, key=lambda t: t[1])
+        if _reach(strip, params, x) < c + ov - 1e-6:
+            return None
+        chosen.append((i, x))
+        c = x
+    return [_span_note(strip, params, c, i) for i, c in chosen[::-1]]
+
+
 def split_strip(strip: Strip, params: FabParams) -> list[Strip]:
     """``[strip]`` if it fits the sheet, else its spliced pieces (numbered, with splice notes
     and, for span splices, the fasteners in ``splice_s``)."""
     if fits_sheet(strip, params):
         return [strip]
     n_min = int(np.ceil(strip.length / (max(params.sheet) - 2 * params.gap)))
-    # joint splices alone, as long as they do; else splices between joints too
+    # joint splices alone, as long as they do; else splices between joints; else both
     splices = _plan(strip, params, False, [100 + 10 * n_min])
+    if splices is None:
+        splices = _span_plan(strip, params)
     if splices is None:
         splices = _plan(strip, params, True, [100 + 10 * n_min])
     if splices is None:
