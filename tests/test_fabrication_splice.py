@@ -215,3 +215,22 @@ def test_short_sheet_where_the_greedy_split_strands_the_rest():
         pieces = split_strip(strip, params)
         _check_pieces(strip, pieces, params)
         assert _span_notes(pieces)
+
+
+def test_span_and_joint_splices_combine():
+    """A 1500 mm span, then joints 80 mm apart for 960 mm: no span overlap fits between the
+    close joints (80 < overlap + 2 margins), so span splices alone cannot cut it and joint
+    splices alone cannot cross the span; both together do."""
+    params = DEFAULTS
+    js = np.concatenate([[0.0], 1500.0 + 80.0 * np.arange(13)])
+    strip = _strip(LineAxis(), js)
+    pieces = split_strip(strip, params)
+    _check_pieces(strip, pieces, params)
+    kinds = {n["kind"] for p in pieces for n in p.splices}
+    assert kinds == {"span", "joint"}
+    for p, q in zip(pieces[:-1], pieces[1:]):
+        n = next(n for n in p.splices if n["with"] == q.piece)
+        if n["kind"] == "joint":          # the two pieces share two joints
+            k = n["splice_joint"]
+            assert n["shared_joints"] == [k, k + 1]
+            assert set(js[[k, k + 1]]) <= set(p.joint_s) & set(q.joint_s)
