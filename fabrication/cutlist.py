@@ -21,8 +21,18 @@ COLUMNS = ("lamella", "family", "piece", "sheet", "shape", "radius_mm", "flat_le
 
 
 def splice_text(notes: list[dict]) -> str:
+    """The splice column: for each splice of the piece, which piece it overlaps, by how
+    much, and where (shared joints; or, between joints, the splice label and its position
+    along the lamella's axis from the axis start, mm)."""
     parts = []
     for n in notes:
+        if n.get("kind") == "span":
+            where = n["where"]
+            fast = ", ".join(f"{x:.1f}" for x in n["fasteners"])
+            parts.append(f"overlaps piece {n['with']} by {n['overlap']:.1f} mm {where}: "
+                         f"splice {n['label']} of lamella {n['lamella']} at {n['at']:.1f} mm "
+                         f"along the lamella (fasteners at {fast} mm)")
+            continue
         joints = ",".join(str(j) for j in n["shared_joints"])
         parts.append(f"overlaps piece {n['with']} by {n['overlap']:.1f} mm "
                      f"(shared joints {joints})")

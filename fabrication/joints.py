@@ -45,9 +45,10 @@ def outline_corners(strip: Strip, params: FabParams) -> np.ndarray:
     return np.array(C, float)
 
 
-def hole_centres(strip: Strip) -> np.ndarray:
-    """Hole centres ``(k,2)`` in the plane: the centre line at each joint."""
-    return strip.axis.point(strip.joint_s, np.full(len(strip.joint_s), strip.t_mid))
+def hole_centres(strip: Strip, at: np.ndarray | None = None) -> np.ndarray:
+    """Hole centres ``(k,2)`` in the plane: the centre line at each joint (or at ``at``)."""
+    s = strip.joint_s if at is None else np.asarray(at, float)
+    return strip.axis.point(s, np.full(len(s), strip.t_mid))
 
 
 def joint_points(strip: Strip) -> np.ndarray:
@@ -55,9 +56,9 @@ def joint_points(strip: Strip) -> np.ndarray:
     return strip.axis.point(strip.joint_s, np.zeros(len(strip.joint_s)))
 
 
-def score_marks(strip: Strip) -> np.ndarray:
-    """Score lines ``(k,2,2)`` across the strip at each joint."""
-    s = strip.joint_s
+def score_marks(strip: Strip, at: np.ndarray | None = None) -> np.ndarray:
+    """Score lines ``(k,2,2)`` across the strip at each joint (or at ``at``)."""
+    s = strip.joint_s if at is None else np.asarray(at, float)
     return np.stack([strip.axis.point(s, np.full(len(s), strip.t_lo)),
                      strip.axis.point(s, np.full(len(s), strip.t_hi))], axis=1)
 

@@ -77,7 +77,8 @@ def text_length(text: str, height: float) -> float:
 def strip_labels(strip: Strip, params: FabParams,
                  material: Polygon) -> tuple[list[np.ndarray], int]:
     """Engraving strokes of the strip: its name (``L12``, ``L12-1/2``) in the widest free
-    stretch and the neighbour ids right after each joint. ``material``: the part's shapely
+    stretch, the neighbour ids right after each joint and the label of each span splice
+    (``L12-S1``) between its fasteners. ``material``: the part's shapely
     polygon (holes as interiors). Returns the strokes and the number of labels dropped."""
     w = strip.width
     band_t, band_h = strip.t_mid, w
@@ -91,7 +92,9 @@ def strip_labels(strip: Strip, params: FabParams,
     pad = feature_halfwidth(params) + 1.0
     strokes: list[np.ndarray] = []
     dropped = 0
-    occupied: list[tuple[float, float]] = [(s - pad, s + pad) for s in strip.joint_s]
+    occupied: list[tuple[float, float]] = [(s - pad, s + pad)
+                                           for s in np.concatenate([strip.joint_s,
+                                                                    strip.splice_s])]
 
     def fits(lines):
         return bool(lines) and safe.contains(MultiLineString([L for L in lines]))
@@ -111,6 +114,26 @@ def strip_labels(strip: Strip, params: FabParams,
                 strokes += lines
                 occupied.append((s_j + pad, s_c + L / 2 + 1.0))
                 break
+            h *= 0.75
+        else:
+            dropped += 1
+    # span splices: their label on both pieces, inside the overlap, clear of the fasteners
+    for note in strip.splices:
+        if note.get("kind") != "span":
+            continue
+        f = note["fasteners"]
+        a, b = (f[0] + pad + 1.0, f[-1] - pad - 1.0) if len(f) > 1 else \
+            (f[0] + pad + 1.0, note["to"] - 1.0)
+        a, b = max(a, strip.s0 + 1.0), min(b, strip.s1 - 1.0)
+        h = h0
+        while h >= MIN_HEIGHT:
+            L = text_length(note["label"], h)
+            if L <= b - a:
+                lines = place_text(strip, note["label"], h, 0.5 * (a + b), band_t)
+                if fits(lines):
+                    strokes += lines
+                    occupied.append((0.5 * (a + b - L), 0.5 * (a + b + L)))
+                    break
             h *= 0.75
         else:
             dropped += 1

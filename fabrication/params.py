@@ -79,8 +79,9 @@ class FabParams:
     gap : float
         Clearance between parts and from the sheet edges.
     overlap : float or None
-        Length of a splice (lap) between two pieces of a split lamella; None: one joint
-        spacing plus two end margins, so that the pieces share two joints.
+        Length of a splice (lap) between two pieces of a split lamella; None: at a joint,
+        one joint spacing plus two end margins, so that the pieces share two joints; between
+        joints, two widths plus two end margins (:mod:`fabrication.splice`).
     kerf : float
         Width of the laser cut; outlines move out and holes in by ``kerf / 2``. 0: off.
     dxf_version : str

@@ -88,10 +88,11 @@ def _corners_to_path(axis, C: np.ndarray, tol: float) -> Path:
 
 
 def check_spacing(strip: Strip, params: FabParams) -> None:
-    """Raise InputError if neighbouring joint features would merge."""
-    if len(strip.joint_s) < 2:
+    """Raise InputError if neighbouring joint (or splice fastener) features would merge."""
+    s = np.sort(np.concatenate([strip.joint_s, strip.splice_s]))
+    if len(s) < 2:
         return
-    gap = float(np.min(np.diff(strip.joint_s)))
+    gap = float(np.min(np.diff(s)))
     need = {"hole": params.hole, "slots": params.slot_width, "marks": 0.0}[params.joints] + 0.5
     if gap < need:
         raise InputError(f"lamella {strip.lamella}: two joints are only {gap:.3g} mm apart at "
@@ -113,6 +114,13 @@ def build_part(strip: Strip, params: FabParams) -> Part:
     else:
         holes, radii = np.zeros((0, 2)), np.zeros(0)
     scores = score_marks(strip) if params.joints == "marks" else np.zeros((0, 2, 2))
+    if len(strip.splice_s):      # span-splice fasteners: holes, else score marks
+        f = len(strip.splice_s)
+        if params.joints == "hole":
+            holes = np.concatenate([holes, hole_centres(strip, strip.splice_s)])
+            radii = np.concatenate([radii, np.full(f, hole_radius(params.hole, params.kerf))])
+        else:
+            scores = np.concatenate([scores, score_marks(strip, strip.splice_s)])
     part = Part(strip, outline, holes, radii, scores, [], joint_points(strip), nominal)
     mat = Polygon(nominal.flatten(tol))
     if len(holes):

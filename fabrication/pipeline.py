@@ -67,9 +67,14 @@ def plan_parts(bundle: DesignBundle, params: FabParams,
             notes = [n for p in ps for n in p.splices if n["with"] > p.piece]
             split.append({"lamella": lam, "pieces": len(ps),
                           "overlaps_mm": [round(n["overlap"], 3) for n in notes],
-                          "splice_joints": [n["splice_joint"] for n in notes]})
+                          "splice_joints": [n["splice_joint"] for n in notes
+                                            if n["kind"] == "joint"],
+                          "span_splices_mm": [round(n["at"], 3) for n in notes
+                                              if n["kind"] == "span"]})
     if split:
-        say(f"{len(split)} lamellae longer than the sheet split at joints")
+        n_span = sum(len(d["span_splices_mm"]) for d in split)
+        say(f"{len(split)} lamellae longer than the sheet split"
+            + (f" ({n_span} splices between joints)" if n_span else " at joints"))
     parts = [build_part(p, params) for p in pieces]
     layout = nest(parts, params)
     check_layout(layout, params.gap)

@@ -44,7 +44,11 @@ class Strip:
     piece, n_pieces : int
         1-based piece number and piece count of the lamella (1, 1 when not split).
     splices : list of dict
-        For split lamellae: ``{"with": piece, "overlap": mm, "from": s, "to": s, "joints": [...]}``.
+        For split lamellae, one note per splice of this piece (:mod:`fabrication.splice`):
+        ``{"kind": "joint" | "span", "with": other piece, "overlap": mm, "from": s, "to": s,
+        ...}``.
+    splice_s : (m,) float
+        Positions of the fasteners (holes or marks) of span splices on this piece.
     """
 
     lamella: int
@@ -61,8 +65,10 @@ class Strip:
     piece: int = 1
     n_pieces: int = 1
     splices: list[dict] = field(default_factory=list)
+    splice_s: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     def __post_init__(self) -> None:
+        self.splice_s = np.asarray(self.splice_s, float).reshape(-1)
         self.joint_s = np.asarray(self.joint_s, float).reshape(-1)
         self.joint_index = np.asarray(self.joint_index, np.int64).reshape(-1)
 
@@ -86,8 +92,11 @@ class Strip:
         return f"L{self.lamella}" + (f"-{self.piece}/{self.n_pieces}" if self.n_pieces > 1 else "")
 
     def sub(self, s0: float, s1: float, **changes) -> "Strip":
-        """The piece ``[s0, s1]`` of this strip with the joints that lie on it."""
+        """The piece ``[s0, s1]`` of this strip with the joints (and splice fasteners) that
+        lie on it."""
         m = (self.joint_s >= s0 - 1e-9) & (self.joint_s <= s1 + 1e-9)
+        f = self.splice_s[(self.splice_s >= s0 - 1e-9) & (self.splice_s <= s1 + 1e-9)]
+        changes.setdefault("splice_s", f)
         return dataclasses.replace(self, s0=float(s0), s1=float(s1), joint_s=self.joint_s[m],
                                    joint_index=self.joint_index[m],
                                    neighbours=[n for n, k in zip(self.neighbours, m) if k],
