@@ -90,6 +90,10 @@ class FabParams:
         Write arcs as short segments instead of bulges.
     labels : bool
         Engrave lamella and neighbour ids.
+    fallback_marks : bool
+        When the joints of a lamella are too close at this scale for ``joints`` (holes or
+        slots would merge), engrave score marks instead and say so in the report
+        (``joints_fallback``); False: refuse (an explicit ``--joints``).
     tolerance : float
         Chord tolerance for tessellated arcs and curves.
     """
@@ -109,6 +113,7 @@ class FabParams:
     dxf_version: str = "R2010"
     segments: bool = False
     labels: bool = True
+    fallback_marks: bool = True
     tolerance: float = 0.01
 
     def __post_init__(self) -> None:

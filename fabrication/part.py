@@ -6,6 +6,8 @@ segments), ``engrave`` (ENGRAVE stroke polylines). :func:`build_part` makes it f
 """
 from __future__ import annotations
 
+import math
+
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -87,13 +89,19 @@ def _corners_to_path(axis, C: np.ndarray, tol: float) -> Path:
     return Path(np.concatenate(Vs), np.concatenate(Bs), closed=True)
 
 
+def joint_clearance(strip: Strip, params: FabParams) -> tuple[float, float]:
+    """``(gap, need)``: the smallest distance between neighbouring joints (and splice
+    fasteners) of ``strip`` and the distance its joint features (hole, slot, mark) need so as
+    not to merge, mm (``gap`` is inf with fewer than two)."""
+    s = np.sort(np.concatenate([strip.joint_s, strip.splice_s]))
+    gap = float(np.min(np.diff(s))) if len(s) >= 2 else math.inf
+    need = {"hole": params.hole, "slots": params.slot_width, "marks": 0.0}[params.joints] + 0.5
+    return gap, need
+
+
 def check_spacing(strip: Strip, params: FabParams) -> None:
     """Raise InputError if neighbouring joint (or splice fastener) features would merge."""
-    s = np.sort(np.concatenate([strip.joint_s, strip.splice_s]))
-    if len(s) < 2:
-        return
-    gap = float(np.min(np.diff(s)))
-    need = {"hole": params.hole, "slots": params.slot_width, "marks": 0.0}[params.joints] + 0.5
+    gap, need = joint_clearance(strip, params)
     if gap < need:
         raise InputError(f"lamella {strip.lamella}: two joints are only {gap:.3g} mm apart at "
                          f"this scale, too close for {params.joints} of {need - 0.5:g} mm; use a "

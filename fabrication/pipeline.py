@@ -13,6 +13,7 @@ file is written; the output directory then appears at once (``gridshell.atomic.a
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 from pathlib import Path
 from typing import Any, Callable
 
@@ -27,7 +28,7 @@ from .cutlist import cutlist_rows, write_cutlist
 from .dxf import write_sheet_dxf
 from .nesting import Layout, check_layout, nest
 from .params import FabParams, scale_text
-from .part import Part, build_part
+from .part import Part, build_part, joint_clearance
 from .plan import write_plan
 from .preview import write_sheet_png
 from .splice import split_strip
@@ -75,11 +76,23 @@ def plan_parts(bundle: DesignBundle, params: FabParams,
         n_span = sum(len(d["span_splices_mm"]) for d in split)
         say(f"{len(split)} lamellae longer than the sheet split"
             + (f" ({n_span} splices between joints)" if n_span else " at joints"))
+    fallback = None
+    if params.joints != "marks" and params.fallback_marks:
+        tight = [(p.lamella, *joint_clearance(p, params)) for p in pieces]
+        tight = [t for t in tight if t[1] < t[2]]
+        if tight:
+            lam, gap, need = min(tight, key=lambda t: t[1])
+            fallback = (f"joints only {gap:.3g} mm apart at {scale_text(params.scale)} (lamella "
+                        f"{lam}; {params.joints} need {need - 0.5:g} mm): engraved as marks "
+                        "instead; use a larger --scale for " + params.joints)
+            say("warning: " + fallback)
+            params = replace(params, joints="marks")
     parts = [build_part(p, params) for p in pieces]
     layout = nest(parts, params)
     check_layout(layout, params.gap)
     say(f"nested {len(parts)} pieces on {layout.n_sheets} sheet(s)")
-    return parts, layout, {"strips": strips, "split": split}
+    return parts, layout, {"strips": strips, "split": split, "params": params,
+                           "joints_fallback": fallback}
 
 
 def fabricate(bundle: str | Path | DesignBundle, out_dir: str | Path,
@@ -122,6 +135,7 @@ def fabricate(bundle: str | Path | DesignBundle, out_dir: str | Path,
     out = Path(out_dir)
     _check_out(out, bundle_dir)
     parts, layout, info = plan_parts(bundle, params, say)
+    params = info["params"]  # joints engraved as marks where holes would merge
     W, H = params.sheet
     area = sum(p.area for p in parts)
     util = area / (layout.n_sheets * W * H)
@@ -145,6 +159,7 @@ def fabricate(bundle: str | Path | DesignBundle, out_dir: str | Path,
         "utilisation_per_sheet": per_sheet,
         "pieces_split": info["split"],
         "labels_dropped": int(sum(p.labels_dropped for p in parts)),
+        "joints_fallback": info["joints_fallback"],
         "radius_mm": info["strips"][0].axis.radius,
         "sheet_files": "one DXF and one SVG per sheet, and a PNG preview of each",
         "files": files,

@@ -88,3 +88,21 @@ def test_bad_bundle_and_unsafe_output(bundles, tmp_path, capsys):
     (tmp_path / "mine" / "notes.txt").write_text("keep")
     assert main(["fabricate", "--force", str(bundles / "gg"), "-o", str(tmp_path / "mine"), "-q"]) == 5
     assert (tmp_path / "mine" / "notes.txt").read_text() == "keep"
+
+
+def test_joints_too_close_for_holes_warn_by_default_and_refuse_when_asked(bundles, tmp_path,
+                                                                           capsys):
+    """A small model: by default the joints are engraved as marks with a warning in the
+    summary and fabrication.json; an explicit --joints hole is refused (exit 2)."""
+    b = bundles / "gg"
+    out = tmp_path / "fab"
+    assert main(["fabricate", str(b), "-o", str(out), "--scale", "1:100", "--no-plan", "--force",
+                 "--json", "-q"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert "engraved as marks" in summary["warning"]
+    rep = json.loads((out / "fabrication.json").read_text())
+    assert rep["params"]["joints"] == "marks" and rep["joints_fallback"]
+    assert main(["fabricate", str(b), "-o", str(tmp_path / "fab2"), "--scale", "1:100",
+                 "--joints", "hole", "--force", "-q"]) == 2
+    assert "too close for hole" in capsys.readouterr().err
+    assert not (tmp_path / "fab2").exists()

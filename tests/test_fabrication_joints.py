@@ -108,3 +108,22 @@ def test_kerf_moves_outlines_out_and_holes_in(kind, joints):
         V, B = comp[0].outline.V, comp[0].outline.B
         r = [np.linalg.norm(V[i] - [0, R]) for i in np.flatnonzero(B)]
         assert sorted(r) == pytest.approx([R - 10 - kerf / 2, R + 10 + kerf / 2])
+
+
+def test_joints_too_close_for_holes_are_engraved_as_marks_by_default(tmp_path):
+    """A small model at 1:10: holes would merge, so the default engraves marks and says so;
+    an explicit --joints hole (fallback_marks=False) refuses as before."""
+    from fabrication.pipeline import plan_parts
+
+    b = make_bundle("GG")
+    strict = FabParams(scale="1:100", hole=3, margin=15, fallback_marks=False)
+    with pytest.raises(InputError, match="too close"):
+        plan_parts(b, strict)
+    parts, layout, info = plan_parts(b, FabParams(scale="1:100", hole=3, margin=15))
+    assert info["params"].joints == "marks" and "engraved as marks" in info["joints_fallback"]
+    assert all(len(p.holes) == 0 for p in parts)
+    assert sum(len(p.scores) for p in parts) == sum(len(p.strip.joint_s) for p in parts)
+    # a scale at which the holes fit keeps them and reports no fallback
+    parts, _, info = plan_parts(b, FabParams(hole=3, margin=15))
+    assert info["joints_fallback"] is None and info["params"].joints == "hole"
+    assert sum(len(p.holes) for p in parts) > 0

@@ -40,8 +40,10 @@ def add_args(p: argparse.ArgumentParser) -> None:
     g.add_argument("--scale", default="1:10",
                    help="model scale, e.g. 1:10 (default), 1:1 or 0.1")
     g = p.add_argument_group("joints")
-    g.add_argument("--joints", choices=JOINT_STYLES, default=FabParams.joints,
-                   help=choice_help(JOINT_HELP, JOINT_STYLES, FabParams.joints))
+    g.add_argument("--joints", choices=JOINT_STYLES, default=None,
+                   help=choice_help(JOINT_HELP, JOINT_STYLES, FabParams.joints) +
+                   "; by default joints too close for holes at this scale are engraved as "
+                   "marks (with a warning), an explicit --joints refuses them instead")
     g.add_argument("--hole", type=float, default=3.0, help="hole diameter, mm (default 3)")
     g.add_argument("--clearance", type=float, default=0.2,
                    help="slot width = thickness + clearance, mm (default 0.2)")
@@ -51,8 +53,9 @@ def add_args(p: argparse.ArgumentParser) -> None:
     g.add_argument("--gap", type=float, default=5.0,
                    help="gap between parts and to the sheet edges, mm (default 5)")
     g.add_argument("--overlap", type=float, default=None,
-                   help="splice overlap of lamellae split to fit a sheet, mm (default: one joint "
-                        "spacing plus two margins, so the pieces share two joints)")
+                   help="splice overlap of lamellae split to fit a sheet, mm (default: at a joint, "
+                        "one joint spacing plus two margins, so the pieces share two joints; "
+                        "between joints, two widths plus two margins)")
     g.add_argument("--kerf", type=float, default=0.0,
                    help="laser kerf, mm: outlines move out and holes in by kerf/2 (default 0: off)")
     g.add_argument("--dxf-version", choices=DXF_VERSIONS, default=FabParams.dxf_version,
@@ -93,7 +96,9 @@ def run(args: Any) -> int:
 
     progress = Progress(args)
     params = FabParams(width=args.width, thickness=args.thickness, hole=args.hole,
-                       joints=args.joints, clearance=args.clearance, margin=args.margin,
+                       joints=args.joints or FabParams.joints,
+                       fallback_marks=args.joints is None, clearance=args.clearance,
+                       margin=args.margin,
                        axis=args.axis, scale=args.scale, sheet=args.sheet, gap=args.gap,
                        overlap=args.overlap, kerf=args.kerf, dxf_version=args.dxf_version,
                        segments=args.segments, labels=not args.no_labels)
@@ -123,6 +128,8 @@ def run(args: Any) -> int:
                                   for d in rep["pieces_split"]) or "none",
         "files": ", ".join(rep["files"]),
     }
+    if rep["joints_fallback"]:
+        summary["warning"] = rep["joints_fallback"]
     if rep["labels_dropped"]:
         summary["labels dropped (no room)"] = rep["labels_dropped"]
     print_summary(args, "Fabrication", summary)
