@@ -139,7 +139,7 @@ def write_bundle(path: str | Path, bundle: DesignBundle,
                  extra: dict[str, bytes | Callable[[Path], None]] | None = None) -> Path:
     """Write ``bundle`` to directory ``path`` atomically; ``extra`` maps file names to bytes
     or to a callable that writes that file given its full path. Returns ``path``."""
-    from .quadmesh import write_mesh, write_polylines
+    from .meshfile import write_mesh, write_polylines
 
     path = Path(path)
     with atomic_dir(path, owner="gg" if bundle.kind == "GG" else "ncp",
@@ -174,10 +174,10 @@ def write_bundle(path: str | Path, bundle: DesignBundle,
 def _check_obj_orientation(directory: Path) -> None:
     """:class:`GridshellError` (a bug) if an OBJ under ``directory`` (``extra`` files given as
     bytes included) has inconsistently oriented faces: every OBJ of a bundle passes its own
-    readers (:func:`gridshell.quadmesh.orientation_problem`, combinatorial, so collapsed
+    readers (:func:`gridshell.meshfile.orientation_problem`, combinatorial, so collapsed
     loops pass)."""
     from .errors import GridshellError
-    from .quadmesh import orientation_problem, read_configuration
+    from .meshfile import orientation_problem, read_configuration
 
     for f in sorted(directory.rglob("*.obj")):
         V, P, sizes = read_configuration(f)
@@ -231,7 +231,7 @@ def read_net_mesh(path: str | Path):
     Loops may touch at a corner only (where a loop of the net is missing), so vertices whose
     loops form several fans are accepted; every other check of ``read_mesh`` applies.
     """
-    from .quadmesh import read_mesh
+    from .meshfile import read_mesh
 
     return read_mesh(path, kind="quad", manifold_vertices=False)
 
@@ -315,7 +315,7 @@ def _finite_field(value: Any, what: str) -> None:
 
 def read_bundle(path: str | Path) -> DesignBundle:
     """Read a design bundle directory written by :func:`write_bundle`."""
-    from .quadmesh import read_configuration, read_mesh, read_polylines
+    from .meshfile import read_configuration, read_mesh, read_polylines
 
     path = Path(path)
     d = read_design_json(path)

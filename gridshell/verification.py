@@ -182,7 +182,7 @@ def verify_bundle(path: str | Path) -> dict[str, Any]:
                            deviation, geodesic_turning, summary)
     from .net import Net
     from .quality import design_gates, failing
-    from .quadmesh import read_configuration, read_mesh, read_polylines
+    from .meshfile import read_configuration, read_mesh, read_polylines
 
     path = Path(path)
     d = read_design_json(path)

@@ -12,7 +12,7 @@ import numpy as np
 from gridshell.bundle import DesignBundle, write_bundle
 from gridshell.grid import grid_quads
 from gridshell.net import Lamella, Net, polyline_arclength
-from gridshell.quadmesh import write_mesh
+from gridshell.meshfile import write_mesh
 
 N = 4  # joints per lamella
 DENSE = 7  # axis points per joint-to-joint segment

@@ -12,7 +12,7 @@ from gridshell.bundle import DesignBundle, read_bundle, write_bundle
 from gridshell.cli.main import main
 from gridshell.grid import grid_quads
 from gridshell.net import Lamella, Net
-from gridshell.quadmesh import write_mesh
+from gridshell.meshfile import write_mesh
 
 
 def _helicoid_target(tmp_path, n=12):

@@ -6,7 +6,7 @@ import pytest
 
 from gridshell.cli.main import main
 from gridshell.grid import grid_quads
-from gridshell.quadmesh import write_mesh
+from gridshell.meshfile import write_mesh
 
 from ncp_cases import PHLW_SADDLE, pseudosphere, torus_grid
 

@@ -5,7 +5,7 @@ import numpy as np
 
 from gridshell.cli.main import main
 from gridshell.grid import grid_quads
-from gridshell.quadmesh import write_mesh
+from gridshell.meshfile import write_mesh
 
 
 def _torus_obj(path, a=12, b=12, inner=False):

@@ -22,7 +22,7 @@ from ncp_cases import torus_grid
 from gridshell.bspline import fit_grid
 from gridshell.cli.main import main
 from gridshell.grid import grid_quads
-from gridshell.quadmesh import write_mesh
+from gridshell.meshfile import write_mesh
 
 # --------------------------------------------------------------------------- small options
 

@@ -12,7 +12,7 @@ import pytest
 from gridshell import manifest
 from gridshell.cli.main import main
 from gridshell.grid import grid_quads
-from gridshell.quadmesh import read_configuration, write_mesh
+from gridshell.meshfile import read_configuration, write_mesh
 
 GG = ["--no-preview", "--frames", "0", "-q"]
 

@@ -72,7 +72,7 @@ def test_write_gg_bundle(tmp_path):
     d = read_design_json(out)
     assert d["kind"] == "GG" and len(d["lamellae"]) == len(st["net"].lamellae)
     # the alignment sequence: net.obj first, aligned.obj last, pictures and a GIF
-    from gridshell.quadmesh import read_configuration
+    from gridshell.meshfile import read_configuration
     from gridshell.render.sequence import read_sequence
     frames, loops = read_sequence(out)
     assert len(frames) == 4
@@ -229,7 +229,7 @@ def test_every_obj_of_a_gg_bundle_is_consistently_oriented(tmp_path, meridians, 
     # fabricate refused it
     from gg_cases import sphere
 
-    from gridshell.quadmesh import read_mesh
+    from gridshell.meshfile import read_mesh
 
     P = revolution_grid(sphere(1.0), np.linspace(0.3, 1.6, 14), np.linspace(0.0, 1.2, 12))
     V, F = _mesh(P)

@@ -18,7 +18,7 @@ from gridshell.bundle import write_bundle
 from gridshell.cli.main import main
 from gridshell.errors import OutputError
 from gridshell.grid import grid_quads
-from gridshell.quadmesh import write_mesh
+from gridshell.meshfile import write_mesh
 
 GG = ["--grid", "6", "6", "--lamellae", "3", "--no-preview", "--frames", "0", "-q"]
 

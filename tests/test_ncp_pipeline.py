@@ -11,7 +11,8 @@ from gridshell.verification import verify_bundle
 from gridshell.diffgeo import surface_curvature
 from gridshell.ncp.collapse import fit_circle, fit_plane, line_deviation
 from gridshell.ncp.pipeline import crossing_normal_curvature, design_ncp, write_ncp
-from gridshell.quadmesh import bbox_diagonal, read_configuration, write_mesh
+from gridshell.quadmesh import bbox_diagonal
+from gridshell.meshfile import read_configuration, write_mesh
 
 from ncp_cases import PHLW_SADDLE, pseudosphere, torus
 
@@ -212,7 +213,7 @@ def _oriented(F):
 
 
 def test_every_obj_of_a_bundle_is_consistently_oriented(aa_bundle, cnc_bundle):
-    from gridshell.quadmesh import read_mesh
+    from gridshell.meshfile import read_mesh
 
     for _, _, out in (aa_bundle, cnc_bundle):
         names = ["net.obj", "surface.obj", "aligned.obj"] + sorted(

@@ -6,8 +6,8 @@ import pytest
 
 from gridshell.errors import MeshError
 from gridshell.grid import grid_quads
-from gridshell.quadmesh import (QuadMesh, TriMesh, read_mesh, read_polylines, validate_mesh,
-                                write_mesh, write_polylines)
+from gridshell.quadmesh import QuadMesh, TriMesh, validate_mesh
+from gridshell.meshfile import read_mesh, read_polylines, write_mesh, write_polylines
 
 
 def planar_grid(R: int = 4, C: int = 5, h: float = 0.5) -> QuadMesh:
@@ -271,7 +271,7 @@ def test_quadmesh_checks_input():
 
 
 def test_read_configuration_accepts_a_collapsed_net_but_not_garbage(tmp_path):
-    from gridshell.quadmesh import read_configuration
+    from gridshell.meshfile import read_configuration
     # a collapsed net: every loop's joints on the x axis, zero area by design
     V = np.array([[0.0, 0, 0], [1, 0, 0], [2, 0, 0], [1.5, 0, 0]])
     F = np.array([[0, 1, 2, 3]])

@@ -13,7 +13,7 @@ from fab_cases import make_bundle
 from gridshell.bundle import write_bundle
 from gridshell.cli.main import main
 from gridshell.errors import GridshellError, InputError
-from gridshell.quadmesh import orientation_problem, read_configuration, write_mesh
+from gridshell.meshfile import orientation_problem, read_configuration, write_mesh
 from gridshell.verification import verify_bundle
 
 FLAT = {"c": 0.0, "twist": 0.0, "stretch": 0.0}  # a plane rectangular grid: Delta_a = 0

@@ -136,7 +136,7 @@ def _ncp(root: Path, sizes: dict, progress) -> dict[str, Any]:
     from ..ncp.phlw import optimize_phlw, write_phlw
     from ..ncp.pipeline import design_ncp, write_ncp
     from ..ncp.reference import initial_surface
-    from ..quadmesh import read_mesh
+    from ..meshfile import read_mesh
     from ..verification import verify_bundle
 
     t0 = time.perf_counter()

@@ -58,7 +58,7 @@ def _load_reference(path: str, args: Any) -> tuple[Any, Any, Any]:
     """(initial surface, V, F) from a mesh or a B-spline JSON."""
     from ..bspline import BSplineSurface
     from ..ncp.reference import initial_surface
-    from ..quadmesh import read_mesh
+    from ..meshfile import read_mesh
 
     if str(path).lower().endswith(".json"):
         surf = BSplineSurface.load(path)

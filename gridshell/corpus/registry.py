@@ -120,7 +120,7 @@ class Reference:
 
     def write_obj(self, path: str | Path) -> Path:
         """Write the mesh as an OBJ file (exact coordinates; atomic); returns the path."""
-        from ..quadmesh import write_mesh
+        from ..meshfile import write_mesh
 
         path = Path(path)
         V, F = self.mesh_arrays()

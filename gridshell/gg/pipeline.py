@@ -268,7 +268,7 @@ def gg_score(P: np.ndarray, **net_options: Any) -> float:
 
 
 def _load_target(target: Any) -> tuple[np.ndarray, np.ndarray, str | None]:
-    from ..quadmesh import read_mesh
+    from ..meshfile import read_mesh
 
     if isinstance(target, (str, Path)):
         m = read_mesh(target, kind="any")
@@ -440,7 +440,7 @@ def write_gg(path: str | Path, bundle: DesignBundle, *, preview: bool = True,
     frames : int
         Steps of a computed sequence; 0 writes none.
     """
-    from ..quadmesh import write_mesh
+    from ..meshfile import write_mesh
 
     net = bundle.net
     extra: dict[str, Any] = {}

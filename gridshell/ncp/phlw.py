@@ -651,7 +651,7 @@ def write_phlw(directory: str | Any, res: PHLWResult, sample_grid: tuple[int, in
     from pathlib import Path
 
     from ..atomic import atomic_dir, write_text
-    from ..quadmesh import write_mesh
+    from ..meshfile import write_mesh
     from ..render.curvature_diagram import curvature_diagram
 
     directory = Path(directory)

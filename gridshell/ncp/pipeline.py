@@ -64,7 +64,7 @@ def load_surface(source: Any, *, mode: str, phlw_options: dict | None = None,
         return source.surface, n, {"source": "phlw-result", "phlw_mode": source.mode}
     if isinstance(source, (str, Path)) and str(source).lower().endswith(".json"):
         return BSplineSurface.load(source), None, {"source": str(source)}
-    from ..quadmesh import read_mesh
+    from ..meshfile import read_mesh
     from .reference import initial_surface
 
     opts = dict(phlw_options or {})
@@ -410,7 +410,7 @@ def write_ncp(path: str | Path, bundle: DesignBundle, report: dict, *, render: b
     """
     import io
 
-    from ..quadmesh import write_mesh
+    from ..meshfile import write_mesh
 
     st: NCPState = report["state"]
     net = bundle.net

@@ -37,14 +37,14 @@ def read_sequence(bundle_dir: str | os.PathLike) -> tuple[list[np.ndarray], np.n
 
     The faces come from the first frame; every frame must have the same vertex count. The
     collapsed frames are degenerate meshes by design, so the files are read without the mesh
-    checks of :func:`gridshell.quadmesh.read_mesh`.
+    checks of :func:`gridshell.meshfile.read_mesh`.
 
     Raises
     ------
     InputError
         No ``sequence/frame_*.obj`` in the bundle, or frames of different sizes.
     """
-    from ..quadmesh import read_configuration
+    from ..meshfile import read_configuration
 
     files = sequence_files(bundle_dir)
     if not files:
