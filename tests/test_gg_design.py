@@ -84,11 +84,14 @@ def test_noisy_catenoid_converges_near_the_target():
     assert d.geodesic_residual_max < 1e-3 and d.length_residual_rel_max < 1e-3
     assert np.abs(geodesic_residual(d.P)).max() == pytest.approx(d.geodesic_residual_max)
     assert d.deviation["max"] < 2.0  # from the noisy target: the noise is up to 1 %
-    # from the clean catenoid the design is closer than the noise was (|noise| averages 0.56 %
-    # of the diagonal, up to 1 %)
+    # from the clean catenoid the design is on average closer than the noise was (|noise|
+    # averages 0.56 % of the diagonal, up to 1 %); its largest deviation is larger (1.94 %, a
+    # boundary vertex; 1.11 % without the orthogonality constraint, which let the meridians
+    # shear after the noise - the figures were then 0.75 of the thresholds, now 0.26)
     from gridshell.metrics import deviation
     clean = deviation(d.P.reshape(-1, 3), *_quads(P))
-    assert clean["mean"] < 0.4 and clean["max"] < 1.2, clean
+    assert clean["mean"] < 0.4 and clean["max"] < 2.0, clean
+    assert gg_score(d.P) < 0.5
     assert d.report["after"]["geodesic"]["rms"] < 1e-3 * d.report["before"]["geodesic"]["rms"]
     # every solver run lowers its energy; the constraint energy drops by orders of magnitude,
     # monotonically through the polish

@@ -57,159 +57,27 @@ from __future__ import annotations
 
 import time
 from dataclasses import asdict, dataclass, field, fields
-from typing import Any, Callable, Mapping, NamedTuple
+from typing import Any, Callable, Mapping
 
 import numpy as np
 import scipy.sparse as sp
 
 from ..errors import InputError
-from ..solver import Layout, Problem, TermResult, result, solve, term
+from ..solver import Layout, Problem, solve
 from ..solver import terms as T
+from .constraints import (EdgeGroups, GridShape, diagonal_residual_rel, edge_groups,
+                          equal_diagonals, equal_lengths, geodesic_meridians, geodesic_residual,
+                          init_group_lengths, length_residual_rel)
 
 __all__ = ["GGDesign", "GGWeights", "design_gg_surface", "edge_groups", "equal_lengths",
            "fairness_matrix", "geodesic_meridians", "geodesic_residual", "GridShape",
-           "EdgeGroups", "init_group_lengths", "length_residual_rel"]
+           "EdgeGroups", "init_group_lengths", "length_residual_rel", "equal_diagonals",
+           "diagonal_residual_rel"]
 
 Progress = Callable[[str], None] | None
 
 
-# ============================================================================ terms
-
-class GridShape(NamedTuple):
-    """Data of :func:`geodesic_meridians`: block ``block`` holds an ``R x C`` grid row-major."""
-
-    shape: tuple[int, int]
-    block: str = "P"
-
-
-def _angle_grads(u: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``theta = atan2(|u x w|, u.w)`` ``(m,)`` and its gradients w.r.t. ``u`` and ``w`` ``(m,3)``.
-
-    ``d theta / du = (u x n) / (|u|^2 |n|)``, ``d theta / dw = (n x w) / (|w|^2 |n|)`` with
-    ``n = u x w`` (minus the unit part of ``w`` normal to ``u``, over ``|u|``).
-    """
-    n = np.cross(u, w)
-    s = np.linalg.norm(n, axis=1)
-    c = np.einsum("ij,ij->i", u, w)
-    theta = np.arctan2(s, c)
-    s_ = np.maximum(s, 1e-300)
-    gu = np.cross(u, n) / (np.einsum("ij,ij->i", u, u) * s_)[:, None]
-    gw = np.cross(n, w) / (np.einsum("ij,ij->i", w, w) * s_)[:, None]
-    return theta, gu, gw
-
-
-def _stencil(shape: tuple[int, int]) -> tuple[np.ndarray, ...]:
-    """Flat indices of interior vertices and their neighbours ``a`` (i-1), ``b`` (i+1),
-    ``l`` (j-1), ``r`` (j+1)."""
-    R, C = shape
-    idx = np.arange(R * C).reshape(R, C)
-    return (idx[1:-1, 1:-1].ravel(), idx[:-2, 1:-1].ravel(), idx[2:, 1:-1].ravel(),
-            idx[1:-1, :-2].ravel(), idx[1:-1, 2:].ravel())
-
-
-@term
-def geodesic_meridians(x: np.ndarray, layout: Layout, data: GridShape) -> TermResult:
-    """Paper Fig. 12a: ``r = ang(a,l) + ang(l,b) - ang(a,r) - ang(r,b)`` (radians) at every
-    interior vertex: the meridians ``P[:, j]`` are discrete geodesics."""
-    X = layout.view(x, data.block).reshape(-1, 3)
-    cols_blk = layout.indices(data.block).reshape(-1, 3)
-    c0, ia, ib, il, ir = _stencil(data.shape)
-    m = len(c0)
-    r = np.zeros(m)
-    rows, cols, vals = [], [], []
-    rr = np.repeat(np.arange(m), 3)
-    for sign, p, q in ((1.0, ia, il), (1.0, il, ib), (-1.0, ia, ir), (-1.0, ir, ib)):
-        th, gu, gw = _angle_grads(X[p] - X[c0], X[q] - X[c0])
-        r += sign * th
-        for vert, g in ((p, gu), (q, gw), (c0, -(gu + gw))):
-            rows.append(rr)
-            cols.append(cols_blk[vert].ravel())
-            vals.append(sign * g.ravel())
-    if m == 0:
-        z = np.zeros(0)
-        return result(z, z, z, z)
-    return result(r, np.concatenate(rows), np.concatenate(cols), np.concatenate(vals))
-
-
-def geodesic_residual(P: np.ndarray) -> np.ndarray:
-    """Residual of :func:`geodesic_meridians` on ``P (R, C, 3)``, radians, ``(R-2, C-2)``."""
-    P = np.asarray(P, float)
-    R, C = P.shape[:2]
-    lay = Layout({"P": (R * C, 3)})
-    return geodesic_meridians(P.reshape(-1), lay, GridShape((R, C))).r.reshape(R - 2, C - 2)
-
-
-class EdgeGroups(NamedTuple):
-    """Data of :func:`equal_lengths`: edges ``p[k] -> q[k]`` of block ``block`` whose lengths
-    all equal the auxiliary ``aux[group[k]]``."""
-
-    block: str
-    aux: str
-    p: np.ndarray
-    q: np.ndarray
-    group: np.ndarray
-
-
-def edge_groups(shape: tuple[int, int], family: str, block: str = "P",
-                aux: str | None = None) -> EdgeGroups:
-    """Edge groups of an ``R x C`` grid: ``"parallel"`` (edges ``(i,j)-(i,j+1)``, group ``i``,
-    aux ``"l"``) or ``"meridian"`` (edges ``(i,j)-(i+1,j)``, group ``i``, aux ``"h"``)."""
-    R, C = shape
-    idx = np.arange(R * C).reshape(R, C)
-    if family == "parallel":
-        p, q = idx[:, :-1], idx[:, 1:]
-        g = np.broadcast_to(np.arange(R)[:, None], p.shape)
-        aux = aux or "l"
-    elif family == "meridian":
-        p, q = idx[:-1, :], idx[1:, :]
-        g = np.broadcast_to(np.arange(R - 1)[:, None], p.shape)
-        aux = aux or "h"
-    else:
-        raise InputError(f"family must be 'parallel' or 'meridian', got {family!r}")
-    return EdgeGroups(block, aux, p.ravel(), q.ravel(), np.ascontiguousarray(g).ravel())
-
-
-@term
-def equal_lengths(x: np.ndarray, layout: Layout, data: EdgeGroups) -> TermResult:
-    """``r = |X[q] - X[p]| - a[group]`` (metres): the edges of a group have one length ``a``
-    (parallels: isometry with a surface of revolution; meridians: geodesic parallels)."""
-    X = layout.view(x, data.block).reshape(-1, 3)
-    A = layout.view(x, data.aux).reshape(-1)
-    cols_blk = layout.indices(data.block).reshape(-1, 3)
-    cols_aux = layout.indices(data.aux).reshape(-1)
-    e = X[data.q] - X[data.p]
-    n = np.linalg.norm(e, axis=1)
-    r = n - A[data.group]
-    t = e / np.maximum(n, 1e-300)[:, None]
-    m = len(r)
-    rows = np.concatenate([np.repeat(np.arange(m), 3), np.repeat(np.arange(m), 3), np.arange(m)])
-    cols = np.concatenate([cols_blk[data.q].ravel(), cols_blk[data.p].ravel(),
-                           cols_aux[data.group]])
-    vals = np.concatenate([t.ravel(), -t.ravel(), -np.ones(m)])
-    return result(r, rows, cols, vals)
-
-
-def init_group_lengths(X: np.ndarray, data: EdgeGroups) -> np.ndarray:
-    """Initial auxiliary of :func:`equal_lengths`: the mean edge length of each group, metres."""
-    X = np.asarray(X, float).reshape(-1, 3)
-    n = np.linalg.norm(X[data.q] - X[data.p], axis=1)
-    k = int(data.group.max()) + 1 if len(data.group) else 0
-    return np.bincount(data.group, n, k) / np.maximum(np.bincount(data.group, None, k), 1)
-
-
-def length_residual_rel(P: np.ndarray) -> dict[str, float]:
-    """Largest relative spread of edge lengths within a parallel (``parallel``) and within a
-    meridian strip (``meridian``): ``max |e - mean| / mean`` over each group."""
-    P = np.asarray(P, float)
-    shape = P.shape[:2]
-    out = {}
-    for fam in ("parallel", "meridian"):
-        g = edge_groups(shape, fam)
-        mean = init_group_lengths(P, g)
-        n = np.linalg.norm(P.reshape(-1, 3)[g.q] - P.reshape(-1, 3)[g.p], axis=1)
-        out[fam] = float(np.max(np.abs(n - mean[g.group]) / np.maximum(mean[g.group], 1e-300)))
-    return out
-
+# ============================================================================ fairness
 
 def fairness_matrix(shape: tuple[int, int]) -> sp.csr_matrix:
     """Second differences ``X[k-1] - 2 X[k] + X[k+1]`` along meridians and along parallels of
@@ -241,6 +109,9 @@ class GGWeights:
         Geodesic meridians (angle sums), 1.
     lengths : float
         Equal edge lengths along parallels and across meridian strips, 1.
+    orthogonal : float
+        Equal diagonals in every quad (meridians orthogonal to the parallels, see
+        :mod:`gridshell.gg.constraints`), 1; in the rounds and the polish like the others.
     closeness : float
         Gliding on the target (distance to the tangent plane at the closest point), 0.1:
         below the constraints so that they dominate.
@@ -289,6 +160,7 @@ class GGWeights:
 
     geodesic: float = 1.0
     lengths: float = 1.0
+    orthogonal: float = 1.0
     closeness: float = 0.1
     boundary: float = 0.1
     fairness: float = 1e-4
@@ -358,7 +230,8 @@ class GGDesign:
     geodesic_residual_max : float
         Largest |angle-sum difference|, radians.
     length_residual_rel_max : float
-        Largest relative spread of edge lengths within a parallel or a meridian strip.
+        Largest relative spread of edge lengths within a parallel or a meridian strip, or
+        relative difference of the two diagonals of a quad.
     """
 
     P: np.ndarray
@@ -447,7 +320,8 @@ def _surface_gliding(X: np.ndarray, V: np.ndarray, F: np.ndarray) -> T.Gliding:
 def _figures(P: np.ndarray) -> tuple[float, float]:
     g = geodesic_residual(P)
     lr = length_residual_rel(P)
-    return float(np.max(np.abs(g))) if g.size else 0.0, max(lr.values())
+    return (float(np.max(np.abs(g))) if g.size else 0.0,
+            max(max(lr.values()), diagonal_residual_rel(P)))
 
 
 #: a continuation round that moves no vertex by more than this many mean edge lengths, with
@@ -465,7 +339,7 @@ POLISH_STALL = 1e-2
 #: by less than this fraction since the previous check
 SCORE_STALL = 0.05
 
-_CONSTRAINTS = ("geodesic", "parallel_lengths", "meridian_lengths")
+_CONSTRAINTS = ("geodesic", "parallel_lengths", "meridian_lengths", "orthogonal")
 
 
 def design_gg_surface(target_V: Any, target_F: Any, P0: Any, *,
@@ -549,6 +423,7 @@ def design_gg_surface(target_V: Any, target_F: Any, P0: Any, *,
                 .add("geodesic", w.geodesic, geodesic_meridians, GridShape((R, C)))
                 .add("parallel_lengths", w.lengths * s2, equal_lengths, par)
                 .add("meridian_lengths", w.lengths * s2, equal_lengths, mer)
+                .add("orthogonal", w.orthogonal * s2, equal_diagonals, GridShape((R, C)))
                 .add("closeness", w.closeness * s2, T.gliding, _surface_gliding(X, V, Ft))
                 .add("boundary", w.boundary * s2, T.gliding, _boundary_gliding(X, P0flat, sides))
                 .add("fairness", w.fairness * s2, T.linear, T.Linear("P", D))
@@ -652,6 +527,7 @@ def _polish(x: np.ndarray, lay: Layout, shape: tuple[int, int], w: GGWeights,
                .add("geodesic", w.geodesic, geodesic_meridians, GridShape((R, C)))
                .add("parallel_lengths", w.lengths * s2, equal_lengths, par)
                .add("meridian_lengths", w.lengths * s2, equal_lengths, mer)
+               .add("orthogonal", w.orthogonal * s2, equal_diagonals, GridShape((R, C)))
                .add("proximity", w.polish_proximity * s2, T.closeness, T.Closeness("P", Xs)))
         if w.polish_elastic > 0:
             pol.add("elastic", w.polish_elastic * w.polish_elastic_decay ** done * s2, T.linear,

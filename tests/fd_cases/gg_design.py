@@ -1,11 +1,11 @@
-"""FD cases of the GG surface-design terms (gridshell.gg.design, paper 4.1.1).
+"""FD cases of the GG surface-design terms (gridshell.gg.constraints, paper 4.1.1).
 
 A 5 x 4 grid on a perturbed saddle with random auxiliary lengths, so that every angle and
 length is generic (no angle near 0 or pi, where atan2's gradient is singular).
 """
 import numpy as np
 
-from gridshell.gg import design as D
+from gridshell.gg import constraints as D
 from gridshell.solver import Layout
 
 R, C = 5, 4
@@ -31,6 +31,7 @@ def _parallel_lengths(rng):
 
 
 CASES = {
-    "gridshell.gg.design.geodesic_meridians": _geodesic,
-    "gridshell.gg.design.equal_lengths": _parallel_lengths,
+    "gridshell.gg.constraints.geodesic_meridians": _geodesic,
+    "gridshell.gg.constraints.equal_lengths": _parallel_lengths,
+    "gridshell.gg.constraints.equal_diagonals": _geodesic,
 }
