@@ -771,7 +771,8 @@ def test_choices_are_the_registries(i, monkeypatch):
     registry = getattr(module, name)
     choices, default, text = _choices(command, option)
     assert choices == tuple(registry)
-    assert default in choices
+    # --joints defaults to None: holes, engraved as marks where they would merge at the scale
+    assert default in choices or (option == "--joints" and default is None)
     assert all(c in text for c in choices)
     # a choice the registry gains is offered without touching the CLI
     grown = {**registry, "zz": "ZZ"} if isinstance(registry, dict) else (*registry, "zz")
