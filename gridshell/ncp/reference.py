@@ -24,12 +24,17 @@ class InitialFit:
     rms : root mean square fitting residual, metres
     method : "grid" (structured quad grid, rows -> u) or "parameterized" (libigl LSCM + scattered fit)
     grid_shape : (R, C) of the vertex grid for "grid", else None
+    principal : the principal angle of the first fit's parameter plane
+        (:class:`gridshell.ncp.principal_frame.PrincipalAngle`), None if not measured
+    rotated_deg : the angle the parameter plane was turned by before the final fit (0: kept)
     """
 
     surface: BSplineSurface
     rms: float
     method: str
     grid_shape: tuple[int, int] | None = None
+    principal: Any = None
+    rotated_deg: float = 0.0
 
 
 def _arrays(mesh: Any, F: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
@@ -48,7 +53,7 @@ def _arrays(mesh: Any, F: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
 
 def initial_surface(mesh: Any, F: np.ndarray | None = None, *, n_ctrl: tuple[int, int] = (9, 9),
                     degree: tuple[int, int] = (4, 4), smoothing: float = 1e-6,
-                    transpose: bool = False) -> InitialFit:
+                    transpose: bool = False, align: bool = True) -> InitialFit:
     """Least-squares B-spline of a reference mesh (paper defaults: bi-degree 4, 9 x 9 control
     points).
 
@@ -61,6 +66,10 @@ def initial_surface(mesh: Any, F: np.ndarray | None = None, *, n_ctrl: tuple[int
     smoothing : relative thin-plate weight of the fit (see :func:`gridshell.bspline.fit_grid`);
         scattered data (triangle meshes) use at least 1e-4
     transpose : swap u and v (grid rows -> v); the PHLW rows then follow the other family
+    align : turn the parameter plane onto the mean principal directions of the first fit
+        (:mod:`gridshell.ncp.principal_frame`) when they are more than
+        :data:`~gridshell.ncp.principal_frame.ALIGN_MIN_DEG` off the parameter lines, and
+        refit; below that the first fit is returned unchanged
 
     Returns
     -------
@@ -85,7 +94,15 @@ def initial_surface(mesh: Any, F: np.ndarray | None = None, *, n_ctrl: tuple[int
                                  f"fewer than the {nu} x {nv} control points; use fewer control "
                                  "points or a denser grid")
             surf, rms = fit_grid(P, nu, nv, du, dv, smoothing=smoothing)
-            return InitialFit(surf, rms, "grid", (P.shape[0], P.shape[1]))
+            fit = InitialFit(surf, rms, "grid", (P.shape[0], P.shape[1]))
+            if not align:
+                return fit
+            from ..bspline import _chord_params
+
+            pu, pv = np.meshgrid(_chord_params(P), _chord_params(P.transpose(1, 0, 2)),
+                                 indexing="ij")
+            return _aligned(fit, P.reshape(-1, 3), pu.ravel(), pv.ravel(), (nu, nv), (du, dv),
+                            max(smoothing, 1e-4))
     from ..igl_adapter import parameterize_disk
 
     UV = parameterize_disk(V, F)
@@ -96,7 +113,24 @@ def initial_surface(mesh: Any, F: np.ndarray | None = None, *, n_ctrl: tuple[int
                          "control points; use fewer control points or a denser mesh")
     surf, rms = fit_points(V, UV[:, 0], UV[:, 1], nu, nv, du, dv,
                            smoothing=max(smoothing, 1e-4))
-    return InitialFit(surf, rms, "parameterized", None)
+    fit = InitialFit(surf, rms, "parameterized", None)
+    if not align:
+        return fit
+    return _aligned(fit, V, UV[:, 0], UV[:, 1], (nu, nv), (du, dv), max(smoothing, 1e-4))
+
+
+def _aligned(fit: InitialFit, P: np.ndarray, u: np.ndarray, v: np.ndarray,
+             n_ctrl: tuple[int, int], degree: tuple[int, int], smoothing: float) -> InitialFit:
+    """``fit`` with its principal angle measured, refitted in the turned parameter plane when
+    the misalignment is at least ALIGN_MIN_DEG (:mod:`gridshell.ncp.principal_frame`)."""
+    from .principal_frame import ALIGN_MIN_DEG, principal_angle, rotated_fit
+
+    pa = principal_angle(fit.surface)
+    fit.principal = pa
+    if abs(pa.angle_deg) < ALIGN_MIN_DEG or not pa.residual_deg < pa.misalignment_deg:
+        return fit
+    surf, rms = rotated_fit(P, u, v, pa, n_ctrl, degree, smoothing)
+    return InitialFit(surf, rms, fit.method, fit.grid_shape, pa, pa.angle_deg)
 
 
 def boundary_segments(F: np.ndarray, return_faces: bool = False
