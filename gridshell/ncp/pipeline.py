@@ -105,7 +105,9 @@ def load_surface(source: Any, *, mode: str, phlw_options: dict | None = None,
     e1 = res.report_after.get("E_PHLW", {}).get("total") if res.report_after else None
     return res.surface, n, {"source": name, "phlw_deviation": res.deviation,
                             "phlw_converged": res.converged, "phlw_diagnostics": res.diagnostics,
-                            "phlw_energy": [e0, e1]}
+                            "phlw_energy": [e0, e1],
+                            "phlw_figures": {k: f["value"] for k, f in (res.figures or {}).items()},
+                            "phlw_aligned_deg": float(init.rotated_deg)}
 
 
 def _phlw_failure(info: dict, mode: str, exc: Exception) -> ConvergenceError:
