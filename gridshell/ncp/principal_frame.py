@@ -22,6 +22,10 @@ from ..diffgeo import surface_curvature
 
 #: Below this mean misalignment (degrees) the parametrization is kept as it is.
 ALIGN_MIN_DEG = 5.0
+#: A turn is kept only if the refit's coverage and deviation (% of the reference's diagonal)
+#: stay within this fraction of the PHLW step's tolerances (the optimizer loses coverage:
+#: corpus associate-07, a 44 degree turn, 16 % before the PHLW step, 28 % after).
+ALIGN_BUDGET = 1.0
 
 
 @dataclass
@@ -124,16 +128,16 @@ def _balanced_rectangle(XY: np.ndarray, n_side: int = 24) -> tuple[np.ndarray, n
 
 def rotated_fit(P: np.ndarray, u: np.ndarray, v: np.ndarray, pa: PrincipalAngle,
                 n_ctrl: tuple[int, int], degree: tuple[int, int],
-                smoothing: float) -> tuple[BSplineSurface, float]:
+                smoothing: float, angle_deg: float | None = None) -> tuple[BSplineSurface, float]:
     """Refit the points ``P (k, 3)`` with parameters ``u, v (k,)`` of a first fit, the
     parameter plane turned by ``-pa.angle_deg`` so that ``u`` follows the k1 direction.
 
     The new domain is the rectangle of :func:`_balanced_rectangle`, mapped onto [0, 1]^2;
     points outside it are left out of the fit. Returns the surface and the RMS residual of
-    the points fitted (metres).
+    the points fitted (metres). ``angle_deg`` turns by another angle than ``pa.angle_deg``.
     """
     lu, lv = pa.scale
-    phi = math.radians(pa.angle_deg)
+    phi = math.radians(pa.angle_deg if angle_deg is None else angle_deg)
     X = np.column_stack([u * lu, v * lv])
     c, s = math.cos(phi), math.sin(phi)
     XY = X @ np.array([[c, -s], [s, c]])            # rows: (x, y) . (cos, sin), (-sin, cos)
