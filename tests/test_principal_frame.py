@@ -85,21 +85,50 @@ def test_torus_zone_along_meridians_is_zero_and_kept():
     np.testing.assert_array_equal(on.surface.ctrl, off.surface.ctrl)
 
 
-@pytest.mark.parametrize("tri", [False, True])
-def test_initial_surface_turns_an_associate_onto_its_principal_directions(tri):
-    t = math.radians(50.0)
-    P = _associate(t, n=24).reshape(-1, 3)
-    F = _tris(24, 24) if tri else _quads(24, 24)
-    off = initial_surface(P, F, align=False)
-    on = initial_surface(P, F)
-    assert off.rotated_deg == 0.0 and principal_angle(off.surface).misalignment_deg > 20.0
-    assert abs(on.rotated_deg) > 20.0
+def _disk_associate(t: float, n: int = 600, r: float = 0.6) -> tuple[np.ndarray, np.ndarray]:
+    """A triangulated disk |(u, v)| <= r of the associate at angle t (its boundary is no
+    rectangle, so a turned rectangle covers it as well as the unturned one)."""
+    from scipy.spatial import Delaunay
+
+    rad = np.sqrt(np.linspace(0.0, 1.0, n)) * r
+    ang = np.arange(n) * 2.399963
+    ring = np.linspace(0.0, 2 * np.pi, 80, endpoint=False)
+    uv = np.vstack([np.column_stack([rad * np.cos(ang), rad * np.sin(ang)])[rad < 0.95 * r],
+                    r * np.column_stack([np.cos(ring), np.sin(ring)])])
+    u, v = uv.T
+    C = np.stack([np.cosh(v) * np.cos(u), np.cosh(v) * np.sin(u), v], -1)
+    H = np.stack([np.sinh(v) * np.sin(u), -np.sinh(v) * np.cos(u), u], -1)
+    return math.cos(t) * C + math.sin(t) * H, Delaunay(uv).simplices
+
+
+@pytest.mark.parametrize("tdeg", [40.0, 70.0])
+def test_initial_surface_turns_a_disk_onto_its_principal_directions(tdeg):
+    from gridshell.ncp.phlw import COVERAGE_TOL, deviation_percent, coverage_percent
+
+    P, T = _disk_associate(math.radians(tdeg))
+    off, on = initial_surface(P, T, align=False), initial_surface(P, T)
+    before = principal_angle(off.surface).misalignment_deg
+    assert before > 20.0 and abs(abs(on.rotated_deg) - before) < 3.0
     assert principal_angle(on.surface).misalignment_deg < 3.0
-    # the refit stays on the associate: distance of its samples to the reference grid points
-    S = on.surface.evaluate_grid(np.linspace(0, 1, 15), np.linspace(0, 1, 15)).reshape(-1, 3)
-    d = np.min(np.linalg.norm(S[:, None] - P[None], axis=2), axis=1)
-    diag = np.linalg.norm(P.max(0) - P.min(0))
-    assert d.max() < 0.15 * diag
+    assert coverage_percent(on.surface, P, T) < COVERAGE_TOL
+    assert deviation_percent(on.surface, P, T) < deviation_percent(off.surface, P, T)
+
+
+def test_initial_surface_turns_a_rectangle_only_within_the_tolerances():
+    """A square patch at 25 degrees to its principal directions: a full turn would leave
+    > 10 % of the diagonal uncovered; the turn stops where coverage and deviation hold."""
+    from gridshell.ncp.phlw import COVERAGE_TOL, DEVIATION_TOL, coverage_percent, \
+        deviation_percent
+
+    P = _associate(math.radians(50.0), n=24).reshape(-1, 3)
+    F = _quads(24, 24)
+    on = initial_surface(P, F)
+    assert on.principal is not None and abs(on.principal.angle_deg) > 20.0
+    assert 0.0 < abs(on.rotated_deg) < abs(on.principal.angle_deg)
+    assert coverage_percent(on.surface, P, F) <= COVERAGE_TOL
+    assert deviation_percent(on.surface, P, F) <= DEVIATION_TOL
+    left = principal_angle(on.surface).misalignment_deg
+    assert abs(left - (abs(on.principal.angle_deg) - abs(on.rotated_deg))) < 2.0
 
 
 def test_small_misalignment_keeps_the_fit():
