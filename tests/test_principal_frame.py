@@ -79,8 +79,7 @@ def test_torus_zone_along_meridians_is_zero_and_kept():
     pa = principal_angle(surf)
     assert abs(pa.angle_deg) < 0.1 and pa.misalignment_deg < 0.1
     F = _quads(20, 24)
-    on, off = initial_surface(P.reshape(-1, 3), F), initial_surface(P.reshape(-1, 3), F,
-                                                                     align=False)
+    on, off = initial_surface(P.reshape(-1, 3), F, align=True), initial_surface(P.reshape(-1, 3), F)
     assert on.rotated_deg == 0.0
     np.testing.assert_array_equal(on.surface.ctrl, off.surface.ctrl)
 
@@ -106,7 +105,7 @@ def test_initial_surface_turns_a_disk_onto_its_principal_directions(tdeg):
     from gridshell.ncp.phlw import COVERAGE_TOL, deviation_percent, coverage_percent
 
     P, T = _disk_associate(math.radians(tdeg))
-    off, on = initial_surface(P, T, align=False), initial_surface(P, T)
+    off, on = initial_surface(P, T), initial_surface(P, T, align=True)
     before = principal_angle(off.surface).misalignment_deg
     assert before > 20.0 and abs(abs(on.rotated_deg) - before) < 3.0
     assert principal_angle(on.surface).misalignment_deg < 3.0
@@ -122,7 +121,7 @@ def test_initial_surface_turns_a_rectangle_only_within_the_tolerances():
 
     P = _associate(math.radians(50.0), n=24).reshape(-1, 3)
     F = _quads(24, 24)
-    on = initial_surface(P, F)
+    on = initial_surface(P, F, align=True)
     assert on.principal is not None and abs(on.principal.angle_deg) > 20.0
     assert 0.0 < abs(on.rotated_deg) < abs(on.principal.angle_deg)
     assert coverage_percent(on.surface, P, F) <= COVERAGE_TOL
@@ -135,6 +134,12 @@ def test_small_misalignment_keeps_the_fit():
     t = math.radians(2 * (ALIGN_MIN_DEG - 2.0))   # principal angle ALIGN_MIN_DEG - 2 degrees
     P = _associate(t, n=20).reshape(-1, 3)
     F = _quads(20, 20)
-    on, off = initial_surface(P, F), initial_surface(P, F, align=False)
+    on, off = initial_surface(P, F, align=True), initial_surface(P, F)
     assert on.rotated_deg == 0.0
     np.testing.assert_array_equal(on.surface.ctrl, off.surface.ctrl)
+
+
+def test_default_keeps_the_parametrization():
+    P = _associate(math.radians(50.0), n=20).reshape(-1, 3)
+    fit = initial_surface(P, _quads(20, 20))
+    assert fit.rotated_deg == 0.0 and fit.principal is None

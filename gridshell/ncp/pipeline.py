@@ -82,7 +82,7 @@ def load_surface(source: Any, *, mode: str, phlw_options: dict | None = None,
     init = initial_surface(V, F, n_ctrl=tuple(opts.pop("ctrl", (9, 9))),
                            degree=tuple(opts.pop("degree", (4, 4))),
                            transpose=bool(opts.pop("transpose", False)),
-                           align=bool(opts.pop("align", True)))
+                           align=bool(opts.pop("align", False)))
     if progress is not None:
         turned = (f", parameter plane turned {init.rotated_deg:.1f} deg onto the principal "
                   "directions" if init.rotated_deg else "")
