@@ -55,6 +55,10 @@ def add_args(p: argparse.ArgumentParser) -> None:
                    help="mesh input: PHLW outer rounds (default 4)")
     p.add_argument("--phlw-max-iter", type=int, default=40,
                    help="mesh input: PHLW iterations per round (default 40)")
+    p.add_argument("--phlw-align", action="store_true",
+                   help="mesh input: turn the reference's parametrization onto its mean principal "
+                        "directions (as far as coverage allows) before the PHLW step (default: "
+                        "keep it)")
     p.add_argument("--allow-unconverged", action="store_true",
                    help="write a design whose figures (Delta_a mean / max after the "
                         "post-optimization, Delta_l max, Delta_n max, the collapse error) miss "
@@ -82,7 +86,8 @@ def run(args: Any) -> int:
     progress = Progress(args)
     progress(f"reading {args.reference}")
     phlw = {"ctrl": tuple(args.phlw_ctrl), "samples": tuple(args.phlw_samples),
-            "outer": args.phlw_outer, "max_iter": args.phlw_max_iter}
+            "outer": args.phlw_outer, "max_iter": args.phlw_max_iter,
+            "align": args.phlw_align}
     curves = args.curves if args.curves is not None or args.spacing is not None else 10
     bundle, report = design_ncp(args.reference, mode=args.mode, curves=curves,
                                 spacing=args.spacing, n=args.n, samples=tuple(args.samples),

@@ -36,6 +36,9 @@ def add_args(p: argparse.ArgumentParser) -> None:
                    help="denser sampling for the check and surface.obj (default 60 60)")
     p.add_argument("--transpose", action="store_true",
                    help="swap u and v of the reference grid (rows follow the other family)")
+    p.add_argument("--align", action="store_true",
+                   help="turn the reference's parametrization onto its mean principal directions "
+                        "(as far as coverage allows) before the PHLW step (default: keep it)")
     p.add_argument("--outer", type=int, default=4,
                    help="outer rounds (closest points refreshed) (default 4)")
     p.add_argument("--max-iter", type=int, default=60,
@@ -66,7 +69,7 @@ def _load_reference(path: str, args: Any) -> tuple[Any, Any, Any]:
         return surf, mesh.V, mesh.F
     mesh = read_mesh(path, kind="any")
     fit = initial_surface(mesh.V, mesh.F, n_ctrl=tuple(args.ctrl), degree=tuple(args.degree),
-                          transpose=args.transpose)
+                          transpose=args.transpose, align=args.align)
     return fit, mesh.V, mesh.F
 
 

@@ -81,9 +81,12 @@ def load_surface(source: Any, *, mode: str, phlw_options: dict | None = None,
         name = "(V, F)"
     init = initial_surface(V, F, n_ctrl=tuple(opts.pop("ctrl", (9, 9))),
                            degree=tuple(opts.pop("degree", (4, 4))),
-                           transpose=bool(opts.pop("transpose", False)))
+                           transpose=bool(opts.pop("transpose", False)),
+                           align=bool(opts.pop("align", False)))
     if progress is not None:
-        progress(f"PHLW step: initial B-spline ({init.method} fit, rms {init.rms:.3g} m)")
+        turned = (f", parameter plane turned {init.rotated_deg:.1f} deg onto the principal "
+                  "directions" if init.rotated_deg else "")
+        progress(f"PHLW step: initial B-spline ({init.method} fit, rms {init.rms:.3g} m{turned})")
     # a reference without the net anywhere (umbilic everywhere; K > 0 everywhere for aa) is a
     # true no-net answer (exit 3); any later no-net answer is the PHLW step's failure (exit 4)
     reference_net_check(init.surface, mode)
@@ -102,7 +105,9 @@ def load_surface(source: Any, *, mode: str, phlw_options: dict | None = None,
     e1 = res.report_after.get("E_PHLW", {}).get("total") if res.report_after else None
     return res.surface, n, {"source": name, "phlw_deviation": res.deviation,
                             "phlw_converged": res.converged, "phlw_diagnostics": res.diagnostics,
-                            "phlw_energy": [e0, e1]}
+                            "phlw_energy": [e0, e1],
+                            "phlw_figures": {k: f["value"] for k, f in (res.figures or {}).items()},
+                            "phlw_aligned_deg": float(init.rotated_deg)}
 
 
 def _phlw_failure(info: dict, mode: str, exc: Exception) -> ConvergenceError:
@@ -192,7 +197,7 @@ def design_ncp(source: Any, *, mode: str = "phlw", curves: int | tuple[int, int]
     frames, sim_weights : alignment simulation
     surface_samples : the PHLW sample mesh of the bundle (surface.obj)
     phlw_options : options of the PHLW step for a mesh source (``ctrl``, ``degree``,
-        ``transpose``, and any keyword of :func:`gridshell.ncp.phlw.optimize_phlw`)
+        ``transpose``, ``align`` (see :func:`gridshell.ncp.reference.initial_surface`), and any keyword of :func:`gridshell.ncp.phlw.optimize_phlw`)
     allow_unconverged : return a design whose figures miss the paper's thresholds
         (:func:`gridshell.quality.design_gates`: Delta_a mean / max after the
         post-optimization, Delta_l max, Delta_n max, the collapse error of CNC / AA) instead of
