@@ -252,3 +252,16 @@ def test_every_obj_of_a_gg_bundle_is_consistently_oriented(tmp_path, meridians, 
              for ln in path.read_text().splitlines() if ln.startswith("f ")]
         assert len(F) > 0 and _same_direction_edges(F) == 0, path.name
     assert len(read_mesh(out / "net.obj", kind="any").F) == len(bundle.net.loops)
+
+
+def test_offsets_off_the_surface_are_an_input_error_in_metres():
+    """``gg --offsets -5 99`` on a ~2 m wide surface: no lamella reaches it. The user's
+    positions are wrong, not the surface (exit 2, not 3), and the message is in metres."""
+    from gridshell.errors import InputError
+
+    P = helicoid_grid(14, 14)
+    with pytest.raises(InputError, match=r"-5, 99 m.*0 to [0-9.]+ m of arc length"):
+        gg_net_from_mesh(P, offsets=([-5.0, 99.0], [-5.0, 99.0]))
+    # positions on the parallel still make a net
+    st = gg_net_from_mesh(P, offsets=([0.3, 0.6, 0.9], [0.3, 0.6, 0.9]))
+    assert len(st["net"].family(1)) == 3

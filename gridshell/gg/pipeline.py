@@ -22,7 +22,7 @@ from scipy.sparse.csgraph import connected_components
 from scipy.sparse.linalg import lsqr
 
 from ..bundle import DesignBundle, write_bundle
-from ..errors import ConvergenceError, GridshellError, InputError
+from ..errors import ConvergenceError, GridshellError, InputError, NoNetError
 from ..grid import grid_quads
 from ..metrics import (alignability_error, alignability_error_arc, coverage, delta_l, deviation,
                        geodesic_turning, summary, target_deviation)
@@ -132,13 +132,27 @@ def gg_net_from_mesh(P: np.ndarray, *, n_lamellae: int | None = 10, spacing: flo
         o3 = np.asarray(offsets[1], float) / r_star + rev.phi[0]
         n_lamellae = spacing = None
     _say(progress, f"tracing geodesics (crossing angle {crossing_angle:g} deg)")
-    inet = geodesic_net(rev, n_lamellae=n_lamellae, spacing=spacing,
-                        crossing_angle=crossing_angle, at_parallel=at_parallel,
-                        offsets1=o1, offsets3=o3, step=step)
+    try:
+        inet = geodesic_net(rev, n_lamellae=n_lamellae, spacing=spacing,
+                            crossing_angle=crossing_angle, at_parallel=at_parallel,
+                            offsets1=o1, offsets3=o3, step=step)
+    except NoNetError:
+        if offsets is None:
+            raise
+        # the user's positions, not the surface, are wrong: say so in the option's unit
+        length = r_star * float(rev.phi[-1] - rev.phi[0])
+        raise InputError(
+            f"no lamella at the given offsets reaches the surface (C1 {_metres(offsets[0])}, "
+            f"C3 {_metres(offsets[1])}); the reference parallel runs from 0 to {length:.4g} m "
+            "of arc length: give positions in that range (metres)") from None
     _say(progress, f"mapping {len(inet.curves1)} + {len(inet.curves3)} curves onto the surface")
     net, extra = map_back(inet, P, rev)
     net_rev, _ = map_to_revolution(inet, rev)
     return {"rev": rev, "inet": inet, "net": net, "extra": extra, "net_rev": net_rev}
+
+
+def _metres(values: Sequence[float]) -> str:
+    return ", ".join(f"{float(v):g}" for v in values) + " m"
 
 
 def collapse_gg(net: Net) -> tuple[np.ndarray, dict[str, float]]:

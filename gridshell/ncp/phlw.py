@@ -651,12 +651,15 @@ def write_phlw(directory: str | Any, res: PHLWResult, sample_grid: tuple[int, in
     from pathlib import Path
 
     from ..atomic import atomic_dir, write_text
+    from ..bundle import finite_json
     from ..meshfile import write_mesh
     from ..render.curvature_diagram import curvature_diagram
 
     directory = Path(directory)
     rows, cols = (int(s) for s in sample_grid)
-    with atomic_dir(directory, overwrite=overwrite) as tmp:
+    # owned by `phlw` whether written by the CLI or the API (an `-o` later may replace it)
+    with atomic_dir(directory, overwrite=overwrite, owner="phlw",
+                    kind=f"PHLW {res.mode}") as tmp:
         res.surface.save(tmp / "surface.json")
         mesh = res.surface.sample(rows, cols)
         write_mesh(tmp / "surface.obj", mesh.V, mesh.F)
@@ -664,7 +667,8 @@ def write_phlw(directory: str | Any, res: PHLWResult, sample_grid: tuple[int, in
             f"{u:.12g},{n:.12g},{t:.12g},{a:.12g},{b:.12g},{c:.12g}"
             for u, n, t, (a, b, c) in zip(res.u_rows, res.n_rows, res.t_rows, res.abc)]
         write_text(tmp / "rows.csv", "\n".join(lines) + "\n")
-        write_text(tmp / "report.json", json.dumps(result_summary(res), indent=1) + "\n")
+        write_text(tmp / "report.json", json.dumps(finite_json(result_summary(res)), indent=1,
+                                                     allow_nan=False) + "\n")
         g = _grid_geometry(res.surface, res.u_rows, res.v_samples)
         curvature_diagram(tmp / "curvature_diagram.png", g["H"], g["K"], res.n_rows, res.t_rows,
                           u_rows=res.u_rows, title=f"curvature diagram ({res.mode})")

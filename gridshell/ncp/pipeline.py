@@ -395,10 +395,11 @@ def design_ncp(source: Any, *, mode: str = "phlw", curves: int | tuple[int, int]
 
 
 def _json_report(report: dict) -> str:
-    from ..bundle import _jsonable
+    from ..bundle import finite_json
 
-    return json.dumps(_jsonable({k: v for k, v in report.items() if k != "state"}), indent=1,
-                      default=float) + "\n"
+    # strict JSON: a figure that could not be measured is null, never a NaN token
+    return json.dumps(finite_json({k: v for k, v in report.items() if k != "state"}), indent=1,
+                      allow_nan=False, default=float) + "\n"
 
 
 def write_ncp(path: str | Path, bundle: DesignBundle, report: dict, *, render: bool = True,
