@@ -67,14 +67,12 @@ def _agrees(v: dict, stored: dict, keys: tuple[tuple[str, str], ...]) -> bool:
     return True
 
 
-def _checks(metrics: dict) -> str:
-    from ..render.report import metric_checks
+def _checks(kind: str, metrics: dict) -> str:
+    """The design's verdict on the paper's figures (:func:`gridshell.quality.design_gates`)."""
+    from ..quality import design_gates, gate_summary, passed
 
-    rows = [r for r in metric_checks(metrics) if r["status"] != "info"]
-    failed = [r["key"] for r in rows if r["status"] == "fail"]
-    if not failed:
-        return f"pass ({len(rows)} of {len(rows)} within the paper's thresholds)"
-    return f"FAIL: {', '.join(failed)}"
+    gates = design_gates(kind, metrics)
+    return ("pass (" if passed(gates) else "FAIL (") + gate_summary(gates) + ")"
 
 
 def _finish(d: Path, label: str, name: str, fab_params: dict, progress) -> dict[str, Any]:
@@ -125,7 +123,7 @@ def _gg(root: Path, sizes: dict, progress) -> dict[str, Any]:
         "frames": len(report["sequence"].V), "sequence_length_error": m["sequence_length_error"],
         "verified": _agrees(v, m, (("alignability", "alignability"),
                                    ("alignability_arc", "alignability_arc"))),
-        "checks": _checks(m), "revolution": report["revolution"]["method"],
+        "checks": _checks("GG", m), "revolution": report["revolution"]["method"],
         "fabrication": fab, "time": time.perf_counter() - t0,
     }
 
@@ -179,7 +177,7 @@ def _ncp(root: Path, sizes: dict, progress) -> dict[str, Any]:
         "sequence_length_error": m["sequence_length_error"],
         "verified": _agrees(v, m, (("alignability", "delta_a_after"), ("delta_l", "delta_l"),
                                    ("delta_n", "delta_n"))),
-        "checks": _checks(m), "fabrication": fab, "time": time.perf_counter() - t0,
+        "checks": _checks("CNC", m), "fabrication": fab, "time": time.perf_counter() - t0,
     }
 
 

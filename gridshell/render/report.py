@@ -20,6 +20,7 @@ from typing import Any, Callable, Iterable
 
 from ..atomic import write_text
 from ..errors import InputError
+from ..quality import THRESHOLDS
 
 __all__ = ["Check", "CHECKS", "metric_checks", "report_html", "write_report"]
 
@@ -35,15 +36,17 @@ class Check:
 
 
 #: metrics checked against the paper's thresholds (5.1), in display order
+_A_MEAN, _A_MAX = THRESHOLDS["delta_a_mean"][1], THRESHOLDS["delta_a_max"][1]
+_L_MAX, _N_MAX = THRESHOLDS["delta_l_max"][1], THRESHOLDS["delta_n_max"][1]
 CHECKS: tuple[Check, ...] = (
-    Check("alignability", "Delta_a, straight edges", 1.0, 3.0),
-    Check("alignability_arc", "Delta_a, lamella arc lengths", 1.0, 3.0),
-    Check("alignability_revolution", "Delta_a on the surface of revolution", 1.0, 3.0),
+    Check("alignability", "Delta_a, straight edges", _A_MEAN, _A_MAX),
+    Check("alignability_arc", "Delta_a, lamella arc lengths", _A_MEAN, _A_MAX),
+    Check("alignability_revolution", "Delta_a on the surface of revolution", _A_MEAN, _A_MAX),
     Check("delta_a_before", "Delta_a, traced net (before post-optimization)"),
-    Check("delta_a_after", "Delta_a, post-optimized net", 1.0, 3.0),
-    Check("delta_l", "Delta_l, edge length change on alignment", None, 1.0),
-    Check("delta_n", "Delta_n, normal curvature change on alignment", None, 1.0),
-    Check("delta_n_interior", "Delta_n at interior joints", None, 1.0),
+    Check("delta_a_after", "Delta_a, post-optimized net", _A_MEAN, _A_MAX),
+    Check("delta_l", "Delta_l, edge length change on alignment", None, _L_MAX),
+    Check("delta_n", "Delta_n, normal curvature change on alignment", None, _N_MAX),
+    Check("delta_n_interior", "Delta_n at interior joints", None, _N_MAX),
 )
 
 #: pictures first in this order, then any other picture alphabetically
