@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from hypothesis import assume, given, settings
+from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
@@ -19,7 +19,9 @@ from gridshell.net import polyline_arclength, polyline_length
 from gridshell.render.ribbons import ribbon_polygons
 from gridshell.solver.layout import Layout
 
-SETTINGS = settings(max_examples=50, deadline=None)
+# derandomized: CI on a fresh clone has no example database, and a flaky health check there
+# (filter_too_much on an unlucky seed) is not a finding; the examples are the same every run
+SETTINGS = settings(max_examples=50, deadline=None, derandomize=True)
 coord = st.floats(-100, 100, allow_nan=False, allow_infinity=False)
 
 
@@ -129,7 +131,8 @@ def test_bspline_basis_is_a_partition_of_unity(dk, ts):
         np.testing.assert_allclose(D.sum(axis=1), 0.0, atol=1e-6 * (1 + np.abs(D).max()))
 
 
-@SETTINGS
+# its polylines are filtered for well-spaced points: many draws are rejected by design
+@settings(SETTINGS, suppress_health_check=[HealthCheck.filter_too_much])
 @given(points(2, 20), st.floats(0.001, 10.0), st.booleans())
 def test_ribbon_has_the_width_and_contains_the_axis(P, width, tangent):
     seg = np.linalg.norm(np.diff(P, axis=0), axis=1)
