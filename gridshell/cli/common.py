@@ -53,6 +53,17 @@ def print_summary(args: Any, title: str, summary: dict[str, Any]) -> None:
         print(f"  {k:<{width}}  {_fmt(v)}")
 
 
+def print_gates(args: Any, summary: dict, title: str, quality: dict) -> None:
+    """The summary, ending with one pass / FAIL line per figure of ``quality`` (``{"ok",
+    "gates": [Gate.as_dict()]}``); with ``--json`` as ``summary["quality"]``."""
+    if getattr(args, "json", False):
+        print_summary(args, title, {**summary, "quality": quality})
+        return
+    print_summary(args, title, {**summary, "quality": "pass" if quality["ok"] else "FAIL"})
+    for g in quality["gates"]:
+        print(f"    {g['line']}")
+
+
 def _fmt(v: Any) -> str:
     if isinstance(v, float):
         return f"{v:.4g}"

@@ -80,7 +80,7 @@ def _unconverged(bundle: Any, report: dict) -> list[str]:
 def run(args: Any) -> int:
     from ..atomic import check_output
     from ..ncp.pipeline import design_ncp, write_ncp
-    from .common import Progress, print_summary
+    from .common import Progress, print_gates
 
     check_output(args.output, marker="design.json")
     progress = Progress(args)
@@ -135,16 +135,3 @@ def run(args: Any) -> int:
     summary["time [s]"] = {k: v for k, v in m["timings"].items() if k != "metrics"}
     print_gates(args, summary, f"{bundle.kind} design", quality)
     return 0
-
-
-def print_gates(args: Any, summary: dict, title: str, quality: dict) -> None:
-    """The summary, ending with one pass / FAIL line per figure of ``quality`` (``{"ok",
-    "gates": [Gate.as_dict()]}``); with ``--json`` as ``summary["quality"]``."""
-    from .common import print_summary
-
-    if getattr(args, "json", False):
-        print_summary(args, title, {**summary, "quality": quality})
-        return
-    print_summary(args, title, {**summary, "quality": "pass" if quality["ok"] else "FAIL"})
-    for g in quality["gates"]:
-        print(f"    {g['line']}")

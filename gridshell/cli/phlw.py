@@ -80,7 +80,7 @@ def run(args: Any) -> int:
     from ..ncp.phlw import optimize_phlw, row_relation_residual, write_phlw
     from ..ncp.phlw_gates import phlw_gates
     from .common import Progress
-    from .ncp import print_gates
+    from .common import print_gates
 
     check_output(args.output, marker="report.json")
     progress = Progress(args)
