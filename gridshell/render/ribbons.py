@@ -22,6 +22,7 @@ import numpy as np
 
 from ..atomic import atomic_path
 from ..errors import InputError
+from ..strips3d import TANGENT_KINDS, nearest_vertex_normals, strip_frame
 
 __all__ = ["FAMILY_COLOURS", "TANGENT_KINDS", "default_width", "nearest_vertex_normals",
            "ribbon_polygons", "view_angles", "render_ribbons", "render_bundle"]
@@ -29,31 +30,12 @@ __all__ = ["FAMILY_COLOURS", "TANGENT_KINDS", "default_width", "nearest_vertex_n
 #: RGB colour of each lamella family (C^1, C^3)
 FAMILY_COLOURS: dict[int, tuple[float, float, float]] = {1: (0.13, 0.42, 0.70),
                                                          3: (0.86, 0.35, 0.12)}
-#: design kinds whose lamellae lie tangent to the surface (the others stand on it)
-TANGENT_KINDS = ("GG",)
 _SURFACE_RGBA = (0.62, 0.64, 0.68, 0.18)
 
 
 def _unit(X: np.ndarray) -> np.ndarray:
     n = np.linalg.norm(X, axis=-1, keepdims=True)
     return np.divide(X, n, out=np.zeros_like(X), where=n > 0)
-
-
-def nearest_vertex_normals(P: np.ndarray, V: np.ndarray, F: np.ndarray) -> np.ndarray:
-    """Unit normals ``(k,3)`` at points ``P (k,3)``: the area-weighted vertex normal of the
-    closest vertex of the surface ``V (n,3)``, ``F (m,3|4)`` (only vertices used by a face)."""
-    from scipy.spatial import cKDTree
-
-    from ..quadmesh import area_weighted_vertex_normals
-
-    V = np.asarray(V, float).reshape(-1, 3)
-    F = np.asarray(F, np.int64)
-    if not len(V) or not F.size:
-        raise InputError("the surface is empty; a ribbon render needs the surface mesh")
-    used = np.unique(F[F >= 0])
-    N = area_weighted_vertex_normals(V, F)[used]
-    _, idx = cKDTree(V[used]).query(np.asarray(P, float).reshape(-1, 3))
-    return N[idx]
 
 
 def ribbon_polygons(axis: np.ndarray, normals: np.ndarray, width: float,
@@ -69,17 +51,17 @@ def ribbon_polygons(axis: np.ndarray, normals: np.ndarray, width: float,
     width : float
         Ribbon width, metres.
     tangent : bool
-        True: offset along ``n x t`` (in the surface, GG); False: along ``n`` (standing on
-        the surface, NCP / CNC / AA).
+        True: offset along ``n x t`` (in the surface, GG); False: along ``n`` made
+        orthogonal to the axis (standing on the surface, NCP / CNC / AA);
+        :func:`gridshell.strips3d.strip_frame`.
     """
     P = np.asarray(axis, float).reshape(-1, 3)
-    N = _unit(np.asarray(normals, float).reshape(-1, 3))
-    if len(P) != len(N):
-        raise InputError(f"ribbon: {len(P)} axis points but {len(N)} normals")
+    n_normals = len(np.asarray(normals).reshape(-1, 3))
+    if len(P) != n_normals:
+        raise InputError(f"ribbon: {len(P)} axis points but {n_normals} normals")
     if len(P) < 2:
         return np.zeros((0, 4, 3))
-    T = _unit(np.gradient(P, axis=0))
-    D = _unit(np.cross(N, T)) if tangent else N
+    _, D, _ = strip_frame(P, normals, tangent)
     h = 0.5 * float(width) * D
     a, b = P - h, P + h
     return np.stack([a[:-1], a[1:], b[1:], b[:-1]], axis=1)

@@ -1,0 +1,121 @@
+"""A lamella as built: its material frame along the axis and a closed solid of width x thickness.
+
+A lamella is a thin flat strip of width ``w`` and thickness ``t`` (metres, real size) whose
+centre line is the lamella axis. Its cross-section is spanned by
+
+- the **width direction** ``W``: in the surface, ``n x T``, for tangent lamellae (GG, paper
+  Fig. 6 centre); the surface normal ``n`` (made orthogonal to ``T``) for lamellae standing
+  on the surface (NCP / CNC / AA, Fig. 6 left);
+- the **thickness direction** ``H = T x W``,
+
+with ``T`` the unit tangent of the axis and ``n`` the surface normal at each axis point. The
+renderer, the WebGL viewer, the Rhino export and the structural check all take the strip's
+geometry from here, so that what is drawn, exported and checked is the strip that is cut.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .errors import InputError
+
+__all__ = ["TANGENT_KINDS", "is_tangent", "nearest_vertex_normals", "strip_frame",
+           "strip_solid", "real_section_m"]
+
+#: design kinds whose lamellae lie tangent to the surface (the others stand on it)
+TANGENT_KINDS = ("GG",)
+
+
+def is_tangent(kind: str) -> bool:
+    """True when lamellae of a design of ``kind`` ("GG", "NCP", "CNC", "AA") lie tangent to
+    the surface."""
+    return str(kind).upper() in TANGENT_KINDS
+
+
+def _unit(X: np.ndarray) -> np.ndarray:
+    n = np.linalg.norm(X, axis=-1, keepdims=True)
+    return np.divide(X, n, out=np.zeros_like(X), where=n > 0)
+
+
+def nearest_vertex_normals(P: np.ndarray, V: np.ndarray, F: np.ndarray) -> np.ndarray:
+    """Unit normals ``(k,3)`` at points ``P (k,3)``: the area-weighted vertex normal of the
+    closest vertex of the surface ``V (n,3)``, ``F (m,3|4)`` (only vertices used by a face)."""
+    from scipy.spatial import cKDTree
+
+    from .quadmesh import area_weighted_vertex_normals
+
+    V = np.asarray(V, float).reshape(-1, 3)
+    F = np.asarray(F, np.int64)
+    if not len(V) or not F.size:
+        raise InputError("the surface is empty; a strip's frame needs the surface mesh")
+    used = np.unique(F[F >= 0])
+    N = area_weighted_vertex_normals(V, F)[used]
+    _, idx = cKDTree(V[used]).query(np.asarray(P, float).reshape(-1, 3))
+    return N[idx]
+
+
+def strip_frame(axis: np.ndarray, normals: np.ndarray, tangent: bool
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The strip's frame ``(T, W, H)``, each ``(k,3)`` unit vectors, at the axis points.
+
+    Parameters
+    ----------
+    axis : (k,3) float
+        Lamella axis polyline, metres (k >= 2).
+    normals : (k,3) float
+        Surface normals at the axis points (any length).
+    tangent : bool
+        True: width in the surface (``W = n x T``, GG); False: width along the normal
+        (``W = n - (n.T) T``, lamellae standing on the surface).
+    """
+    P = np.asarray(axis, float).reshape(-1, 3)
+    N = _unit(np.asarray(normals, float).reshape(-1, 3))
+    if len(P) != len(N):
+        raise InputError(f"strip frame: {len(P)} axis points but {len(N)} normals")
+    if len(P) < 2:
+        raise InputError("strip frame: a lamella axis needs at least 2 points")
+    T = _unit(np.gradient(P, axis=0))
+    if tangent:
+        W = _unit(np.cross(N, T))
+    else:
+        W = _unit(N - np.sum(N * T, axis=1, keepdims=True) * T)
+    H = _unit(np.cross(T, W))
+    return T, W, H
+
+
+def strip_solid(axis: np.ndarray, normals: np.ndarray, width: float, thickness: float,
+                tangent: bool) -> tuple[np.ndarray, np.ndarray]:
+    """A closed, outward-oriented triangle mesh of the strip: the axis swept by its
+    ``width x thickness`` rectangle (metres), with end caps.
+
+    Returns ``V (4k,3)`` (the corners of the cross-section at each axis point, in the order
+    ``-W-H, +W-H, +W+H, -W+H``) and ``F (8(k-1)+4, 3)``. The faces ``+-H`` are the strip's
+    two wide faces, each of area ~ length x width.
+    """
+    if not (np.isfinite(width) and np.isfinite(thickness) and width > 0 and thickness > 0):
+        raise InputError(f"strip solid: width {width!r} and thickness {thickness!r} must be "
+                         "positive lengths in metres")
+    P = np.asarray(axis, float).reshape(-1, 3)
+    _, W, H = strip_frame(P, normals, tangent)
+    w, h = 0.5 * float(width) * W, 0.5 * float(thickness) * H
+    V = np.stack([P - w - h, P + w - h, P + w + h, P - w + h], axis=1).reshape(-1, 3)
+    k = len(P)
+    i = np.arange(k - 1)[:, None] * 4
+    faces = []
+    for a in range(4):                       # the four long sides, each a quad per segment
+        b = (a + 1) % 4
+        q = np.hstack([i + a, i + b, i + 4 + b, i + 4 + a])
+        faces.append(np.stack([q[:, [0, 1, 2]], q[:, [0, 2, 3]]], axis=1).reshape(-1, 3))
+    last = 4 * (k - 1)
+    faces.append(np.array([[0, 2, 1], [0, 3, 2],
+                           [last, last + 1, last + 2], [last, last + 2, last + 3]]))
+    F = np.concatenate(faces).astype(np.int64)
+    return V, F
+
+
+def real_section_m(width_mm: float, thickness_mm: float, scale: float) -> tuple[float, float]:
+    """The strip's real width and thickness in metres of the design, from the cut strip's
+    width and thickness in mm of a model at ``scale`` (model / design, ``1:10`` -> 0.1)."""
+    if not (scale > 0 and width_mm > 0 and thickness_mm > 0):
+        raise InputError(f"section: width {width_mm} mm, thickness {thickness_mm} mm and scale "
+                         f"{scale} must be positive")
+    return 1e-3 * width_mm / scale, 1e-3 * thickness_mm / scale
