@@ -1,0 +1,129 @@
+"""Stresses in the states of the alignment sequence and in the collapsed state (transport).
+
+A state is known by its joints only (``sequence/frame_*.obj``, ``aligned.obj``): each lamella
+is the cubic spline (not-a-knot) through its joints at the design's arc lengths (the alignment
+keeps them), and the strip's section normal at a joint is the normal of the joint mesh there
+(:func:`gridshell.structure.frames.joint_normals`) or, for NCP kinds, the stored joint axis
+(``axes_r.npy`` deployed, ``aligned_r.npy`` collapsed), which is the strip's width direction.
+In a collapsed GG net every lamella lies on one line: no curvature, and the strips lie stacked
+untwisted. The resolution is the joint spacing, coarser than the dense axes of the deployed
+check; the deployed state is evaluated the same way (``frame_000``) so that the states compare
+with each other.
+"""
+from __future__ import annotations
+
+import re
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..bundle import DesignBundle
+from .cutshape import collapse_curvature, cut_curvature, cut_shape
+from .frames import joint_curvatures, joint_normals
+from .materials import Material
+from .section import Section
+from .stresses import KIND_ORIENTATION, strip_curvatures, strip_stresses
+
+METHOD = ("joints only: a cubic spline (not-a-knot) through each lamella's joints at the design's "
+          "arc lengths; section normals from the joint mesh (NCP: the stored joint axes where "
+          "given); resolution the joint spacing")
+
+_FRAME = re.compile(r"^frame_(\d+)\.obj$")
+
+
+def _frames(path: Path | None, n: int) -> list[np.ndarray]:
+    """The joints of every frame of ``path/sequence`` in order (empty if none or unreadable
+    as a configuration of ``n`` joints)."""
+    from ..meshfile import read_configuration
+
+    if path is None or not (path / "sequence").is_dir():
+        return []
+    found = sorted((int(m.group(1)), p) for p in (path / "sequence").iterdir()
+                   if (m := _FRAME.match(p.name)))
+    out = []
+    for _, p in found:
+        V = read_configuration(p)[0]
+        if V.shape != (n, 3):
+            return []
+        out.append(V)
+    return out
+
+
+def _axes(path: Path | None, name: str, n: int) -> np.ndarray | None:
+    if path is None or not (path / name).is_file():
+        return None
+    try:
+        r = np.load(path / name)
+    except (OSError, ValueError):
+        return None
+    return r if r.shape == (n, 3) and np.all(np.isfinite(r)) else None
+
+
+def state_record(bundle: DesignBundle, V: np.ndarray, normals: np.ndarray, section: Section,
+                 material: Material, curve=None) -> dict[str, Any]:
+    """Utilisation of every lamella in the state with joints ``V (n,3)`` and section normals
+    ``normals (n,3)`` (zero rows: unknown); the cut shape is matched with the orientation of
+    the normals that fits it best (their sign is arbitrary). Lamellae of fewer than 3 joints
+    are not measured (``None`` in ``lamellae_max_utilisation``)."""
+    orientation = KIND_ORIENTATION[bundle.kind]
+    lams = bundle.net.lamellae
+    dcs = [joint_curvatures(V[lam.joints], lam.joint_s, normals[lam.joints]) for lam in lams]
+    k_cut = [np.zeros(len(lam.joints)) for lam in lams]
+    sign = 1.0
+    if orientation == "orthogonal":
+        k_cut = [cut_curvature(bundle, lam, lam.joint_s, curve) for lam in lams]
+        a, b = np.concatenate([dc.kn for dc in dcs]), np.concatenate(k_cut)
+        a, b = np.nan_to_num(a), np.where(np.isfinite(a), b, 0.0)
+        sign = 1.0 if np.sum((a - b) ** 2) <= np.sum((a + b) ** 2) else -1.0
+    per, best = [], (0.0, -1, -1)
+    kw = ks = kt = 0.0
+    for lam, dc, kc in zip(lams, dcs, k_cut):
+        k = strip_curvatures(dc, orientation, section, sign * kc)
+        u = strip_stresses(k, section, material).utilisation
+        if not np.all(np.isfinite(u)):    # fewer than 3 joints: not measured
+            per.append(None)
+            continue
+        m = float(u.max()) if len(u) else 0.0
+        per.append(m)
+        if len(u) and m > best[0]:
+            best = (m, int(lam.id), int(lam.joints[int(np.argmax(u))]))
+        if len(u):
+            kw = max(kw, float(np.abs(k.weak).max()))
+            ks = max(ks, float(np.abs(k.strong).max()))
+            kt = max(kt, float(np.abs(k.twist).max()))
+    return {"max_utilisation": best[0], "worst_lamella": best[1], "worst_joint": best[2],
+            "max_weak_curvature_per_m": kw, "max_strong_curvature_per_m": ks,
+            "max_twist_rad_per_m": kt, "lamellae_max_utilisation": per}
+
+
+def bundle_states(bundle: DesignBundle, path: Path | None, section: Section,
+                  material: Material) -> dict[str, Any]:
+    """``structure.json["states"]``: the record of :func:`state_record` for every frame of the
+    alignment sequence (``frame_000`` deployed ... last = collapsed) or, without a sequence,
+    for the deployed and the collapsed joints; ``frames`` in order, each with ``name`` and
+    ``t`` (0 deployed, 1 collapsed); ``collapsed`` and ``sequence_max_utilisation``."""
+    n = len(bundle.net.joints)
+    loops = bundle.net.loops
+    frames = _frames(path, n)
+    named = [(f"frame_{k:03d}", V) for k, V in enumerate(frames)] if frames else \
+        [("deployed", bundle.net.joints), ("collapsed", bundle.aligned)]
+    K = max(len(named) - 1, 1)
+    curve = collapse_curvature(bundle) if cut_shape(bundle) == "curve" else None
+    r_dep, r_col = _axes(path, "axes_r.npy", n), _axes(path, "aligned_r.npy", n)
+    out = []
+    for k, (name, V) in enumerate(named):
+        N = joint_normals(V, loops)
+        if k == 0 and r_dep is not None:
+            N = r_dep
+        if k == len(named) - 1 and r_col is not None:
+            N = r_col
+        rec = state_record(bundle, np.asarray(V, float), N, section, material, curve)
+        out.append({"name": name, "t": k / K, **rec})
+    collapsed = out[-1]
+    return {"method": METHOD, "frames": out,
+            "collapsed": {"name": collapsed["name"],
+                          "max_utilisation": collapsed["max_utilisation"],
+                          "worst_lamella": collapsed["worst_lamella"],
+                          "worst_joint": collapsed["worst_joint"]},
+            "sequence_max_utilisation": max(f["max_utilisation"] for f in out)}
