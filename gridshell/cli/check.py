@@ -2,7 +2,8 @@
 
 Stresses along every lamella of a design bundle for a strip section and material
 (:func:`gridshell.structure.check.check_bundle`), written to ``DIR/structure.json`` (listed in
-the bundle's manifest). Prints a table (the ``--top`` most utilised lamellae) and a verdict.
+the bundle's manifest) and ``DIR/structure.png`` (the strips coloured by utilisation). Prints a
+table (the ``--top`` most utilised lamellae) and a verdict.
 Exit code: 0 every state stays elastic (utilisation <= 1); 4 overstressed (like a figure
 that fails in ``verify``; ``structure.json`` is written all the same); 2 bad input.
 """
@@ -49,6 +50,8 @@ def add_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--no-states", action="store_true",
                    help="deployed state only (not the collapsed state nor the alignment "
                         "sequence)")
+    p.add_argument("--no-picture", action="store_true",
+                   help="do not draw DIR/structure.png (the strips coloured by utilisation)")
     p.add_argument("--top", type=int, default=12, metavar="N",
                    help="lamellae listed in the table, most utilised first (default 12; 0: all)")
 
@@ -141,11 +144,18 @@ def run(args: Any) -> int:
     res = check_bundle(bundle, material, section, states=not args.no_states,
                        bundle_dir=Path(args.bundle), progress=progress.callback)
     out = write_structure_json(args.bundle, res)
+    picture = None
+    if not args.no_picture:
+        from ..render.structure import PICTURE, render_utilisation
+
+        progress(f"drawing {PICTURE}")
+        picture = render_utilisation(bundle, res, Path(args.bundle) / PICTURE)
     code = 0 if res["verdict"] == "ok" else OVERSTRESSED
     if getattr(args, "json", False):
         summary = {k: v for k, v in res.items() if k not in ("lamellae", "states")}
         summary["states"] = {k: v for k, v in res["states"].items() if k != "frames"}
         summary["file"] = str(out)
+        summary["picture"] = str(picture) if picture else None
         print(json.dumps(finite_json({"ok": code == 0, **summary}), indent=1, allow_nan=False))
         return code
     print(f"Structure of {args.bundle} ({res['kind']}, {res['orientation']} strips cut "
@@ -160,7 +170,7 @@ def run(args: Any) -> int:
         col = st["collapsed"]
         print(f"  states    alignment sequence max utilisation "
               f"{st['sequence_max_utilisation']:.2f}; collapsed {col['max_utilisation']:.2f}")
-    print(f"  file      {out}")
+    print(f"  files     {out}" + (f", {picture}" if picture else ""))
     print(verdict_line(res))
     if code and not getattr(args, "quiet", False):
         print("gridshell check: overstressed (exit 4); a thinner strip, a larger scale or a "

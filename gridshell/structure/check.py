@@ -177,3 +177,26 @@ def write_structure_json(bundle_dir: str | Path, result: dict[str, Any]) -> Path
     out = Path(bundle_dir) / FILENAME
     write_text(out, json.dumps(finite_json(result), indent=1, allow_nan=False) + "\n")
     return out
+
+
+def overstress_warning(result: dict[str, Any]) -> str | None:
+    """One line naming the overstressed lamellae of ``result`` (:func:`check_bundle`) and where
+    the worst one is (None when every state stays elastic): what ``fabricate`` warns with."""
+    if result["verdict"] == "ok":
+        return None
+    sec = result["section"]
+    strip = (f"{sec['width_mm']:g} x {sec['thickness_mm']:g} mm {result['material']['name']} "
+             f"at {sec['scale_text']}")
+    bad = [r for r in result["lamellae"] if r["max_utilisation"] > 1.0]
+    if bad:
+        w = max(bad, key=lambda r: r["max_utilisation"])
+        more = f" ({len(bad)} lamellae above 1)" if len(bad) > 1 else ""
+        return (f"{strip} overstressed: lamella {w['id']} at s = {w['worst_s_m']:.3f} m "
+                f"(joint {w['worst_joint']}), utilisation {w['max_utilisation']:.2f} > 1{more}; "
+                f"a strip thinner than {result['max_elastic_thickness_mm']:.2f} mm stays elastic "
+                "('gridshell check' for the details)")
+    st = result["governing_state"]
+    frame = next((f for f in result["states"].get("frames", []) if f["name"] == st), {})
+    return (f"{strip} overstressed in the alignment state {st}: lamella "
+            f"{frame.get('worst_lamella')} at joint {frame.get('worst_joint')}, utilisation "
+            f"{result['max_utilisation']:.2f} > 1 ('gridshell check' for the details)")

@@ -162,7 +162,7 @@ def joint_curvatures(X: np.ndarray, s: np.ndarray, normals: np.ndarray) -> Darbo
     d1, d2 = sp(ss, 1), sp(ss, 2)
     sp1 = np.linalg.norm(d1, axis=1)
     t = _unit_rows(d1)
-    kvec = (d2 - np.einsum("ij,ij->i", d2, t)[:, None] * t) / np.maximum(sp1, 1e-300)[:, None] ** 2
+    kvec = (d2 - np.einsum("ij,ij->i", d2, t)[:, None] * t) / np.maximum(sp1 ** 2, 1e-300)[:, None]
     N = np.asarray(normals, float).reshape(-1, 3)[ok_s]
     N = N - np.einsum("ij,ij->i", N, t)[:, None] * t
     known = np.linalg.norm(N, axis=1) > 1e-6
