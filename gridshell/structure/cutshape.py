@@ -1,6 +1,7 @@
 """The in-plane curvature of each strip as cut (orthogonal lamellae), along its axis.
 
-Same shapes as :mod:`fabrication.strips` (which cuts them): AA and GG strips are straight;
+The shapes :mod:`fabrication.strips` cuts (it takes :func:`cut_shape` and
+:func:`collapse_radius` from here): AA and GG strips are straight;
 CNC strips are arcs of radius ``collapse.radius`` (or ``1 / metrics.n``); NCP strips are pieces
 of the planar collapse curve, joint 0 at ``collapse_s[0]`` and the axis following at its own arc
 length. Curvatures are signed against the flattened surface normals stored with the collapse
@@ -28,7 +29,8 @@ def cut_shape(bundle: DesignBundle) -> str:
     return {"circle": "arc", "line": "line"}.get(bundle.collapse.shape, "curve")
 
 
-def _radius(bundle: DesignBundle) -> float:
+def collapse_radius(bundle: DesignBundle) -> float:
+    """Radius (m) of the circle a CNC (or circular NCP) design collapses into."""
     c = bundle.collapse
     if c is not None and c.radius:
         return abs(float(c.radius))
@@ -70,7 +72,7 @@ def cut_curvature(bundle: DesignBundle, lam: Lamella, s: np.ndarray,
     if shape == "line":
         return np.zeros_like(s)
     if shape == "arc":
-        return np.full_like(s, 1.0 / _radius(bundle))
+        return np.full_like(s, 1.0 / collapse_radius(bundle))
     arc, k = curve if curve is not None else collapse_curvature(bundle)
     cs = (bundle.collapse_s or {}).get(int(lam.id))
     c0 = float(cs[0]) if cs is not None and len(cs) else 0.0

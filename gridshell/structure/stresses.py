@@ -107,7 +107,7 @@ def strip_stresses(k: StripCurvatures, section: Section, material: Material) -> 
 
 
 def max_elastic_thickness(k: StripCurvatures, section: Section, material: Material,
-                          iterations: int = 60) -> np.ndarray:
+                          iterations: int = 45) -> np.ndarray:
     """The thickest strip (m) of the same width that stays elastic (utilisation <= 1) under
     the curvatures ``k``, per point.
 
