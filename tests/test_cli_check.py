@@ -148,3 +148,16 @@ def test_report_and_fabricate_use_the_check(tmp_path, capsys):
     out = capsys.readouterr().out
     assert code == 0
     assert "warning (structure)" in out and "lamella" in out and "overstressed" in out
+
+
+def test_strip_defaults_from_the_cut_files(tmp_path, capsys):
+    """Without --width/--thickness/--scale the check takes those fabricate cut with."""
+    d = write_case(tmp_path / "gg", "GG")
+    (d / "fabrication").mkdir()
+    (d / "fabrication" / "fabrication.json").write_text(json.dumps(
+        {"params": {"width": 12.0, "thickness": 0.8, "scale": 0.05}}))
+    main(["check", str(d), "-q", "--no-picture", "--no-states"])
+    sec = _read(d)["section"]
+    assert (sec["width_mm"], sec["thickness_mm"], sec["scale"]) == (12.0, 0.8, 0.05)
+    main(["check", str(d), "--thickness", "2", "-q", "--no-picture", "--no-states"])
+    assert _read(d)["section"]["thickness_mm"] == 2.0
