@@ -161,3 +161,21 @@ def test_strip_defaults_from_the_cut_files(tmp_path, capsys):
     assert (sec["width_mm"], sec["thickness_mm"], sec["scale"]) == (12.0, 0.8, 0.05)
     main(["check", str(d), "--thickness", "2", "-q", "--no-picture", "--no-states"])
     assert _read(d)["section"]["thickness_mm"] == 2.0
+
+
+def test_folded_sequence_states_are_listed_not_judged(tmp_path, capsys):
+    from gridshell.meshfile import write_mesh
+
+    b = make_bundle("GG")
+    extra = sequence_extra(b, frames=3)
+    V = 0.5 * (b.net.joints + b.aligned)
+    V[::2, 2] += 0.5                       # every other joint lifted: lamellae zig-zag
+    extra["sequence/frame_001.obj"] = lambda p, V=V: write_mesh(p, V, b.net.loops)
+    d = write_bundle(tmp_path / "gg", b, extra=extra)
+    main(["check", str(d), "--width", "5", "-q", "--no-picture"])
+    out = capsys.readouterr().out
+    st = _read(d)["states"]
+    assert "frame_001" in st["unresolved"] and "fold" in out
+    f1 = st["frames"][1]
+    assert not f1["resolved"] and f1["max_turn_deg"] > 30
+    assert _read(d)["governing_state"] != "frame_001"

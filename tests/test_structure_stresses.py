@@ -227,3 +227,13 @@ def test_joint_normals_of_a_grid_and_a_collapsed_net():
     assert np.allclose(np.abs(N[:, 2]), 1.0)
     V[:, 1] = 0.0           # every loop flat on a line: no normal
     assert np.allclose(joint_normals(V, F), 0.0)
+
+
+def test_slerp_axes():
+    from gridshell.structure.states import slerp_axes
+    a = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])
+    b = np.array([[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0]])    # a line: -x is +x
+    assert np.allclose(slerp_axes(a, b, 0.0), a)
+    assert np.allclose(np.abs(slerp_axes(a, b, 1.0)), np.abs(b))
+    m = slerp_axes(a, b, 0.5)
+    assert np.allclose(m[0], [np.sqrt(0.5), 0, np.sqrt(0.5)]) and np.allclose(m[1], [1, 0, 0])

@@ -170,6 +170,11 @@ def run(args: Any) -> int:
         col = st["collapsed"]
         print(f"  states    alignment sequence max utilisation "
               f"{st['sequence_max_utilisation']:.2f}; collapsed {col['max_utilisation']:.2f}")
+        if st["unresolved"]:
+            print(f"  warning   {len(st['unresolved'])} states of the alignment sequence fold "
+                  f"(a lamella turns by more than {st['fold_deg']:g} deg between joints): "
+                  f"{', '.join(st['unresolved'])}: not judged (the sequence is kinematic; "
+                  "where it folds its stresses mean nothing)")
     print(f"  files     {out}" + (f", {picture}" if picture else ""))
     print(verdict_line(res))
     if code and not getattr(args, "quiet", False):

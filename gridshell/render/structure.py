@@ -166,7 +166,9 @@ def structure_section(bundle_dir: str | os.PathLike, rows: int = 40) -> str:
     if st:
         info.append(("alignment sequence", f"max utilisation "
                      f"{_num(st.get('sequence_max_utilisation'), '{:.2f}')}; collapsed "
-                     f"{_num((st.get('collapsed') or {}).get('max_utilisation'), '{:.2f}')}"))
+                     f"{_num((st.get('collapsed') or {}).get('max_utilisation'), '{:.2f}')}"
+                     + (f"; folded, not judged: {html.escape(', '.join(st['unresolved']))}"
+                        if st.get("unresolved") else "")))
     kv = "".join(f"<tr><th>{k}</th><td>{v}</td></tr>" for k, v in info)
     head = ("<tr><th>lamella</th><th>family</th><th>utilisation</th><th>worst s [m]</th>"
             "<th>joint</th><th>&sigma; weak / strong, &tau; [MPa]</th><th>R min [mm]</th>"

@@ -120,7 +120,8 @@ def check_bundle(bundle: DesignBundle | str | Path, material: Material, section:
         "worst_joint", "min_radius_m", "max_elastic_thickness_mm", ...}],
         "max_elastic_thickness_mm", "min_radius_m", "worst": {...}}``. ``verdict`` is
         ``"ok"`` when every evaluated state stays elastic (``max_utilisation <= 1``),
-        ``"overstressed"`` otherwise.
+        ``"overstressed"`` otherwise; states of a folded sequence (``states["unresolved"]``)
+        are listed, not judged.
     """
     path = None if bundle_dir is None else Path(bundle_dir)
     if not isinstance(bundle, DesignBundle):
@@ -141,7 +142,7 @@ def check_bundle(bundle: DesignBundle | str | Path, material: Material, section:
         say("stresses in the collapsed state and the alignment sequence")
         out_states = bundle_states(bundle, path, section, material)
         for st in out_states["frames"]:    # the deployed state: the dense check above
-            if st["t"] > 0 and st["max_utilisation"] > u_all:
+            if st["t"] > 0 and st["resolved"] and st["max_utilisation"] > u_all:
                 governing, u_all = st["name"], st["max_utilisation"]
     finite_min = [r["min_radius_m"] for r in lams if np.isfinite(r["min_radius_m"])]
     return {
