@@ -1,0 +1,10 @@
+"""Structure: materials, sections and the stresses a design imposes on its lamellae.
+
+Reads a design bundle and the fabrication parameters (width, thickness, scale); never imports
+a pipeline (gg/, ncp/, fabrication/) nor the CLI. SI units inside: metres, pascals, kg/m^3.
+"""
+from .materials import MATERIALS, Material, get_material, material_names, user_material
+from .section import Section
+
+__all__ = ["MATERIALS", "Material", "Section", "get_material", "material_names",
+           "user_material"]
