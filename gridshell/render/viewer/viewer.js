@@ -1,6 +1,6 @@
 // gridshell report viewer: the design bundle's surface, strips and joints in WebGL (three.js).
-// Reads the scene written by gridshell/render/viewer/scene.py from the page's
-// <script type="application/json" id="gridshell-scene"> element; no network, works from file://.
+// Reads the scene written by gridshell/render/viewer/scene.py from the JSON script element
+// #gridshell-scene of the page; no network, works from file://.
 (function () {
   "use strict";
   var root = document.getElementById("gridshell-viewer");
