@@ -41,7 +41,7 @@ class Browser:
     """One headless Chromium with one page; ``events`` holds every protocol event seen."""
 
     def __init__(self, exe: str, profile: Path, size: tuple[int, int] = (1200, 1000),
-                 timeout: float = 20.0):
+                 timeout: float = 90.0):
         import websocket
 
         profile.mkdir(parents=True, exist_ok=True)
@@ -78,7 +78,7 @@ class Browser:
             if "method" in msg:
                 self.events.append(msg)
 
-    def wait_event(self, method: str, timeout: float = 20.0) -> dict:
+    def wait_event(self, method: str, timeout: float = 90.0) -> dict:
         end = time.monotonic() + timeout
         seen = len(self.events)
         while time.monotonic() < end:
@@ -98,7 +98,7 @@ class Browser:
             raise RuntimeError(f"{expr}: {r['exceptionDetails']}")
         return r["result"].get("value")
 
-    def wait_for(self, expr: str, timeout: float = 20.0):
+    def wait_for(self, expr: str, timeout: float = 90.0):
         end = time.monotonic() + timeout
         while time.monotonic() < end:
             v = self.evaluate(expr)

@@ -158,6 +158,8 @@ def test_scene_delta_a_matches_the_metrics(gg):
     b = read_bundle(gg)
     da = 100 * alignability_error(b.net.joints, b.net.loops)
     assert S["delta_a"]["max"] == pytest.approx(da.max())
+    assert np.array_equal(decode(S["loops"]["F"], "u4").reshape(-1, 4), b.net.loops)
+    assert np.allclose(decode(S["loops"]["delta_a"], "f4"), da, rtol=1e-6, atol=1e-7)
     jda = decode(S["joints"]["delta_a"], "f4")
     for j in range(len(b.net.joints)):
         near = [da[i] for i, loop in enumerate(b.net.loops) if j in loop]
@@ -266,7 +268,7 @@ def test_report_in_headless_chromium(tmp_path):
         assert float(np.mean(np.abs(util - b).max(axis=2) > 30)) > 0.005
         # hiding both families and the joints leaves the (aligned, surface-less) view empty
         br.evaluate("document.querySelectorAll('[data-layer]').forEach(b => {"
-                    "if (b.dataset.layer !== 'surface') b.click();})")
+                    "if (b.checked && b.dataset.layer !== 'surface') b.click();})")
         empty = br.screenshot(rect)
         assert _blank(empty)[0], "toggles hide the strips and the joints"
         problems = br.problems()

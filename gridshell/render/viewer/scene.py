@@ -8,7 +8,8 @@ Everything the page draws, in metres, as little-endian float32 / uint32 arrays i
   real section (:func:`gridshell.render.section.bundle_section`) into a closed solid
   (:func:`gridshell.strips3d.strip_solid`), one vertex array per **state** of the alignment
   sequence (``sequence/frame_*.obj``, else the deployed and the aligned joints), one face array;
-- the **joints** of every state;
+- the **joints** of every state and the **net-loops** (quads of joint indices) with their
+  Delta_a;
 - **scalars** per axis sample for the colours: ``delta_a`` (Delta_a of the net-loops, paper
   5.1, in %, the largest of the loops at each joint, interpolated along the lamella) and, when
   ``structure.json`` exists, ``utilisation`` (its per-axis-point values, by arc length).
@@ -250,6 +251,9 @@ def build_scene(bundle_dir: str | os.PathLike) -> dict[str, Any]:
         "joints": {"n": int(len(net.joints)), "radius": min(0.6 * w, diag / 80.0),
                    "V": [encode(J, "f4") for J in states],
                    "delta_a": encode(jda, "f4")},
+        "loops": {"m": int(len(net.loops)),
+                  "F": encode(np.asarray(net.loops, np.int64).reshape(-1, 4), "u4"),
+                  "delta_a": encode(loop_da, "f4")},
         "states": labels,
         "scalars": scalars,
         "delta_a": {"mean": float(np.mean(loop_da)) if len(loop_da) else None,

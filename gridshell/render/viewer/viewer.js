@@ -100,6 +100,20 @@
   joints.renderOrder = 2;
   world.add(joints);
 
+  // net-loops: two triangles per loop over the joints of the current state, coloured per loop
+  var loopIdx = u32(S.loops.F), loopDa = f32(S.loops.delta_a), nL = S.loops.m;
+  var loopGeo = new THREE.BufferGeometry();
+  var loopPos = new THREE.BufferAttribute(new Float32Array(nL * 18), 3);
+  var loopCol = new THREE.BufferAttribute(new Float32Array(nL * 18), 3);
+  loopGeo.setAttribute("position", loopPos);
+  loopGeo.setAttribute("color", loopCol);
+  var loops = new THREE.Mesh(loopGeo, new THREE.MeshStandardMaterial({
+    vertexColors: true, side: THREE.DoubleSide, roughness: 0.9, transparent: true,
+    opacity: 0.85, polygonOffset: true, polygonOffsetFactor: 1, polygonOffsetUnits: 1}));
+  loops.visible = false;
+  world.add(loops);
+  var TRI = [0, 1, 2, 0, 2, 3];
+
   scene.add(new THREE.HemisphereLight(0xffffff, 0x8a8f99, 1.6));
   var camera = new THREE.PerspectiveCamera(35, 1, diag / 1000, diag * 20);
   camera.up.set(0, 0, 1);
@@ -128,7 +142,7 @@
 
   // ---- state, colours, visibility ------------------------------------------------------
   var state = 0, mode = "family";
-  var show = {surface: true, f1: true, f3: true, joints: true};
+  var show = {surface: true, f1: true, f3: true, joints: true, loops: false};
   var dummy = new THREE.Object3D();
 
   function ramp(v, m) {
@@ -160,6 +174,12 @@
       joints.setColorAt(j, jc);
     }
     if (joints.instanceColor) { joints.instanceColor.needsUpdate = true; }
+    var lc = loopCol.array, da = MODES.delta_a;
+    for (var l = 0; l < nL; l++) {
+      var rgb = mode === "family" ? [0.55, 0.74, 0.55] : ramp(loopDa[l], da);
+      for (var q = 0; q < 6; q++) { lc.set(rgb, 18 * l + 3 * q); }
+    }
+    loopCol.needsUpdate = true;
     legend(m);
   }
 
@@ -177,6 +197,17 @@
       joints.setMatrixAt(j, dummy.matrix);
     }
     joints.instanceMatrix.needsUpdate = true;
+    var lp = loopPos.array;
+    for (var l = 0; l < nL; l++) {
+      for (var q = 0; q < 6; q++) {
+        var jj = loopIdx[4 * l + TRI[q]];
+        lp[18 * l + 3 * q] = J[3 * jj]; lp[18 * l + 3 * q + 1] = J[3 * jj + 1];
+        lp[18 * l + 3 * q + 2] = J[3 * jj + 2];
+      }
+    }
+    loopPos.needsUpdate = true;
+    loopGeo.computeVertexNormals();
+    loopGeo.computeBoundingSphere();
     joints.computeBoundingSphere();
     stateLabel.textContent = S.states[state];
     visibility();
@@ -187,6 +218,7 @@
     if (stripMeshes[1]) { stripMeshes[1].visible = show.f1; }
     if (stripMeshes[3]) { stripMeshes[3].visible = show.f3; }
     joints.visible = show.joints;
+    loops.visible = show.loops;
     render();
   }
 
@@ -212,7 +244,7 @@
   function toggle(key, label, title) {
     var lab = el("label", {"class": "gv-toggle", title: title || ""});
     var box = el("input", {type: "checkbox", "data-layer": key});
-    box.checked = true;
+    box.checked = show[key];
     box.addEventListener("change", function () { show[key] = box.checked; visibility(); });
     lab.appendChild(box);
     lab.appendChild(document.createTextNode(" " + label));
@@ -225,6 +257,8 @@
   layers.appendChild(toggle("f1", "family C1 (" + n1 + ")"));
   layers.appendChild(toggle("f3", "family C3 (" + n3 + ")"));
   layers.appendChild(toggle("joints", "joints (" + nJ + ")"));
+  layers.appendChild(toggle("loops", "net-loops (" + nL + ")",
+                            "the net's quads between the joints, coloured by Delta_a"));
   panel.appendChild(layers);
 
   var colours = el("div", {"class": "gv-row"});
