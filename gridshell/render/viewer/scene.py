@@ -18,7 +18,9 @@ In a state ``k > 0`` the axes are carried with the joints (:func:`gridshell.net.
 sampled at the same arc-length fractions as in the deployed state, and the strip frame takes
 the normals of the net-loops at the joints of that state (oriented as in the state before; where
 the loops have collapsed, the normal of the state before). The deployed state takes the
-surface's normals.
+surface's normals at the joints; between joints the normals are interpolated by arc length.
+Tangent (GG) strips lie in two layers that meet at the joints: family C1 on the side of the
+normal, C3 on the other, each at half a thickness from the surface.
 """
 from __future__ import annotations
 
@@ -194,8 +196,13 @@ def build_scene(bundle_dir: str | os.PathLike) -> dict[str, Any]:
         Vk, Fk, nv = [], [], 0
         for lam, frac, jf in zip(lams, fracs, joint_fracs):
             P = _sample(by_id[lam.id].axis, frac)
-            N = nearest_vertex_normals(P, V, F) if k == 0 else \
-                _interp_along(frac, jf, normals[k][lam.joints])
+            if len(lam.joints) >= 2:  # smooth along the strip (the nearest vertex's is not)
+                N = _unit(_interp_along(frac, jf, normals[k][lam.joints]))
+            else:
+                N = nearest_vertex_normals(P, V, F) if k == 0 else \
+                    np.repeat(normals[k][lam.joints[:1]], len(P), axis=0)
+            if tangent:  # two layers, bolted at the joints: C1 on the outer side, C3 inside
+                P = P + (0.5 * t if lam.family == 1 else -0.5 * t) * N
             SV, SF = strip_solid(P, N, w, t, tangent)
             if k == 0:
                 offsets.append((nv, len(SV), sum(len(f) for f in Fk), len(SF)))
@@ -231,6 +238,7 @@ def build_scene(bundle_dir: str | os.PathLike) -> dict[str, Any]:
     Ftri = F if F.shape[1] == 3 else np.concatenate([F[:, [0, 1, 2]], F[:, [0, 2, 3]]])
     Ftri = Ftri[np.all(Ftri >= 0, axis=1)]
     lo, hi = allP.min(axis=0), allP.max(axis=0)
+    centres = [(0.5 * (X.min(axis=0) + X.max(axis=0))).tolist() for X in strip_V]
     return {
         "format": "gridshell.viewer", "version": 1, "kind": b.kind, "units": "m",
         "tangent": bool(tangent),
@@ -255,10 +263,12 @@ def build_scene(bundle_dir: str | os.PathLike) -> dict[str, Any]:
                   "F": encode(np.asarray(net.loops, np.int64).reshape(-1, 4), "u4"),
                   "delta_a": encode(loop_da, "f4")},
         "states": labels,
+        "centres": centres,
         "scalars": scalars,
         "delta_a": {"mean": float(np.mean(loop_da)) if len(loop_da) else None,
                     "max": float(np.max(loop_da)) if len(loop_da) else None},
         "has_structure": structure is not None,
+        "max_utilisation": max(lam_util.values()) if lam_util else None,
     }
 
 

@@ -132,16 +132,19 @@
 
   function homeView() {
     var ext = new THREE.Vector3(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
-    var d = 0.8 * diag / (2 * Math.tan(THREE.MathUtils.degToRad(camera.fov / 2)));
+    var d = 1.0 * diag / (2 * Math.tan(THREE.MathUtils.degToRad(camera.fov / 2)));
     var dir = new THREE.Vector3(ext.y >= ext.x ? 0.85 : 0.35, ext.y >= ext.x ? -0.35 : -0.85,
                                 0.75).normalize();
     camera.position.copy(dir.multiplyScalar(d));
-    controls.target.set(0, 0, 0);
+    var c = S.centres[shownCentre];
+    var at = new THREE.Vector3(c[0], c[1], c[2]).sub(centre);
+    camera.position.add(at);
+    controls.target.copy(at);
     controls.update();
   }
 
   // ---- state, colours, visibility ------------------------------------------------------
-  var state = 0, mode = "family";
+  var state = 0, mode = "family", shownCentre = 0;
   var show = {surface: true, f1: true, f3: true, joints: true, loops: false};
   var dummy = new THREE.Object3D();
 
@@ -209,6 +212,13 @@
     loopGeo.computeVertexNormals();
     loopGeo.computeBoundingSphere();
     joints.computeBoundingSphere();
+    // the view follows the sequence: the camera moves with the centre of the state
+    var c0 = S.centres[shownCentre], c1 = S.centres[state];
+    var shift = new THREE.Vector3(c1[0] - c0[0], c1[1] - c0[1], c1[2] - c0[2]);
+    camera.position.add(shift);
+    controls.target.add(shift);
+    controls.update();
+    shownCentre = state;
     stateLabel.textContent = S.states[state];
     visibility();
   }
@@ -297,8 +307,10 @@
     bar.style.background = "linear-gradient(90deg," + stops.join(",") + ")";
     legendBox.appendChild(document.createTextNode(m.lo + " "));
     legendBox.appendChild(bar);
+    var top = m.scalar === "delta_a" ? S.delta_a.max : S.max_utilisation;
     legendBox.appendChild(document.createTextNode(" " + m.hi + (m.scalar === "delta_a" ? " %" : "")
-                                                  + " \u2014 " + m.note));
+      + " \u2014 " + m.note + (top === null || top === undefined ? "" :
+                               "; largest " + top.toPrecision(3))));
   }
 
   var seq = el("div", {"class": "gv-row"});
