@@ -110,10 +110,14 @@ class Painter:
         self.edge.extend(np.broadcast_to(edge_rgba, (len(Q), 4)))
 
     def add_strip(self, Q: np.ndarray, side: np.ndarray, axis_normals: np.ndarray,
-                  rgb: np.ndarray, light: np.ndarray, bias: float) -> None:
+                  rgb: np.ndarray, light: np.ndarray, bias: float, layer: float = 0.0) -> None:
         """Strip quads of :func:`strip_faces` (``side`` from it; ``axis_normals (m,3)`` the
         surface normal under each quad): back faces dropped, faces shaded, each placed nearer
-        by ``bias`` on the viewer's side of the surface, farther on the other side."""
+        by ``bias`` on the viewer's side of the surface, farther on the other side.
+
+        ``layer`` (metres) orders strips that lie in the surface and cross each other (GG: two
+        layers bolted at the joints): positive puts this strip on the side of the normal, i.e.
+        nearer by ``layer`` where the normal faces the viewer, farther where it does not."""
         c = self.camera.dir
         n = _unit(np.cross(Q[:, 2] - Q[:, 0], Q[:, 3] - Q[:, 1]))
         keep = n @ c > 1e-9
@@ -122,10 +126,10 @@ class Painter:
         shade = 0.55 + 0.45 * np.abs(n[keep] @ light)
         face = np.column_stack([np.clip(rgb[keep] * shade[:, None], 0, 1),
                                 np.ones(int(keep.sum()))])
-        edge = np.column_stack([0.6 * face[:, :3], np.full(len(face), 0.6)])
+        edge = face  # no seams between the segments
         viewer_side = np.sign(axis_normals[keep] @ c)
         s = np.sign(np.where(np.abs(side[keep]) < 1e-12, 0.0, side[keep]))
-        b = np.where(s * viewer_side >= 0, bias, -bias)
+        b = np.where(s * viewer_side >= 0, bias, -bias) + layer * np.where(viewer_side >= 0, 1, -1)
         self.add(Q[keep], face, edge, b)
 
     def draw(self, ax, linewidth: float = 0.2) -> None:

@@ -199,7 +199,7 @@ def render_ribbons(path: str | os.PathLike, axes: Sequence[np.ndarray],
         n = _unit(np.cross(S[:, 2] - S[:, 0], S[:, -1] - S[:, 1]))
         k = 0.62 + 0.3 * np.abs(n @ light)
         face = np.column_stack([np.outer(k, _SURFACE_RGB), np.ones(len(S))])
-        painter.add(S, face, np.column_stack([face[:, :3] * 0.97, np.full(len(S), 0.5)]))
+        painter.add(S, face, face)  # edges as the faces: no seams, no mesh lines
         size_faces = float(np.median(np.linalg.norm(S[:, 2] - S[:, 0], axis=1)))
     else:
         size_faces = 0.0
@@ -213,16 +213,19 @@ def render_ribbons(path: str | os.PathLike, axes: Sequence[np.ndarray],
         Q, side, qn = strip_faces(a, N[start:start + len(a)], w, t, tangent)
         start += len(a)
         rgb = np.broadcast_to(np.asarray(FAMILY_COLOURS.get(f, (0.3, 0.3, 0.3))), (len(Q), 3))
-        painter.add_strip(Q, side, qn, rgb, light, bias)
+        # GG: family C1 lies on the side of the normal where the two layers cross
+        layer = (0.5 * w if f == 1 else -0.5 * w) if tangent else 0.0
+        painter.add_strip(Q, side, qn, rgb, light, bias, layer)
     if J is not None and len(J):
         ring = np.linspace(0, 2 * np.pi, 9)[:-1]
-        rad = 0.45 * w
+        diag = float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0)))
+        rad = min(0.3 * w, 0.007 * diag) if diag > 0 else 0.3 * w
         dots = J[:, None, :] + rad * (np.cos(ring)[None, :, None] * r +
                                       np.sin(ring)[None, :, None] * u)
         Nj = nearest_vertex_normals(J, V, F)
         lift = np.where(tangent, 0.5 * t, 0.25 * w) * np.sign(Nj @ c)
         painter.add(dots + (lift[:, None] * Nj)[:, None, :], np.array([0.12, 0.12, 0.14, 1.0]),
-                    np.array([0.0, 0.0, 0.0, 1.0]), bias + 0.5 * w)
+                    np.array([0.0, 0.0, 0.0, 1.0]), bias + 1.5 * w)
 
     fig = Figure(figsize=(size[0] / dpi, size[1] / dpi), dpi=dpi)
     ax = fig.add_axes((0.01, 0.01, 0.98, 0.91 if title else 0.98))
