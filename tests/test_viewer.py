@@ -224,6 +224,22 @@ def test_scene_without_sequence_has_deployed_and_aligned(tmp_path):
     assert S["states"] == ["deployed", "aligned"]
 
 
+def test_long_sequence_is_thinned_keeping_both_ends(tmp_path):
+    from render_cases import make_bundle, sequence_extra
+
+    from gridshell.bundle import write_bundle
+    from gridshell.render.viewer.scene import MAX_STATES
+
+    b = make_bundle("GG")
+    d = write_bundle(tmp_path / "gg", b, extra=sequence_extra(b, frames=MAX_STATES + 15))
+    S = build_scene(d)
+    K = MAX_STATES + 14
+    assert len(S["states"]) == MAX_STATES == len(S["strips"]["V"]) == len(S["joints"]["V"])
+    assert S["states"][0] == f"state 0/{K} (deployed)"
+    assert S["states"][-1] == f"state {K}/{K} (aligned)"
+    assert np.allclose(decode(S["joints"]["V"][-1], "f4").reshape(-1, 3), b.aligned, atol=1e-6)
+
+
 # ---- in a browser ---------------------------------------------------------------------------
 
 def _blank(png: bytes) -> tuple[bool, float]:

@@ -36,11 +36,13 @@ from ...errors import InputError
 from ...strips3d import is_tangent, nearest_vertex_normals, strip_solid
 from ..section import bundle_section
 
-__all__ = ["encode", "decode", "build_scene", "scene_json", "MAX_SAMPLES"]
+__all__ = ["encode", "decode", "build_scene", "scene_json", "MAX_SAMPLES", "MAX_STATES"]
 
 #: axis samples per lamella at most (and at least 8); the step is ~1/100 of the bbox diagonal
 MAX_SAMPLES = 96
 _STEP = 1.0 / 100.0
+#: states of the alignment sequence shown at most (evenly picked, first and last kept)
+MAX_STATES = 25
 #: a joint's loops count as collapsed below this fraction of their deployed vector area
 _COLLAPSED = 1e-3
 
@@ -150,9 +152,10 @@ def _states(bundle_dir: Path, bundle) -> tuple[list[np.ndarray], list[str]]:
         frames, _ = read_sequence(bundle_dir)
         if all(f.shape == bundle.net.joints.shape for f in frames):
             K = len(frames) - 1
-            return frames, [f"state {k}/{K}" + (" (deployed)" if k == 0 else
-                                                  " (aligned)" if k == K else "")
-                            for k in range(K + 1)]
+            keep = np.unique(np.linspace(0, K, min(K + 1, MAX_STATES)).round().astype(int))
+            return [frames[k] for k in keep], [
+                f"state {k}/{K}" + (" (deployed)" if k == 0 else " (aligned)" if k == K else "")
+                for k in keep]
     return [bundle.net.joints, bundle.aligned], ["deployed", "aligned"]
 
 
