@@ -17,7 +17,7 @@ CMAKE_BIN := $(PY) -c 'import cmake; print(cmake.CMAKE_BIN_DIR)' 2>/dev/null
 # a C++ compiler on PATH: $CXX if set, else the usual names
 HAVE_CXX  := { command -v "$${CXX:-c++}" || command -v g++ || command -v clang++; } >/dev/null 2>&1
 
-.PHONY: demo test bench clean venv
+.PHONY: demo test bench clean venv browser
 
 venv: $(STAMP)
 
@@ -55,7 +55,19 @@ $(STAMP): pyproject.toml
 demo: $(STAMP)
 	$(VENV)/bin/gridshell demo -o out/demo
 
-test: $(STAMP)
+# The report viewer's browser test (tests/test_viewer.py) drives Debian's chromium headless. As
+# root with apt-get, a missing chromium is installed quietly; otherwise that test is skipped and
+# says why.
+browser:
+	@command -v chromium >/dev/null 2>&1 || command -v chromium-browser >/dev/null 2>&1 || { \
+	  if [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then \
+	    echo "no chromium: installing it with apt-get (the report viewer's browser test)"; \
+	    { apt-get update && DEBIAN_FRONTEND=noninteractive apt-get install -y chromium; } \
+	      >/dev/null 2>&1 || echo >&2 "apt-get could not install chromium; the browser test is skipped"; \
+	  else echo "no chromium (not root or no apt-get): the report viewer's browser test is skipped"; \
+	  fi; }
+
+test: $(STAMP) browser
 	$(PY) -m pytest -q
 
 bench: $(STAMP)

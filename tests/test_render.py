@@ -65,6 +65,74 @@ def test_render_ribbons_png(tmp_path, kind):
     assert not list(tmp_path.glob(".*"))  # atomic: no temporary file left
 
 
+def _square(z: float, n: int = 1, half: float = 1.0):
+    """A horizontal square ``[-half, half]^2`` at height ``z`` as an ``n x n`` quad grid."""
+    from gridshell.grid import grid_quads
+
+    t = np.linspace(-half, half, n + 1)
+    X, Y = np.meshgrid(t, t, indexing="ij")
+    return np.stack([X, Y, np.full_like(X, z)], axis=-1).reshape(-1, 3), grid_quads(n + 1, n + 1)
+
+
+def _line(y: float, z: float, k: int = 30) -> np.ndarray:
+    x = np.linspace(-0.8, 0.8, k)
+    return np.stack([x, np.full(k, y), np.full(k, z)], axis=1)
+
+
+@pytest.mark.parametrize("kind", ["GG", "NCP"])
+def test_surface_hides_the_strips_behind_it(tmp_path, kind):
+    """Two stacked opaque squares seen from above: the strip on the upper one shows, the strip
+    on the lower one is hidden (a transparent surface or a per-collection sort shows both)."""
+    V1, F1 = _square(0.0, 4)
+    V2, F2 = _square(1.0, 4)
+    V, F = np.concatenate([V1, V2]), np.concatenate([F1, F2 + len(V1)])
+    corners = np.array([[-0.9, -0.9, 0.0], [0.9, 0.9, 1.0]])  # the drawn part: both squares
+    out = render_ribbons(tmp_path / "r.png", [_line(0.0, 0.0), _line(0.3, 1.0)], [1, 3], V, F,
+                         corners, kind=kind, width=0.1, thickness=0.01, size=SIZE,
+                         view=(89.0, -90.0))
+    img = _image(out)
+    img[-50:, :130] = 255  # the legend's colour patches
+    img[img.max(axis=2) < 80] = 255  # the joint dots (dark grey, close to a dimmed blue)
+    assert _has_colour(img, FAMILY_COLOURS[3]), "the strip on the near surface is seen"
+    assert not _has_colour(img, FAMILY_COLOURS[1]), "the strip behind the surface is hidden"
+
+
+def test_strip_on_a_large_face_is_not_painted_over():
+    """A strip near the far edge of one big face, seen obliquely: its mean depth is behind the
+    face's, yet it lies on it and is seen (matplotlib's mean-depth order paints it over)."""
+    import tempfile
+    from pathlib import Path
+
+    V, F = _square(0.0, 1)
+    with tempfile.TemporaryDirectory() as d:
+        out = render_ribbons(Path(d) / "r.png", [_line(0.7, 0.0)], [1], V, F, kind="GG",
+                             width=0.1, thickness=0.01, size=SIZE, view=(30.0, -90.0))
+        img = _image(out)
+        img[-50:, :130] = 255  # the legend's colour patches
+        assert _has_colour(img, FAMILY_COLOURS[1])
+
+
+def test_render_bundle_title_says_the_real_strip_width(tmp_path, monkeypatch):
+    import json
+
+    import gridshell.render.ribbons as ribbons
+
+    seen = {}
+    monkeypatch.setattr(ribbons, "render_ribbons",
+                        lambda path, *a, **kw: seen.update(kw) or Path(path))
+    from pathlib import Path
+    d = write_case(tmp_path / "b", "GG")
+    render_bundle(d)
+    assert seen["width"] == pytest.approx(0.2) and seen["thickness"] == pytest.approx(0.01)
+    assert seen["title"].endswith("strips 200 x 10 mm (20 x 1 mm cut at 1:10)")
+    (d / "fabrication").mkdir()
+    (d / "fabrication" / "fabrication.json").write_text(json.dumps(
+        {"params": {"width": 15.0, "thickness": 1.5, "scale": 0.05}}))
+    render_bundle(d)
+    assert seen["width"] == pytest.approx(0.3)
+    assert "300 x 30 mm (15 x 1.5 mm cut at 1:20)" in seen["title"]
+
+
 def test_render_bundle_writes_render_png(tmp_path):
     d = write_case(tmp_path / "b", "GG")
     out = render_bundle(d, size=SIZE)

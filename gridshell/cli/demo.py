@@ -83,7 +83,7 @@ def _finish(d: Path, label: str, name: str, fab_params: dict, progress) -> dict[
     from ..render.report import write_report
     from ..render.ribbons import render_bundle
 
-    progress(f"{label}: rendering render.png (lamellae as ribbons)")
+    progress(f"{label}: rendering render.png (lamellae as strips of their real section)")
     render_bundle(d)
     progress(f"{label}: exporting {name}.3dm (Rhino)")
     export_3dm(d, d / f"{name}.3dm")

@@ -5,8 +5,9 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-HELP = ("render a design bundle: render.png (lamellae as ribbons), alignment.gif when the bundle "
-        "has an alignment sequence, and optionally report.html and a Rhino .3dm")
+HELP = ("render a design bundle: render.png (lamellae as strips of their real width), "
+        "alignment.gif when the bundle has an alignment sequence, and optionally report.html "
+        "(with an interactive 3D view) and a Rhino .3dm")
 
 
 def add_args(p: argparse.ArgumentParser) -> None:
@@ -17,8 +18,9 @@ def add_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--3dm", dest="rhino", metavar="PATH",
                    help="also export net, surface and lamellae to this Rhino .3dm file")
     p.add_argument("--width", type=float, metavar="MM",
-                   help="ribbon width in mm of the model (default a quarter of the joint "
-                        "spacing)")
+                   help="strip width in mm at full size (default the cut strip's width over "
+                        "the scale, from DIR/fabrication/fabrication.json, else 20 mm at 1:10 "
+                        "= 200 mm)")
     p.add_argument("--size", nargs=2, type=int, default=(1200, 900), metavar=("W", "H"),
                    help="render.png size in pixels (default 1200 900)")
     p.add_argument("--no-sequence", action="store_true",

@@ -3,8 +3,9 @@
 The page holds the kind, the parameters, the metrics against the paper's thresholds (5.1:
 mean ``Delta_a`` < 1 %, max < 3 %; ``Delta_l`` and ``Delta_n`` < 1 %) with pass/fail marks,
 every picture of the bundle (PNG and GIF as base64 ``data:`` URIs), the fabrication plan and
-sheets (SVG inline) when ``fabrication/`` exists, and the lamella table. Nothing is fetched
-from the network: inline CSS, no scripts.
+sheets (SVG inline) when ``fabrication/`` exists, and the lamella table; on top, the
+interactive 3D view (:mod:`gridshell.render.viewer`: WebGL, three.js bundled inline). Nothing
+is fetched from the network: inline CSS and scripts, pictures as ``data:`` URIs.
 """
 from __future__ import annotations
 
@@ -249,6 +250,7 @@ def report_html(bundle_dir: str | os.PathLike) -> str:
     """The HTML text of the report of ``bundle_dir`` (see :func:`write_report`)."""
     from .. import __version__
     from ..bundle import read_design_json
+    from .viewer.page import viewer_css, viewer_section
 
     d = Path(bundle_dir)
     design = read_design_json(d)
@@ -298,11 +300,12 @@ def report_html(bundle_dir: str | os.PathLike) -> str:
                    if not p.name.startswith("."))
     parts = [
         "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">",
-        f"<title>{title}</title><style>{_CSS}</style></head><body>",
+        f"<title>{title}</title><style>{_CSS}{viewer_css()}</style></head><body>",
         f"<header><h1>{title}</h1><p>design report written by gridshell {__version__} "
         "&middot; self-contained: no external resources</p></header><main>",
         f'<section id="overview"><h2>Overview</h2><p>{verdict}</p>{_kv_table(overview)}'
         "</section>",
+        viewer_section(d),
         f'<section id="metrics"><h2>Metrics (paper 5.1)</h2>{check_table}',
         "<h2>Other metrics</h2>" + _kv_table(other) if other else "",
         "</section>",

@@ -1,16 +1,19 @@
-"""A headless picture of a gridshell: every lamella as a thin ribbon on its surface (Figs. 1, 10).
+"""A headless picture of a gridshell: every lamella as the strip that is cut, on its surface
+(Figs. 1, 10).
 
-A ribbon is the lamella axis offset by ``+- width/2``:
+A strip is the lamella axis swept by its real section, ``width x thickness`` (the cut strip
+divided by the model scale: 20 x 1 mm at 1:10 = 200 x 10 mm, :mod:`.section`), with its width
 
 - along the in-surface direction ``n x t`` for GG (tangent lamellae, paper Fig. 6 centre);
 - along the surface normal ``n`` for NCP / CNC / AA (orthogonal lamellae standing on the
   surface, Fig. 6 left),
 
-with ``n`` the vertex normal of the surface vertex closest to each axis point. Ribbons are
-coloured by family, the surface is drawn faintly, the camera is chosen from the principal axes
-of the geometry and the three axes are scaled equally. Plain arrays in, one PNG out;
-:func:`render_bundle` does the same for a design bundle. matplotlib's ``Figure`` is used
-directly (Agg canvas, no pyplot state, no display).
+with ``n`` the vertex normal of the surface vertex closest to each axis point
+(:mod:`gridshell.strips3d`). Strips are coloured by family on an opaque surface; all polygons
+are painted far to near in one list (:mod:`.painter`), so no strip shows through the surface
+and none vanishes under it. The camera is chosen from the principal axes of the geometry
+(orthographic). Plain arrays in, one PNG out; :func:`render_bundle` does the same for a design
+bundle. matplotlib's ``Figure`` is used directly (Agg canvas, no pyplot state, no display).
 """
 from __future__ import annotations
 
@@ -24,13 +27,13 @@ from ..atomic import atomic_path
 from ..errors import InputError
 from ..strips3d import TANGENT_KINDS, nearest_vertex_normals, strip_frame
 
-__all__ = ["FAMILY_COLOURS", "TANGENT_KINDS", "default_width", "nearest_vertex_normals",
+__all__ = ["FAMILY_COLOURS", "TANGENT_KINDS", "nearest_vertex_normals",
            "ribbon_polygons", "view_angles", "render_ribbons", "render_bundle"]
 
 #: RGB colour of each lamella family (C^1, C^3)
 FAMILY_COLOURS: dict[int, tuple[float, float, float]] = {1: (0.13, 0.42, 0.70),
                                                          3: (0.86, 0.35, 0.12)}
-_SURFACE_RGBA = (0.62, 0.64, 0.68, 0.18)
+_SURFACE_RGB = (0.80, 0.82, 0.85)
 
 
 def _unit(X: np.ndarray) -> np.ndarray:
@@ -67,17 +70,6 @@ def ribbon_polygons(axis: np.ndarray, normals: np.ndarray, width: float,
     return np.stack([a[:-1], a[1:], b[1:], b[:-1]], axis=1)
 
 
-def default_width(axes: Sequence[np.ndarray], joint_spacing: float | None = None) -> float:
-    """A ribbon width that reads well: a quarter of the joint spacing when known, else 1.5 %
-    of the bounding-box diagonal of the axes (metres)."""
-    if joint_spacing is not None and joint_spacing > 0:
-        return 0.25 * float(joint_spacing)
-    P = np.concatenate([np.asarray(a, float).reshape(-1, 3) for a in axes]) if len(axes) \
-        else np.zeros((1, 3))
-    diag = float(np.linalg.norm(P.max(axis=0) - P.min(axis=0)))
-    return 0.015 * diag if diag > 0 else 0.01
-
-
 def view_angles(P: np.ndarray, tilt_deg: float = 55.0, turn_deg: float = 25.0
                 ) -> tuple[float, float]:
     """Camera ``(elev, azim)`` in degrees (matplotlib's convention) from the principal axes.
@@ -106,53 +98,11 @@ def view_angles(P: np.ndarray, tilt_deg: float = 55.0, turn_deg: float = 25.0
     return elev, azim
 
 
-def _camera_dir(elev: float, azim: float) -> np.ndarray:
-    e, a = np.radians(elev), np.radians(azim)
-    return np.array([np.cos(e) * np.cos(a), np.cos(e) * np.sin(a), np.sin(e)])
-
-
-def _shade(polys: np.ndarray, rgb: np.ndarray, light: np.ndarray) -> np.ndarray:
-    """Face colours ``rgb (m,3)`` dimmed by ``|n . light|`` (two-sided Lambert + ambient)."""
-    if not len(polys):
-        return rgb
-    n = _unit(np.cross(polys[:, 2] - polys[:, 0], polys[:, 3] - polys[:, 1]))
-    k = 0.5 + 0.5 * np.abs(n @ light)
-    return np.clip(rgb * k[:, None], 0.0, 1.0)
-
-
-def _fit_view(fig, ax, P: np.ndarray, fill: float = 0.92) -> None:
-    """Equal axis scales around ``P (k,3)`` and the zoom that makes the projected points fill
-    ``fill`` of the axes rectangle (3D axes otherwise draw into a centred square)."""
-    from mpl_toolkits.mplot3d import proj3d
-
-    _set_equal_limits(ax, P, zoom=1.0)
-    ax.apply_aspect()  # the centred square that draw() would use, so transData is final
-    x, y, _ = proj3d.proj_transform(P[:, 0], P[:, 1], P[:, 2], ax.get_proj())
-    xy = ax.transData.transform(np.column_stack([x, y]))
-    box = ax.get_position(original=True).transformed(fig.transFigure)
-    cx, cy = 0.5 * (box.x0 + box.x1), 0.5 * (box.y0 + box.y1)
-    dx = float(np.max(np.abs(xy[:, 0] - cx))) or 1.0
-    dy = float(np.max(np.abs(xy[:, 1] - cy))) or 1.0
-    zoom = fill * min(0.5 * box.width / dx, 0.5 * box.height / dy)
-    _set_equal_limits(ax, P, zoom=float(np.clip(zoom, 0.2, 5.0)))
-
-
-def _set_equal_limits(ax, P: np.ndarray, pad: float = 0.0, zoom: float = 1.0) -> None:
-    lo, hi = P.min(axis=0), P.max(axis=0)
-    span = hi - lo
-    m = float(span.max()) or 1.0
-    span = np.maximum(span, 0.05 * m)
-    c = 0.5 * (lo + hi)
-    half = 0.5 * span * (1 + 2 * pad)
-    ax.set_xlim(c[0] - half[0], c[0] + half[0])
-    ax.set_ylim(c[1] - half[1], c[1] + half[1])
-    ax.set_zlim(c[2] - half[2], c[2] + half[2])
-    ax.set_box_aspect(tuple(2 * half), zoom=zoom)
-
-
 def _surface_near(V: np.ndarray, F: np.ndarray, P: np.ndarray, max_faces: int) -> np.ndarray:
-    """Face corner arrays of the surface faces whose centroid lies in the bounding box of the
-    points ``P`` grown by 5 % (the part under the net), thinned to ``max_faces``."""
+    """Face corner arrays ``(m, k, 3)`` of the surface faces whose centroid lies in the
+    bounding box of the points ``P`` grown by 5 % (the part under the net); the whole of it
+    (an opaque surface with holes would show what is behind it) unless it has more than
+    ``max_faces`` faces, then thinned to that many."""
     C = V[F].mean(axis=1)
     lo, hi = P.min(axis=0), P.max(axis=0)
     g = 0.05 * float(np.max(hi - lo))
@@ -171,11 +121,15 @@ def _resample(P: np.ndarray, max_points: int) -> np.ndarray:
 def render_ribbons(path: str | os.PathLike, axes: Sequence[np.ndarray],
                    families: Sequence[int], V: np.ndarray, F: np.ndarray,
                    joints: np.ndarray | None = None, *, kind: str = "GG",
-                   width: float | None = None, title: str | None = None,
-                   size: tuple[int, int] = (1000, 750), dpi: int = 100,
-                   view: tuple[float, float] | None = None, max_faces: int = 12000,
-                   max_points: int = 200) -> Path:
-    """Write a PNG of the lamellae as ribbons on the surface, atomically.
+                   width: float | None = None, thickness: float | None = None,
+                   title: str | None = None, size: tuple[int, int] = (1000, 750),
+                   dpi: int = 100, view: tuple[float, float] | None = None,
+                   max_faces: int = 40000, max_points: int = 200) -> Path:
+    """Write a PNG of the lamellae as strips on the opaque surface, atomically.
+
+    Every polygon (surface faces, strip faces, joints) is painted far to near in one list
+    (:class:`gridshell.render.painter.Painter`), so strips behind the surface are hidden and
+    strips on it are seen.
 
     Parameters
     ----------
@@ -186,13 +140,14 @@ def render_ribbons(path: str | os.PathLike, axes: Sequence[np.ndarray],
     families : (len(axes),) int
         Family of each lamella (1 or 3), which sets its colour (:data:`FAMILY_COLOURS`).
     V, F : (n,3) float, (m,3|4) int
-        The surface, drawn faintly (thinned to ``max_faces``) and giving the normals.
+        The surface, drawn opaque, giving the normals.
     joints : (p,3) float, optional
         Joint positions, drawn as small dots.
     kind : {"GG", "NCP", "CNC", "AA"}
         GG lamellae lie tangent to the surface, the others stand orthogonal to it.
-    width : float, optional
-        Ribbon width in metres (default :func:`default_width`).
+    width, thickness : float, optional
+        The strip's real section in metres (default :data:`gridshell.render.section.DEFAULT_CUT`
+        at its scale: 200 x 10 mm).
     title : str, optional
     size : (w, h) int
         Picture size in pixels (exact: no tight bounding box).
@@ -209,7 +164,9 @@ def render_ribbons(path: str | os.PathLike, axes: Sequence[np.ndarray],
     """
     from matplotlib.figure import Figure
     from matplotlib.patches import Patch
-    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    from .painter import Camera, Painter, strip_faces
+    from .section import bundle_section
 
     axes = [np.asarray(a, float).reshape(-1, 3) for a in axes]
     fams = [int(f) for f in families]
@@ -223,49 +180,64 @@ def render_ribbons(path: str | os.PathLike, axes: Sequence[np.ndarray],
     V = np.asarray(V, float).reshape(-1, 3)
     F = np.asarray(F, np.int64)
     J = None if joints is None else np.asarray(joints, float).reshape(-1, 3)
-    w = default_width(axes) if width is None else float(width)
-    if not w > 0:
-        raise InputError(f"render_ribbons: width must be positive, got {width}")
+    default = bundle_section(None)
+    w = default.width_m if width is None else float(width)
+    t = default.thickness_m if thickness is None else float(thickness)
+    if not (w > 0 and t > 0):
+        raise InputError(f"render_ribbons: width and thickness must be positive, got {w}, {t}")
     tangent = kind in TANGENT_KINDS
 
     pts = np.concatenate(axes + ([J] if J is not None and len(J) else []))
     elev, azim = view if view is not None else view_angles(pts)
-    light = _unit(_camera_dir(elev + 25.0, azim - 30.0))
+    cam = Camera(elev, azim)
+    r, u, c = cam.basis()
+    light = _unit(0.5 * c + 0.6 * u - 0.4 * r)
+    painter = Painter(cam)
+
+    S = _surface_near(V, F, pts, max_faces)
+    if len(S):
+        n = _unit(np.cross(S[:, 2] - S[:, 0], S[:, -1] - S[:, 1]))
+        k = 0.62 + 0.3 * np.abs(n @ light)
+        face = np.column_stack([np.outer(k, _SURFACE_RGB), np.ones(len(S))])
+        painter.add(S, face, face)  # edges as the faces: no seams, no mesh lines
+        size_faces = float(np.median(np.linalg.norm(S[:, 2] - S[:, 0], axis=1)))
+    else:
+        size_faces = 0.0
+    bias = 0.5 * size_faces + 0.5 * t
 
     axes_d = [_resample(a, max_points) for a in axes if len(a) >= 2]
     fams_d = [f for a, f in zip(axes, fams) if len(a) >= 2]
     N = nearest_vertex_normals(np.concatenate(axes_d), V, F)
-    polys, cols = [], []
     start = 0
     for a, f in zip(axes_d, fams_d):
-        q = ribbon_polygons(a, N[start:start + len(a)], w, tangent)
+        Q, side, qn = strip_faces(a, N[start:start + len(a)], w, t, tangent)
         start += len(a)
-        polys.append(q)
-        cols.append(np.broadcast_to(FAMILY_COLOURS.get(f, (0.3, 0.3, 0.3)), (len(q), 3)))
-    R = np.concatenate(polys)
-    rgb = _shade(R, np.concatenate(cols), light)
-    S = _surface_near(V, F, pts, max_faces)
-    if S.shape[1] == 3:  # triangles: repeat a corner so one collection holds everything
-        S = np.concatenate([S, S[:, 2:3]], axis=1)
-    face_rgba = np.concatenate([np.tile(_SURFACE_RGBA, (len(S), 1)),
-                                np.column_stack([rgb, np.ones(len(R))])])
-    edge_rgba = np.concatenate([np.zeros((len(S), 4)),
-                                np.column_stack([0.6 * rgb, np.full(len(R), 0.9)])])
+        rgb = np.broadcast_to(np.asarray(FAMILY_COLOURS.get(f, (0.3, 0.3, 0.3))), (len(Q), 3))
+        # GG: family C1 lies on the side of the normal where the two layers cross
+        layer = (0.5 * w if f == 1 else -0.5 * w) if tangent else 0.0
+        painter.add_strip(Q, side, qn, rgb, light, bias, layer)
+    if J is not None and len(J):
+        ring = np.linspace(0, 2 * np.pi, 9)[:-1]
+        diag = float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0)))
+        rad = min(0.3 * w, 0.007 * diag) if diag > 0 else 0.3 * w
+        dots = J[:, None, :] + rad * (np.cos(ring)[None, :, None] * r +
+                                      np.sin(ring)[None, :, None] * u)
+        Nj = nearest_vertex_normals(J, V, F)
+        lift = np.where(tangent, 0.5 * t, 0.25 * w) * np.sign(Nj @ c)
+        painter.add(dots + (lift[:, None] * Nj)[:, None, :], np.array([0.12, 0.12, 0.14, 1.0]),
+                    np.array([0.0, 0.0, 0.0, 1.0]), bias + 1.5 * w)
 
     fig = Figure(figsize=(size[0] / dpi, size[1] / dpi), dpi=dpi)
-    ax = fig.add_axes((0.0, 0.0, 1.0, 0.93 if title else 1.0), projection="3d")
-    ax.computed_zorder = False
-    coll = Poly3DCollection(np.concatenate([S, R]), facecolors=face_rgba,
-                            edgecolors=edge_rgba, linewidths=0.25)
-    ax.add_collection3d(coll)
-    if J is not None and len(J):
-        ax.scatter(J[:, 0], J[:, 1], J[:, 2], s=4, color=(0.1, 0.1, 0.1), depthshade=False,
-                   zorder=5)
-    allP = np.concatenate([pts, R.reshape(-1, 3)])
-    ax.view_init(elev=elev, azim=azim)
+    ax = fig.add_axes((0.01, 0.01, 0.98, 0.91 if title else 0.98))
+    painter.draw(ax, linewidth=0.2)
+    xy = np.concatenate(painter.polys)
+    lo, hi = xy.min(axis=0), xy.max(axis=0)
+    box = np.array([0.98 * size[0], (0.91 if title else 0.98) * size[1]])  # axes, pixels
+    scale = 1.06 * float(np.max((hi - lo) / box)) or 1.0  # metres per pixel, equal both ways
+    mid = 0.5 * (lo + hi)
+    ax.set_xlim(mid[0] - 0.5 * scale * box[0], mid[0] + 0.5 * scale * box[0])
+    ax.set_ylim(mid[1] - 0.5 * scale * box[1], mid[1] + 0.5 * scale * box[1])
     ax.set_axis_off()
-    _fit_view(fig, ax, allP)
-    coll.set_clip_on(False)
     present = sorted(set(fams_d))
     fig.legend(handles=[Patch(color=FAMILY_COLOURS.get(f, (0.3, 0.3, 0.3)),
                               label=f"family C{f} ({fams_d.count(f)})") for f in present],
@@ -278,15 +250,20 @@ def render_ribbons(path: str | os.PathLike, axes: Sequence[np.ndarray],
 
 
 def render_bundle(bundle, path: str | os.PathLike | None = None, *,
-                  width: float | None = None, **kwargs) -> Path:
-    """Render the ribbons of a design bundle (a directory or a
+                  width: float | None = None, thickness: float | None = None,
+                  **kwargs) -> Path:
+    """Render the strips of a design bundle (a directory or a
     :class:`~gridshell.bundle.DesignBundle`) to ``path`` (default ``DIR/render.png``).
 
-    ``width`` is in metres (default a quarter of the median joint spacing); further keyword
-    arguments go to :func:`render_ribbons`.
+    ``width`` and ``thickness`` are the strip's real section in metres (default the cut strip
+    of the bundle's ``fabrication/fabrication.json`` divided by its scale, else 20 x 1 mm at
+    1:10 = 200 x 10 mm: :func:`gridshell.render.section.bundle_section`); the title says it.
+    Further keyword arguments go to :func:`render_ribbons`.
     """
     from ..bundle import read_bundle
+    from .section import bundle_section
 
+    directory = None
     if isinstance(bundle, (str, os.PathLike)):
         directory = Path(bundle)
         b = read_bundle(directory)
@@ -296,15 +273,18 @@ def render_bundle(bundle, path: str | os.PathLike | None = None, *,
         if path is None:
             raise InputError("render_bundle: give an output path for an in-memory bundle")
     lams = b.net.lamellae
-    if width is None:
-        gaps = np.concatenate([np.diff(lam.joint_s) for lam in lams] or [np.zeros(0)])
-        gaps = gaps[gaps > 0]
-        width = default_width([lam.axis for lam in lams],
-                              float(np.median(gaps)) if len(gaps) else None)
+    section = bundle_section(directory)
+    if width is None and thickness is None:
+        text = section.text()
+    else:
+        text = (f"{1000 * (width or section.width_m):.4g} x "
+                f"{1000 * (thickness or section.thickness_m):.4g} mm")
+    width = section.width_m if width is None else width
+    thickness = section.thickness_m if thickness is None else thickness
     n1, n3 = len(b.net.family(1)), len(b.net.family(3))
     orient = "tangent to" if b.kind in TANGENT_KINDS else "standing on"
     kwargs.setdefault("title", f"{b.kind} gridshell: {n1} + {n3} lamellae {orient} the surface, "
-                               f"width {1000 * width:.0f} mm")
+                               f"strips {text}")
     return render_ribbons(path, [lam.axis for lam in lams], [lam.family for lam in lams],
                           b.surface_V, b.surface_F, b.net.joints, kind=b.kind, width=width,
-                          **kwargs)
+                          thickness=thickness, **kwargs)

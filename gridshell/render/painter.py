@@ -1,0 +1,145 @@
+"""A painter's algorithm for strips on a surface: every polygon sorted by depth in one list.
+
+matplotlib's 3D axes sort polygons per collection and by their mean depth only, so thin strips
+lying on (GG) or standing on (NCP) a surface are painted in the wrong order where the surface's
+faces are larger than the strips' segments: strips on the far side of a saddle show through the
+near side, strips vanish under the faces they lie on. Here the surface is opaque and each
+polygon is placed by its own key:
+
+- a **surface face**: its mean depth;
+- a **strip face**: its mean depth moved by ``bias`` towards the viewer when the face lies on
+  the side of the surface that faces the viewer (or in it), away from the viewer otherwise
+  (``bias`` is about the size of a surface face, the depth error the mean-depth order makes
+  between a strip and the face under it);
+
+and only strip faces turned to the viewer are drawn (a closed strip hides its back faces).
+The projection is orthographic, the camera given as matplotlib's ``(elev, azim)``.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+__all__ = ["Camera", "Painter", "strip_faces"]
+
+
+def _unit(X: np.ndarray) -> np.ndarray:
+    n = np.linalg.norm(X, axis=-1, keepdims=True)
+    return np.divide(X, n, out=np.zeros_like(X), where=n > 0)
+
+
+@dataclass(frozen=True)
+class Camera:
+    """Orthographic camera looking along ``-dir``; ``dir`` points from the scene to the viewer,
+    ``(elev, azim)`` in degrees as in matplotlib."""
+
+    elev: float
+    azim: float
+
+    @property
+    def dir(self) -> np.ndarray:
+        e, a = np.radians(self.elev), np.radians(self.azim)
+        return np.array([np.cos(e) * np.cos(a), np.cos(e) * np.sin(a), np.sin(e)])
+
+    def basis(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(right, up, towards the viewer)`` unit vectors; ``up`` is the world's z made
+        orthogonal to the view (or y when looking straight down)."""
+        c = self.dir
+        r = np.cross([0.0, 0.0, 1.0], c)
+        if np.linalg.norm(r) < 1e-9:
+            r = np.array([1.0, 0.0, 0.0])
+        r = _unit(r)
+        return r, np.cross(c, r), c
+
+    def project(self, P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Screen coordinates ``(..., 2)`` and depth ``(...)`` (larger = nearer) of ``P``."""
+        r, u, c = self.basis()
+        P = np.asarray(P, float)
+        return np.stack([P @ r, P @ u], axis=-1), P @ c
+
+
+def strip_faces(axis: np.ndarray, normals: np.ndarray, width: float, thickness: float,
+                tangent: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The four long sides of a strip (:func:`gridshell.strips3d.strip_solid`) as quads, each
+    side split in two along its width: ``Q (8(k-1), 4, 3)``; ``side (8(k-1),)``, the signed
+    distance of each quad's centre from the surface along the normal (metres; 0 for a quad in
+    the surface); and that unit normal under each quad ``(8(k-1), 3)``."""
+    from ..strips3d import strip_frame
+
+    P = np.asarray(axis, float).reshape(-1, 3)
+    _, W, H = strip_frame(P, normals, tangent)
+    N = _unit(np.asarray(normals, float).reshape(-1, 3))
+    w, h = 0.5 * float(width) * W, 0.5 * float(thickness) * H
+    corners = [-w - h, +w - h, +w + h, -w + h]  # strip_solid's order around the section
+    quads, sides, normals_q = [], [], []
+    for a in range(4):
+        A, B = corners[a], corners[(a + 1) % 4]
+        M = 0.5 * (A + B)
+        for X, Y in ((A, M), (M, B)):
+            q = np.stack([P[:-1] + X[:-1], P[:-1] + Y[:-1], P[1:] + Y[1:], P[1:] + X[1:]], axis=1)
+            quads.append(q)
+            mid = 0.25 * (X[:-1] + Y[:-1] + X[1:] + Y[1:])
+            nm = 0.5 * (N[:-1] + N[1:])
+            sides.append(np.sum(mid * nm, axis=1))
+            normals_q.append(nm)
+    return np.concatenate(quads), np.concatenate(sides), np.concatenate(normals_q)
+
+
+@dataclass
+class Painter:
+    """Polygons collected with their colours and sort keys, drawn far to near."""
+
+    camera: Camera
+    polys: list[np.ndarray] = field(default_factory=list)     # (k_i, 2) screen
+    keys: list[float] = field(default_factory=list)
+    face: list[np.ndarray] = field(default_factory=list)      # RGBA
+    edge: list[np.ndarray] = field(default_factory=list)
+
+    def add(self, Q: np.ndarray, face_rgba: np.ndarray, edge_rgba: np.ndarray,
+            bias: np.ndarray | float = 0.0) -> None:
+        """Add polygons ``Q (m, k, 3)`` with colours ``(m, 4)`` and depth ``bias`` (metres,
+        positive = nearer)."""
+        if not len(Q):
+            return
+        xy, z = self.camera.project(Q)
+        key = z.mean(axis=1) + np.broadcast_to(np.asarray(bias, float), (len(Q),))
+        self.polys.extend(xy)
+        self.keys.extend(key.tolist())
+        self.face.extend(np.broadcast_to(face_rgba, (len(Q), 4)))
+        self.edge.extend(np.broadcast_to(edge_rgba, (len(Q), 4)))
+
+    def add_strip(self, Q: np.ndarray, side: np.ndarray, axis_normals: np.ndarray,
+                  rgb: np.ndarray, light: np.ndarray, bias: float, layer: float = 0.0) -> None:
+        """Strip quads of :func:`strip_faces` (``side`` from it; ``axis_normals (m,3)`` the
+        surface normal under each quad): back faces dropped, faces shaded, each placed nearer
+        by ``bias`` on the viewer's side of the surface, farther on the other side.
+
+        ``layer`` (metres) orders strips that lie in the surface and cross each other (GG: two
+        layers bolted at the joints): positive puts this strip on the side of the normal, i.e.
+        nearer by ``layer`` where the normal faces the viewer, farther where it does not."""
+        c = self.camera.dir
+        n = _unit(np.cross(Q[:, 2] - Q[:, 0], Q[:, 3] - Q[:, 1]))
+        keep = n @ c > 1e-9
+        if not np.any(keep):
+            return
+        shade = 0.55 + 0.45 * np.abs(n[keep] @ light)
+        face = np.column_stack([np.clip(rgb[keep] * shade[:, None], 0, 1),
+                                np.ones(int(keep.sum()))])
+        edge = face  # no seams between the segments
+        viewer_side = np.sign(axis_normals[keep] @ c)
+        s = np.sign(np.where(np.abs(side[keep]) < 1e-12, 0.0, side[keep]))
+        b = np.where(s * viewer_side >= 0, bias, -bias) + layer * np.where(viewer_side >= 0, 1, -1)
+        self.add(Q[keep], face, edge, b)
+
+    def draw(self, ax, linewidth: float = 0.2) -> None:
+        """Paint everything, far to near, into a 2D matplotlib ``ax``."""
+        from matplotlib.collections import PolyCollection
+
+        if not self.polys:
+            return
+        order = np.argsort(np.asarray(self.keys), kind="stable")
+        coll = PolyCollection([self.polys[i] for i in order],
+                              facecolors=np.asarray(self.face)[order],
+                              edgecolors=np.asarray(self.edge)[order], linewidths=linewidth)
+        ax.add_collection(coll)
