@@ -111,11 +111,11 @@ def _surface_near(V: np.ndarray, F: np.ndarray, P: np.ndarray, max_faces: int) -
     return V[Fd[:: max(1, int(np.ceil(len(Fd) / max_faces)))]]
 
 
-def _resample(P: np.ndarray, max_points: int) -> np.ndarray:
-    if len(P) <= max_points:
-        return P
-    idx = np.unique(np.linspace(0, len(P) - 1, max_points).round().astype(int))
-    return P[idx]
+def _resample_index(k: int, max_points: int) -> np.ndarray:
+    """Indices of at most ``max_points`` of ``k`` points, evenly spread, ends kept."""
+    if k <= max_points:
+        return np.arange(k)
+    return np.unique(np.linspace(0, k - 1, max_points).round().astype(int))
 
 
 def render_ribbons(path: str | os.PathLike, axes: Sequence[np.ndarray],
@@ -124,7 +124,9 @@ def render_ribbons(path: str | os.PathLike, axes: Sequence[np.ndarray],
                    width: float | None = None, thickness: float | None = None,
                    title: str | None = None, size: tuple[int, int] = (1000, 750),
                    dpi: int = 100, view: tuple[float, float] | None = None,
-                   max_faces: int = 40000, max_points: int = 200) -> Path:
+                   max_faces: int = 40000, max_points: int = 200,
+                   colours: Sequence[np.ndarray] | None = None,
+                   colorbar: tuple[str, str] | None = None) -> Path:
     """Write a PNG of the lamellae as strips on the opaque surface, atomically.
 
     Every polygon (surface faces, strip faces, joints) is painted far to near in one list
@@ -156,6 +158,11 @@ def render_ribbons(path: str | os.PathLike, axes: Sequence[np.ndarray],
         Camera (default :func:`view_angles` of the axes and joints).
     max_faces, max_points : int
         Drawing budget for surface faces and points per axis.
+    colours : list of (k_i,3) float, optional
+        RGB at every point of each axis (e.g. a utilisation map) instead of the family
+        colours; each segment takes the colour of its first point.
+    colorbar : (cmap name, label), optional
+        A colour bar over ``[0, 1]`` beside the picture (with ``colours``).
 
     Returns
     -------
@@ -205,14 +212,24 @@ def render_ribbons(path: str | os.PathLike, axes: Sequence[np.ndarray],
         size_faces = 0.0
     bias = 0.5 * size_faces + 0.5 * t
 
-    axes_d = [_resample(a, max_points) for a in axes if len(a) >= 2]
-    fams_d = [f for a, f in zip(axes, fams) if len(a) >= 2]
+    if colours is not None and [len(c) for c in colours] != [len(a) for a in axes]:
+        raise InputError("render_ribbons: give one RGB per axis point in colours")
+    keep = [i for i, a in enumerate(axes) if len(a) >= 2]
+    picks = [_resample_index(len(axes[i]), max_points) for i in keep]
+    axes_d = [axes[i][p] for i, p in zip(keep, picks)]
+    fams_d = [fams[i] for i in keep]
+    cols_d = (None if colours is None else
+              [np.asarray(colours[i], float).reshape(-1, 3)[p] for i, p in zip(keep, picks)])
     N = nearest_vertex_normals(np.concatenate(axes_d), V, F)
     start = 0
-    for a, f in zip(axes_d, fams_d):
+    for i, (a, f) in enumerate(zip(axes_d, fams_d)):
         Q, side, qn = strip_faces(a, N[start:start + len(a)], w, t, tangent)
         start += len(a)
-        rgb = np.broadcast_to(np.asarray(FAMILY_COLOURS.get(f, (0.3, 0.3, 0.3))), (len(Q), 3))
+        if cols_d is None:
+            rgb = np.broadcast_to(np.asarray(FAMILY_COLOURS.get(f, (0.3, 0.3, 0.3))),
+                                  (len(Q), 3))
+        else:  # strip_faces: 8 groups of one quad per segment
+            rgb = np.tile(cols_d[i][:-1], (len(Q) // (len(a) - 1), 1))
         # GG: family C1 lies on the side of the normal where the two layers cross
         layer = (0.5 * w if f == 1 else -0.5 * w) if tangent else 0.0
         painter.add_strip(Q, side, qn, rgb, light, bias, layer)
@@ -238,7 +255,16 @@ def render_ribbons(path: str | os.PathLike, axes: Sequence[np.ndarray],
     ax.set_xlim(mid[0] - 0.5 * scale * box[0], mid[0] + 0.5 * scale * box[0])
     ax.set_ylim(mid[1] - 0.5 * scale * box[1], mid[1] + 0.5 * scale * box[1])
     ax.set_axis_off()
-    present = sorted(set(fams_d))
+    if colorbar is not None:
+        from matplotlib import colormaps
+        from matplotlib.cm import ScalarMappable
+        from matplotlib.colors import Normalize
+
+        cax = fig.add_axes((0.92, 0.15, 0.02, 0.6))
+        cb = fig.colorbar(ScalarMappable(norm=Normalize(0.0, 1.0),
+                                         cmap=colormaps[colorbar[0]]), cax=cax)
+        cb.set_label(colorbar[1], fontsize=8)
+    present = sorted(set(fams_d)) if colours is None else []
     fig.legend(handles=[Patch(color=FAMILY_COLOURS.get(f, (0.3, 0.3, 0.3)),
                               label=f"family C{f} ({fams_d.count(f)})") for f in present],
                loc="lower left", fontsize=8, frameon=False)

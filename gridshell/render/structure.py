@@ -17,8 +17,6 @@ import numpy as np
 
 from ..atomic import atomic_path
 from ..errors import InputError
-from .ribbons import (TANGENT_KINDS, _camera_dir, _fit_view, _shade, _surface_near, _unit,
-                      default_width, nearest_vertex_normals, ribbon_polygons, view_angles)
 
 __all__ = ["render_utilisation", "structure_section", "utilisation_colours", "PICTURE"]
 
@@ -41,89 +39,44 @@ def utilisation_colours(u: np.ndarray, top: float | None = None) -> np.ndarray:
 
 
 def render_utilisation(bundle, result: dict[str, Any], path: str | os.PathLike, *,
-                       width: float | None = None, size: tuple[int, int] = (1000, 750),
-                       dpi: int = 100, max_points: int = 200) -> Path:
+                       size: tuple[int, int] = (1000, 750), dpi: int = 100,
+                       max_points: int = 200) -> Path:
     """Write the utilisation picture of ``bundle`` (a :class:`~gridshell.bundle.DesignBundle`
     or its directory) from ``result`` (:func:`gridshell.structure.check.check_bundle`) to
-    ``path`` (PNG, atomically). ``width``: ribbon width, metres of the design (default as
-    ``render.png``)."""
-    from matplotlib import colormaps
-    from matplotlib.cm import ScalarMappable
-    from matplotlib.colors import Normalize
-    from matplotlib.figure import Figure
-    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
-
+    ``path`` (PNG, atomically): the strips at the checked section (``result["section"]``,
+    real size), depth-sorted as ``render.png`` (:func:`.ribbons.render_ribbons`), coloured
+    by utilisation."""
     from ..bundle import read_bundle
+    from .ribbons import render_ribbons
 
     b = read_bundle(bundle) if isinstance(bundle, (str, os.PathLike)) else bundle
     recs = {int(r["id"]): r for r in result.get("lamellae", [])}
     lams = [lam for lam in b.net.lamellae if len(lam.axis) >= 2]
     if not lams:
         raise InputError("render_utilisation: no lamella axes to draw")
-    if width is None:
-        gaps = np.concatenate([np.diff(lam.joint_s) for lam in lams] or [np.zeros(0)])
-        gaps = gaps[gaps > 0]
-        width = default_width([lam.axis for lam in lams],
-                              float(np.median(gaps)) if len(gaps) else None)
     top = max(float(result.get("max_utilisation_deployed", 1.0) or 1.0), 1.0)
-    pts = np.concatenate([lam.axis for lam in lams] + [b.net.joints])
-    elev, azim = view_angles(pts)
-    light = _unit(_camera_dir(elev + 25.0, azim - 30.0))
-    polys, cols = [], []
+    colours = []
     for lam in lams:
-        idx = np.unique(np.linspace(0, len(lam.axis) - 1, min(len(lam.axis), max_points))
-                        .round().astype(int))
-        a = lam.axis[idx]
         u = np.asarray(recs.get(int(lam.id), {}).get("utilisation") or np.zeros(len(lam.axis)),
                        float)
-        u = u[idx] if len(u) == len(lam.axis) else np.zeros(len(idx))
-        q = ribbon_polygons(a, nearest_vertex_normals(a, b.surface_V, b.surface_F), width,
-                            b.kind in TANGENT_KINDS)
-        polys.append(q)
-        cols.append(utilisation_colours(np.maximum(u[:-1], u[1:]), top))
-    R = np.concatenate(polys)
-    rgb = _shade(R, np.concatenate(cols), light) * 0.35 + np.concatenate(cols) * 0.65
-    S = _surface_near(np.asarray(b.surface_V, float), np.asarray(b.surface_F, np.int64), pts,
-                      8000)
-    if S.shape[1] == 3:
-        S = np.concatenate([S, S[:, 2:3]], axis=1)
-    face = np.concatenate([np.tile((0.62, 0.64, 0.68, 0.15), (len(S), 1)),
-                           np.column_stack([rgb, np.ones(len(R))])])
-    edge = np.concatenate([np.zeros((len(S), 4)),
-                           np.column_stack([0.7 * rgb, np.full(len(R), 0.9)])])
-    fig = Figure(figsize=(size[0] / dpi, size[1] / dpi), dpi=dpi)
-    ax = fig.add_axes((0.0, 0.0, 0.88, 0.93), projection="3d")
-    ax.computed_zorder = False
-    coll = Poly3DCollection(np.concatenate([S, R]), facecolors=face, edgecolors=edge,
-                            linewidths=0.25)
-    ax.add_collection3d(coll)
-    w = result.get("worst") or {}
-    wl = next((lam for lam in lams if int(lam.id) == w.get("lamella")), None)
-    if wl is not None:
-        from ..net import polyline_arclength
-
-        s = polyline_arclength(wl.axis)
-        p = np.array([np.interp(float(w.get("s_m", 0.0)), s, wl.axis[:, c]) for c in range(3)])
-        ax.scatter([p[0]], [p[1]], [p[2]], s=60, marker="x", color="black", zorder=6,
-                   depthshade=False)
-        ax.text(p[0], p[1], p[2], f"  L{wl.id}: {w.get('utilisation', 0):.2f}", fontsize=8,
-                zorder=7)
-    ax.view_init(elev=elev, azim=azim)
-    ax.set_axis_off()
-    _fit_view(fig, ax, np.concatenate([pts, R.reshape(-1, 3)]))
-    coll.set_clip_on(False)
-    cax = fig.add_axes((0.90, 0.15, 0.025, 0.65))
-    sm = ScalarMappable(norm=Normalize(0.0, 1.0), cmap=colormaps["RdYlGn_r"])
-    cb = fig.colorbar(sm, cax=cax)
-    cb.set_label("utilisation (1 = elastic limit)", fontsize=8)
+        u = u if len(u) == len(lam.axis) else np.zeros(len(lam.axis))
+        colours.append(utilisation_colours(np.maximum(u, np.r_[u[1:], u[-1]]), top))
     sec, mat = result.get("section", {}), result.get("material", {})
-    fig.suptitle(f"{b.kind}: {sec.get('width_mm', 0):g} x {sec.get('thickness_mm', 0):g} mm "
-                 f"{mat.get('name', '')} at {sec.get('scale_text', '')}, max utilisation "
-                 f"{result.get('max_utilisation_deployed', 0):.2f} deployed - "
-                 f"{result.get('verdict', '')}", fontsize=10)
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, format="png", dpi=dpi)
-    return Path(path)
+    scale = float(sec.get("scale") or 0.1)
+    width = 1e-3 * float(sec.get("width_mm") or 20.0) / scale
+    thickness = 1e-3 * float(sec.get("thickness_mm") or 1.0) / scale
+    w = result.get("worst") or {}
+    worst = (f", worst L{w.get('lamella')} ({w.get('utilisation', 0):.2f}) at "
+             f"{float(w.get('s_m', 0.0)):.2f} m" if w.get("lamella") is not None else "")
+    title = (f"{b.kind}: {sec.get('width_mm', 0):g} x {sec.get('thickness_mm', 0):g} mm "
+             f"{mat.get('name', '')} at {sec.get('scale_text', '')}, max utilisation "
+             f"{result.get('max_utilisation_deployed', 0):.2f} deployed{worst} - "
+             f"{result.get('verdict', '')}")
+    return render_ribbons(path, [lam.axis for lam in lams], [lam.family for lam in lams],
+                          b.surface_V, b.surface_F, b.net.joints, kind=b.kind, width=width,
+                          thickness=thickness, title=title, size=size, dpi=dpi,
+                          max_points=max_points, colours=colours,
+                          colorbar=("RdYlGn_r", "utilisation (1 = elastic limit)"))
 
 
 def _num(v: Any, fmt: str = "{:.3g}") -> str:
@@ -180,7 +133,8 @@ def structure_section(bundle_dir: str | os.PathLike, rows: int = 40) -> str:
         body.append(
             f"<tr><td class=num>{int(x['id'])}</td><td>C{int(x['family'])}</td>"
             f"<td class=num><span{cls}>{float(x['max_utilisation']):.2f}</span></td>"
-            f"<td class=num>{float(x['worst_s_m']):.3f}</td><td class=num>{x['worst_joint']}</td>"
+            f"<td class=num>{_num(x.get('worst_s_m'), '{:.3f}')}</td>"
+            f"<td class=num>{_num(x.get('worst_joint'), '{}')}</td>"
             f"<td class=num>{_num(x.get('max_sigma_weak_MPa'))} / "
             f"{_num(x.get('max_sigma_strong_MPa'))}, {_num(x.get('max_tau_MPa'))}</td>"
             f"<td class=num>{_num(R * 1e3 if R else None, '{:.0f}')}</td>"
