@@ -257,6 +257,16 @@ def read_configuration(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray,
     file must still parse and hold at least one vertex (:class:`MeshError` otherwise);
     coordinates must be finite.
     """
+    V, P, sizes = read_polygons(path)
+    check_coordinates(V, Path(path).name)
+    return V, P, sizes
+
+
+def read_polygons(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Vertices ``V (n,3)`` (finite, in the file's units), padded faces ``(m,k)`` (``-1``
+    padded, indices checked) and face sizes ``(m,)`` of a mesh file: the file as it is, before
+    unit conversion, cleaning and the geometry checks (:mod:`gridshell.io` reads user meshes
+    through it)."""
     path = Path(path)
     V, P, sizes = _read_raw(path)
     V = np.asarray(V, dtype=np.float64).reshape(-1, 3)
@@ -266,7 +276,6 @@ def read_configuration(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray,
     if len(P) and (P.max() >= len(V)):
         raise MeshError(f"{path.name}: a face refers to vertex {int(P.max())} but the file has "
                         f"{len(V)} vertices; the file is truncated or corrupt")
-    check_coordinates(V, path.name)
     return V, P, sizes
 
 

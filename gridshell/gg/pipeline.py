@@ -281,17 +281,16 @@ def gg_score(P: np.ndarray, **net_options: Any) -> float:
 # ----------------------------------------------------------------------------- the pipeline
 
 
-def _load_target(target: Any) -> tuple[np.ndarray, np.ndarray, str | None]:
-    from ..meshfile import read_mesh
+def _load_target(target: Any, units: Any = None, clean: bool = True, obj: str | None = None,
+                 progress: Progress = None) -> tuple[np.ndarray, np.ndarray, Any]:
+    """``(V, F, input)`` of a target (path, InputGeometry, mesh or ``(V, F)``), metres, read
+    through :func:`gridshell.io.read.read_input` (units, cleaning, the disk check)."""
+    from ..io.read import read_input
 
-    if isinstance(target, (str, Path)):
-        m = read_mesh(target, kind="any")
-        return m.V, m.F, str(Path(target).resolve())
-    if hasattr(target, "V") and hasattr(target, "F"):
-        return np.asarray(target.V, float), np.asarray(target.F, np.int64), None
-    if isinstance(target, tuple) and len(target) == 2:
-        return np.asarray(target[0], float), np.asarray(target[1], np.int64), None
-    raise InputError("the target must be a mesh file path, a QuadMesh/TriMesh or a (V, F) pair")
+    geo = read_input(target, units=units, clean=clean, obj=obj)
+    if progress is not None and geo.path is not None:
+        progress(f"input: {geo.summary()}")
+    return geo.V, geo.F, geo
 
 
 def design_gg(target: Any, *, meridians: str = "cols", grid: tuple[int, int] | None = None,
@@ -301,14 +300,19 @@ def design_gg(target: Any, *, meridians: str = "cols", grid: tuple[int, int] | N
               offsets: tuple[Sequence[float], Sequence[float]] | None = None,
               weights: dict[str, float] | None = None, angle: float | None = None,
               rounds: int = 10, polish_iter: int = 20, allow_unconverged: bool = False,
-              frames: int = 12, progress: Progress = None
+              frames: int = 12, units: Any = None, clean: bool = True,
+              obj: str | None = None, progress: Progress = None
               ) -> tuple[DesignBundle, dict[str, Any]]:
     """Design a geodesic alignable gridshell on (an approximation of) a target surface.
 
     Parameters
     ----------
-    target : path, QuadMesh/TriMesh or (V, F)
-        The target surface, metres; one disk.
+    target : path (OBJ, PLY, OFF, 3DM), InputGeometry, QuadMesh/TriMesh or (V, F)
+        The target surface, one disk (a .3dm NURBS surface is sampled).
+    units, clean, obj
+        The unit the target is drawn in (None: a .3dm's own, else metres if plausible),
+        cleaning (weld, de-duplicate, orient) and the .3dm object to read: see
+        :func:`gridshell.io.read.read_input`. The bundle records the unit.
     meridians : {"rows", "cols"}
         For a structured quad-grid target: which grid lines become the meridians (geodesics
         of the designed surface); passed to :func:`gridshell.gg.initial.initial_grid`.
@@ -358,7 +362,8 @@ def design_gg(target: Any, *, meridians: str = "cols", grid: tuple[int, int] | N
     if offsets is not None:
         offsets = check_offsets(offsets)  # before the long surface optimization
         n_lamellae = spacing = None       # the offsets place every lamella
-    V, F, target_path = _load_target(target)
+    V, F, geo = _load_target(target, units, clean, obj, progress)
+    target_path = geo.path
     from .design import design_gg_surface
     from .initial import initial_grid
 
@@ -411,6 +416,7 @@ def design_gg(target: Any, *, meridians: str = "cols", grid: tuple[int, int] | N
               "crossing_angle": crossing_angle, "at_parallel": at_parallel,
               "offsets": [list(map(float, o)) for o in offsets] if offsets else None,
               "weights": weights, "converged": quality["ok"], "quality": quality,
+              "input": geo.info(),
               "surface": {"geodesic_residual_max": design.geodesic_residual_max,
                           "length_residual_rel_max": design.length_residual_rel_max,
                           "residuals_at_round_off": design.converged, "polish_stop": design.stop,
@@ -419,7 +425,8 @@ def design_gg(target: Any, *, meridians: str = "cols", grid: tuple[int, int] | N
               "total_angle": rev.total_angle,
               "clairaut_c": inet.c, "s_star": inet.s_star, "frames": int(frames)}
     bundle = DesignBundle(kind="GG", net=net, aligned=aligned, surface_V=sV, surface_F=sF,
-                          metrics=metrics, params=params, revolution_V=rV, revolution_F=rF)
+                          metrics=metrics, params=params, revolution_V=rV, revolution_F=rF,
+                          units=geo.units)
     report = {"design": design_report, "revolution": rev.info, "collapse": collapse_info,
               "net": inet.info, "sequence": seq}
     return bundle, report
