@@ -214,7 +214,8 @@ def _pct(d: dict[str, float]) -> dict[str, float]:
 
 
 def gg_metrics(net: Net, V: np.ndarray, F: np.ndarray, *, net_rev: Net | None = None,
-               target: tuple[np.ndarray, np.ndarray] | None = None) -> dict[str, Any]:
+               target: tuple[np.ndarray, np.ndarray] | None = None,
+               target_samples: tuple[np.ndarray, np.ndarray] | None = None) -> dict[str, Any]:
     """Paper 5.1 metrics of a GG net on its surface ``(V, F)``; percentages.
 
     Returns
@@ -224,7 +225,9 @@ def gg_metrics(net: Net, V: np.ndarray, F: np.ndarray, *, net_rev: Net | None = 
         ``alignability_revolution`` (the same net on the surface of revolution, if given),
         ``geodesic_turning`` (ratio, %, with the normals of the smooth surface through the grid
         when ``(V, F)`` is one, see :func:`gridshell.metrics.geodesic_turning`), and with a
-        target: ``deviation`` (the surface's vertices from the target), ``deviation_joints``
+        target: ``deviation`` (the surface's vertices from the target; ``target_samples``, a
+        working copy of a big target, if given, is what the target -> surface figures
+        ``deviation_target`` and ``coverage`` sample), ``deviation_joints``
         (the joints from the target), ``deviation_target`` (the target from the surface: large
         where the design does not reach the target's boundary), all ``{"mean", "max"}`` in % of
         the target's bounding-box diagonal, and ``coverage`` (area of the surface / area of the
@@ -244,9 +247,10 @@ def gg_metrics(net: Net, V: np.ndarray, F: np.ndarray, *, net_rev: Net | None = 
         dj = deviation(net.joints, tV, tF)
         out["deviation"] = {"mean": dv["mean"], "max": dv["max"]}
         out["deviation_joints"] = {"mean": dj["mean"], "max": dj["max"]}
-        dt = target_deviation(V, F, tV, tF)
+        sV, sF = target_samples if target_samples is not None else target
+        dt = target_deviation(V, F, sV, sF)
         out["deviation_target"] = {"mean": dt["mean"], "max": dt["max"]}
-        out["coverage"] = coverage(V, F, tV, tF)
+        out["coverage"] = coverage(V, F, sV, sF)
     out["n_joints"] = int(len(net.joints))
     out["n_loops"] = int(len(net.loops))
     out["n_lamellae"] = {"C1": len(net.family(1)), "C3": len(net.family(3))}
@@ -368,12 +372,20 @@ def design_gg(target: Any, *, meridians: str = "cols", grid: tuple[int, int] | N
     from .initial import initial_grid
 
     _say(progress, f"target: {len(V)} vertices, {len(F)} faces")
-    P0 = initial_grid(V, F, meridians=meridians, grid=grid, direction=direction)
+    from ..io.working import working_mesh
+
+    # a big target: the grid is sampled and projected on a working copy; the deviations
+    # below are measured against the full target
+    Vw, Fw, work = working_mesh(V, F)
+    if work is not None:
+        _say(progress, f"designing on a working copy of {work['faces'][1]} faces "
+             f"({work['method']}); deviations measured against all {len(F)}")
+    P0 = initial_grid(Vw, Fw, meridians=meridians, grid=grid, direction=direction)
     _say(progress, f"initial grid {P0.shape[0]} x {P0.shape[1]}; designing the GG surface")
     net_options = {"n_lamellae": n_lamellae, "spacing": spacing,
                    "crossing_angle": crossing_angle, "at_parallel": at_parallel,
                    "offsets": offsets, "angle": angle}
-    design = design_gg_surface(V, F, P0, weights=weights, outer=rounds,
+    design = design_gg_surface(Vw, Fw, P0, weights=weights, outer=rounds,
                                polish_iter=polish_iter, progress=progress,
                                evaluate=lambda P: gg_score(P, **net_options))
     P, design_report = design.P, dict(design.report, converged=design.converged,
@@ -387,7 +399,8 @@ def design_gg(target: Any, *, meridians: str = "cols", grid: tuple[int, int] | N
     aligned, collapse_info = collapse_gg(net)
     R, C = P.shape[:2]
     sV, sF = P.reshape(-1, 3), grid_quads(R, C)
-    metrics = gg_metrics(net, sV, sF, net_rev=stage["net_rev"], target=(V, F))
+    metrics = gg_metrics(net, sV, sF, net_rev=stage["net_rev"], target=(V, F),
+                         target_samples=(Vw, Fw) if work is not None else None)
     metrics["collapse_mismatch_max"] = collapse_info["mismatch_max"]
     gates = gg_gates(metrics)
     quality = {"ok": passed(gates), "gates": [g.as_dict() for g in gates],
@@ -416,7 +429,7 @@ def design_gg(target: Any, *, meridians: str = "cols", grid: tuple[int, int] | N
               "crossing_angle": crossing_angle, "at_parallel": at_parallel,
               "offsets": [list(map(float, o)) for o in offsets] if offsets else None,
               "weights": weights, "converged": quality["ok"], "quality": quality,
-              "input": geo.info(),
+              "input": {**geo.info(), "working_mesh": work},
               "surface": {"geodesic_residual_max": design.geodesic_residual_max,
                           "length_residual_rel_max": design.length_residual_rel_max,
                           "residuals_at_round_off": design.converged, "polish_stop": design.stop,

@@ -107,8 +107,6 @@ def clean_mesh(V: np.ndarray, P: np.ndarray, sizes: np.ndarray, *, name: str = "
         faces in their original order among the kept ones)
     report : CleanReport
     """
-    import pymeshlab
-
     V = np.asarray(V, dtype=np.float64)
     P = np.asarray(P, dtype=np.int64)
     sizes = np.asarray(sizes, dtype=np.int64)
@@ -116,6 +114,8 @@ def clean_mesh(V: np.ndarray, P: np.ndarray, sizes: np.ndarray, *, name: str = "
     tol = tolerance * mean_edge_length(V, P, sizes)
     if not needs_cleaning(V, P, sizes, tol):  # the usual case: a welded, oriented mesh
         return V, P, sizes, CleanReport(vertices=(n0, n0), faces=(m0, m0), tolerance=tol)
+    import pymeshlab
+
     T, owner = _fan(P, sizes)
     ms = pymeshlab.MeshSet()
     ms.add_mesh(pymeshlab.Mesh(vertex_matrix=V, face_matrix=T.astype(np.int32),
@@ -127,10 +127,14 @@ def clean_mesh(V: np.ndarray, P: np.ndarray, sizes: np.ndarray, *, name: str = "
             ms.meshing_merge_close_vertices(threshold=pymeshlab.PureValue(tol))
         ms.meshing_remove_duplicate_faces()
         ms.meshing_remove_unreferenced_vertices()
-        ms.meshing_re_orient_faces_coherently()
     except pymeshlab.PyMeshLabException as exc:  # pragma: no cover - filters on valid arrays
-        raise MeshError(f"{name}: cleaning the mesh failed ({exc}); repair it in the modeller "
+        msg = " ".join(str(exc).split())
+        raise MeshError(f"{name}: cleaning the mesh failed ({msg}); repair it in the modeller "
                         "or pass --no-clean") from None
+    try:
+        ms.meshing_re_orient_faces_coherently()
+    except pymeshlab.PyMeshLabException:
+        pass  # not manifold: nothing to orient; the mesh checks name the non-manifold part
     cm = ms.current_mesh()
     keep = np.rint(cm.vertex_scalar_array()).astype(np.int64)  # original index of survivors
     Tn = cm.face_matrix().astype(np.int64)                     # in survivor numbering

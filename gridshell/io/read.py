@@ -226,7 +226,8 @@ def _sample_surface(surface: Any) -> Any:
 
 
 def check_disk(V: np.ndarray, F: np.ndarray, name: str, report: Any = None, *,
-               what: str = "the target", tolerance: float | None = None) -> None:
+               what: str = "the target", tolerance: float | None = None,
+               weld_hint: bool = True) -> None:
     """:class:`MeshError` unless ``(V, F)`` (checked manifold and oriented) is one disk: one
     connected piece, Euler characteristic 1, one boundary loop. The message says whether the
     mesh looked unwelded: with ``report`` (the cleaning done) what the weld did; without it
@@ -262,7 +263,9 @@ def check_disk(V: np.ndarray, F: np.ndarray, name: str, report: Any = None, *,
         fix = "the surface is closed (no boundary): cut it open"
     else:
         fix = "cut the surface open (e.g. a cylinder along a generator) or fill its holes"
-    if report is not None:
+    if not weld_hint:
+        weld = "a working copy of the target"
+    elif report is not None:
         weld = (f"it was welded ({report.summary()}) and is still not one disk" if report.welded
                 else "it is not an unwelded mesh (no coincident vertices to weld)")
     else:
