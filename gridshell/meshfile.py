@@ -325,7 +325,8 @@ def read_polygons(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray, np.n
                         "NaN or infinite coordinates; re-export the mesh")
     if len(P) and (P.max() >= len(V)):
         raise MeshError(f"{path.name}: a face refers to vertex {int(P.max())} but the file has "
-                        f"{len(V)} vertices; the file is truncated or corrupt")
+                        f"{len(V)} vertices (outside 0 .. {len(V) - 1}); the file is truncated "
+                        "or corrupt")
     return V, P, sizes
 
 

@@ -62,14 +62,24 @@ def mean_edge_length(V: np.ndarray, P: np.ndarray, sizes: np.ndarray) -> float:
     return float(d.mean()) if len(d) else 0.0
 
 
-def coincident_vertices(V: np.ndarray, tol: float) -> int:
+def coincident_vertices(V: np.ndarray, tol: float, P: np.ndarray | None = None) -> int:
     """How many vertices of ``V (n,3)`` lie within ``tol`` of an earlier vertex (0 for a welded
-    mesh; about two thirds of them for a triangle soup)."""
+    mesh; about two thirds of them for a triangle soup). With faces ``P (m,k)`` (padded), pairs
+    already joined by an edge do not count: they are a degenerate face, not an unwelded seam,
+    and welding them would collapse faces."""
     from scipy.spatial import cKDTree
 
     if len(V) < 2:
         return 0
     pairs = cKDTree(V).query_pairs(max(tol, 0.0), output_type="ndarray")
+    if len(pairs) and P is not None and len(P):
+        from ..quadmesh import _face_edges
+
+        a, b, _ = _face_edges(P)
+        n = np.int64(len(V))
+        edges = np.minimum(a, b) * n + np.maximum(a, b)
+        key = np.minimum(pairs[:, 0], pairs[:, 1]) * n + np.maximum(pairs[:, 0], pairs[:, 1])
+        pairs = pairs[~np.isin(key, edges)]
     return int(len(np.unique(pairs[:, 1]))) if len(pairs) else 0
 
 
@@ -112,7 +122,8 @@ def clean_mesh(V: np.ndarray, P: np.ndarray, sizes: np.ndarray, *, name: str = "
     sizes = np.asarray(sizes, dtype=np.int64)
     n0, m0 = len(V), len(P)
     tol = tolerance * mean_edge_length(V, P, sizes)
-    if not needs_cleaning(V, P, sizes, tol):  # the usual case: a welded, oriented mesh
+    weld = coincident_vertices(V, tol, P) > 0
+    if not weld and not needs_cleaning(V, P, sizes, tol, check_weld=False):  # the usual case: welded, oriented
         return V, P, sizes, CleanReport(vertices=(n0, n0), faces=(m0, m0), tolerance=tol)
     import pymeshlab
 
@@ -122,8 +133,9 @@ def clean_mesh(V: np.ndarray, P: np.ndarray, sizes: np.ndarray, *, name: str = "
                                v_scalar_array=np.arange(n0, dtype=np.float64),
                                f_scalar_array=owner.astype(np.float64)))
     try:
-        ms.meshing_remove_duplicate_vertices()  # exact copies first: fast, and fewer to merge
-        if tol > 0:
+        if weld:  # exact copies first: fast, and fewer to merge
+            ms.meshing_remove_duplicate_vertices()
+        if weld and tol > 0:
             ms.meshing_merge_close_vertices(threshold=pymeshlab.PureValue(tol))
         ms.meshing_remove_duplicate_faces()
         ms.meshing_remove_unreferenced_vertices()
@@ -206,13 +218,14 @@ def clean_mesh(V: np.ndarray, P: np.ndarray, sizes: np.ndarray, *, name: str = "
     return Vout, Pout, sz, rep
 
 
-def needs_cleaning(V: np.ndarray, P: np.ndarray, sizes: np.ndarray, tol: float) -> bool:
+def needs_cleaning(V: np.ndarray, P: np.ndarray, sizes: np.ndarray, tol: float,
+                   check_weld: bool = True) -> bool:
     """Whether :func:`clean_mesh` has anything to do: coincident vertices (within ``tol``,
     metres), duplicate faces, unreferenced vertices or inconsistently oriented faces. Cheap
     (numpy), so a clean mesh never goes through pymeshlab."""
     from ..meshfile import orientation_problem
 
-    if _unreferenced_count(P, len(V)) or coincident_vertices(V, tol):
+    if _unreferenced_count(P, len(V)) or (check_weld and coincident_vertices(V, tol, P)):
         return True
     j = np.arange(P.shape[1])[None, :]
     S = np.sort(np.where(j < sizes[:, None], P, -1), axis=1)

@@ -275,7 +275,7 @@ def check_disk(V: np.ndarray, F: np.ndarray, name: str, report: Any = None, *,
         P, sizes = _as_padded(F)
         tol = tolerance if tolerance is not None else \
             WELD_TOLERANCE * mean_edge_length(np.asarray(V, float), P, sizes)
-        c = coincident_vertices(np.asarray(V, float), tol)
+        c = coincident_vertices(np.asarray(V, float), tol, P)
         weld = (f"it looks unwelded: {c} of its {n} vertices coincide with others - weld it "
                 "(drop --no-clean)" if c else
                 "it is not an unwelded mesh (no coincident vertices)")
