@@ -112,11 +112,14 @@ def _parse_obj_fast(data: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray] | 
         return None
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        V = np.fromstring(b" ".join(vrec), dtype=np.float64, sep=" ")
         ftext = re.sub(rb"/[^ \t\r]*", b"", b" 0 ".join(frec))  # 0 separates faces
         if b"-" in ftext:
             return None
-        flat = np.fromstring(ftext, dtype=np.int64, sep=" ")
+        try:  # malformed text: the line-by-line parser names it
+            V = np.fromstring(b" ".join(vrec), dtype=np.float64, sep=" ")
+            flat = np.fromstring(ftext, dtype=np.int64, sep=" ")
+        except ValueError:
+            return None
     if len(V) != 3 * len(vrec) or not np.all(np.isfinite(V)):
         return None
     cuts = np.flatnonzero(flat == 0)

@@ -5,8 +5,9 @@ A NURBS surface becomes a :class:`~gridshell.bspline.BSplineSurface` (still in f
 caller converts): Rhino stores ``count + order - 2`` knots per direction (no end knots), so one
 knot is added at each end, and the knot vectors are mapped onto ``[0, 1]`` (an affine change of
 parameter: the surface is the same). A rational surface (weights not all equal) has no exact
-non-rational form: it is fitted by a non-rational one of the same degrees with three times as
-many spans, and the largest distance on a dense sampling is reported.
+non-rational form: it is fitted by a non-rational one of the same degrees with as
+many spans as needed (2, 4 or 8 times) for a largest distance below 0.01 % of its diagonal,
+and that distance is reported.
 """
 from __future__ import annotations
 
@@ -24,8 +25,11 @@ from .units import Units, parse_units
 RHINO_UNITS = {"Millimeters": "mm", "Centimeters": "cm", "Meters": "m", "Inches": "in",
                "Feet": "ft", "Decimeters": "dm", "Kilometers": "km", "Microns": "um",
                "Yards": "yd", "Miles": "mi", "Dekameters": "dam", "Hectometers": "hm"}
-#: samples per span used to fit and check a rational surface
+#: samples per control point (x 1/4) used to fit a rational surface; twice as dense to check
 _RATIONAL_SAMPLES = 12
+#: a rational surface is approximated until its largest distance is below this fraction of its
+#: diagonal (or with 8 times its spans)
+RATIONAL_TOLERANCE = 1e-4
 
 
 @dataclass
@@ -204,16 +208,17 @@ def _domain(knots: np.ndarray, d: int) -> tuple[float, float]:
 
 def _fit_rational(ns: Any, du: int, dv: int, full_u: np.ndarray, full_v: np.ndarray,
                   name: str) -> tuple[Any, float]:
-    """A non-rational surface with three times as many spans fitted (least squares) to a dense
-    sampling of the rational ``ns``; its largest distance on a denser sampling."""
+    """A non-rational surface fitted (least squares, same degrees, uniform knots) to a dense
+    sampling of the rational ``ns``, with 2, 4 or 8 times as many spans: the first whose
+    largest distance on a denser sampling is below :data:`RATIONAL_TOLERANCE` of the
+    diagonal of the control net. Returns it and that distance (file units)."""
+    import scipy.sparse.linalg as spla
+
     from ..bspline import BSplineSurface, open_uniform_knots
 
     (u0, u1), (v0, v1) = _domain(full_u, du), _domain(full_v, dv)
     spans_u = max(len(np.unique(full_u[du:len(full_u) - du])) - 1, 1)
     spans_v = max(len(np.unique(full_v[dv:len(full_v) - dv])) - 1, 1)
-    cu, cv = 3 * spans_u + du, 3 * spans_v + dv
-    surf = BSplineSurface(du, dv, open_uniform_knots(cu, du), open_uniform_knots(cv, dv),
-                          np.zeros((cu, cv, 3)))
 
     def sample(nu: int, nv: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         s, t = np.linspace(0, 1, nu), np.linspace(0, 1, nv)
@@ -221,17 +226,23 @@ def _fit_rational(ns: Any, du: int, dv: int, full_u: np.ndarray, full_v: np.ndar
                       for a in s], dtype=np.float64)
         return s, t, P
 
-    s, t, P = sample(_RATIONAL_SAMPLES * cu, _RATIONAL_SAMPLES * cv)
-    A = surf.operator_grid(s, t)
-    import scipy.sparse.linalg as spla
-
-    N = (A.T @ A).tocsc()
-    solve = spla.factorized(N)
-    C = np.stack([solve(A.T @ P[..., k].ravel()) for k in range(3)], axis=1)
-    fit = BSplineSurface(du, dv, surf.knots_u, surf.knots_v, C.reshape(cu, cv, 3))
-    s2, t2, P2 = sample(2 * _RATIONAL_SAMPLES * cu + 1, 2 * _RATIONAL_SAMPLES * cv + 1)
-    err = float(np.linalg.norm(fit.evaluate_grid(s2, t2) - P2, axis=-1).max())
-    return fit, err
+    best = None
+    for k in (2, 4, 8):
+        cu, cv = min(k * spans_u + du, 60), min(k * spans_v + dv, 60)
+        surf = BSplineSurface(du, dv, open_uniform_knots(cu, du), open_uniform_knots(cv, dv),
+                              np.zeros((cu, cv, 3)))
+        s, t, P = sample(_RATIONAL_SAMPLES * cu // 4 + 2, _RATIONAL_SAMPLES * cv // 4 + 2)
+        A = surf.operator_grid(s, t)
+        solve = spla.factorized((A.T @ A).tocsc())
+        C = np.stack([solve(A.T @ P[..., i].ravel()) for i in range(3)], axis=1)
+        fit = BSplineSurface(du, dv, surf.knots_u, surf.knots_v, C.reshape(cu, cv, 3))
+        s2, t2, P2 = sample(2 * len(s) + 1, 2 * len(t) + 1)
+        err = float(np.linalg.norm(fit.evaluate_grid(s2, t2) - P2, axis=-1).max())
+        best = (fit, err)
+        diag = float(np.linalg.norm(np.ptp(P2.reshape(-1, 3), axis=0)))
+        if err <= RATIONAL_TOLERANCE * diag:
+            break
+    return best
 
 
 def _xyz(p: Any) -> tuple[float, float, float]:
