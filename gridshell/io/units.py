@@ -99,9 +99,32 @@ def parse_units(text: str) -> Units:
 
 
 def to_metres(V: np.ndarray, units: Units) -> np.ndarray:
-    """Coordinates ``V (n,3)`` in ``units`` as metres (a new float64 array)."""
+    """Coordinates ``V (n,3)`` in ``units`` as metres (a new float64 array).
+
+    For a unit a whole number of which makes a metre (cm, mm: ``k`` = 100, 1000) each value
+    ``p`` becomes the float ``x`` nearest ``p / k`` for which ``x * k`` is ``p`` again, where
+    such a float is one of the two neighbours of ``p / k``: a model drawn in metres and exported
+    in millimetres (``x * 1000``) comes back as the very same numbers (a plain ``p * 0.001``
+    missed 12 % of them by an ulp, and the optimizers carry an ulp into ~1e-6 of the
+    diagonal). Other values are ``p / k`` (correctly rounded)."""
     V = np.asarray(V, dtype=np.float64)
-    return V * float(units.metres_per_unit) if units.metres_per_unit != 1.0 else V.copy()
+    f = float(units.metres_per_unit)
+    if f == 1.0:
+        return V.copy()
+    k = 1.0 / f
+    if k != round(k) or k < 1:
+        return V * f
+    k = float(round(k))
+    p = V.ravel()
+    x = p / k
+    for direction in (np.inf, -np.inf):
+        miss = np.flatnonzero(x * k != p)
+        if not len(miss):
+            break
+        y = np.nextafter(x[miss], direction)
+        hit = y * k == p[miss]
+        x[miss[hit]] = y[hit]
+    return x.reshape(V.shape)
 
 
 def from_metres(V: np.ndarray, units: Units) -> np.ndarray:
