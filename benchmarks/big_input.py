@@ -20,22 +20,10 @@ import tempfile
 import time
 from pathlib import Path
 
-import numpy as np
-
 from gridshell.meshfile import write_mesh
 
-
-def hill(n: int, m: int, scale: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
-    """A 12 x 8 m hill (2.5 m high, tilted) triangulated on an ``n x m`` grid, metres x scale."""
-    x, y = np.linspace(-6, 6, n), np.linspace(-4, 4, m)
-    X, Y = np.meshgrid(x, y, indexing="ij")
-    Z = 2.5 * np.exp(-(X ** 2 / 30 + Y ** 2 / 14)) + 0.1 * X
-    V = np.stack([X, Y, Z], -1).reshape(-1, 3) * scale
-    idx = np.arange(n * m).reshape(n, m)
-    a, b, c, d = idx[:-1, :-1], idx[1:, :-1], idx[1:, 1:], idx[:-1, 1:]
-    T = np.concatenate([np.stack([a, b, c], -1).reshape(-1, 3),
-                        np.stack([a, c, d], -1).reshape(-1, 3)])
-    return V, T
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+from io_cases import hill  # noqa: E402 - the tests' hill, one definition
 
 
 def run(target: Path, out: Path) -> dict:

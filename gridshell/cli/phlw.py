@@ -76,10 +76,9 @@ def _load_reference(path: str, args: Any) -> tuple[Any, Any, Any, Any]:
         return surf, mesh.V, mesh.F, None
     geo = read_input(path, **input_options(args), what="the reference")
     if geo.surface is not None:  # a NURBS surface is the initial B-spline as it is
-        srf = geo.surface
-        if args.transpose:
-            srf = BSplineSurface(srf.degree_v, srf.degree_u, srf.knots_v, srf.knots_u,
-                                 srf.ctrl.transpose(1, 0, 2).copy())
+        from ..io.read import swap_uv
+
+        srf = swap_uv(geo.surface) if args.transpose else geo.surface
         mesh = srf.sample(*args.check_samples)
         return srf, mesh.V, mesh.F, geo
     fit = initial_surface(geo.V, geo.F, n_ctrl=tuple(args.ctrl), degree=tuple(args.degree),

@@ -210,6 +210,15 @@ def _scaled_surface(surface: Any, factor: float) -> Any:
                           surface.ctrl * float(factor))
 
 
+def swap_uv(surface: Any) -> Any:
+    """The same B-spline surface with ``u`` and ``v`` exchanged (``--transpose`` of a NURBS
+    input: the PHLW rows follow the other family)."""
+    from ..bspline import BSplineSurface
+
+    return BSplineSurface(surface.degree_v, surface.degree_u, surface.knots_v, surface.knots_u,
+                          surface.ctrl.transpose(1, 0, 2).copy())
+
+
 def surface_grid(surface: Any, longest: int = SURFACE_SAMPLES) -> tuple[int, int]:
     """Rows x columns of a sampling of ``surface`` with ``longest`` samples along its longer
     side (mean iso-curve lengths through the control net), at least 8 along the other."""

@@ -92,10 +92,9 @@ def load_surface(source: Any, *, mode: str, phlw_options: dict | None = None,
     if geo.surface is not None:  # a NURBS surface is the initial B-spline as it is
         from .reference import InitialFit
 
-        srf = geo.surface
-        if transpose:
-            srf = BSplineSurface(srf.degree_v, srf.degree_u, srf.knots_v, srf.knots_u,
-                                 srf.ctrl.transpose(1, 0, 2).copy())
+        from ..io.read import swap_uv
+
+        srf = swap_uv(geo.surface) if transpose else geo.surface
         init = InitialFit(surface=srf, rms=0.0, method="NURBS")
         if progress is not None:
             progress(f"PHLW step: initial B-spline = the NURBS surface ({srf.shape[0]} x "
