@@ -71,6 +71,10 @@ def _load_reference(path: str, args: Any) -> tuple[Any, Any, Any, Any]:
     from .common import input_options
 
     if str(path).lower().endswith(".json"):
+        if args.units is not None or args.object is not None:
+            from ..errors import InputError
+
+            raise InputError(f"{path}: a B-spline .json is in metres: drop --units / --object")
         surf = BSplineSurface.load(path)
         mesh = surf.sample(*args.check_samples)
         return surf, mesh.V, mesh.F, None

@@ -69,6 +69,9 @@ def load_surface(source: Any, *, mode: str, phlw_options: dict | None = None,
         return source.surface, n, {"source": "phlw-result", "phlw_mode": source.mode,
                                    "units": METRES}
     if isinstance(source, (str, Path)) and str(source).lower().endswith(".json"):
+        if units is not None or obj is not None:
+            raise InputError(f"{Path(source).name} is a B-spline in metres written by 'gridshell "
+                             "phlw' (its input unit is in report.json): drop --units / --object")
         return BSplineSurface.load(source), None, {"source": str(source),
                                                    "units": _phlw_units(Path(source))}
     from .reference import initial_surface
