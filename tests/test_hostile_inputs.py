@@ -150,8 +150,13 @@ def _write_hostile(path: Path, kind: str):
 def test_malformed_mesh_for_gg(tmp_path, capsys, ext, kind):
     src = tmp_path / f"target{ext}"
     words = _write_hostile(src, kind)
-    run_hostile(capsys, tmp_path, ["gg", str(src), "-o", str(tmp_path / "out"), *GG], 2,
-                words + [src.name])
+    run_hostile(capsys, tmp_path, ["gg", str(src), "-o", str(tmp_path / "out"), *GG,
+                                   *_UNCLEANED.get(kind, [])], 2, words + [src.name])
+
+
+#: cases the cleaning repairs (a flipped face is turned back, two copies of a face become one,
+#: issue 18): the checks are tested on the mesh as it is
+_UNCLEANED = {"inconsistent orientation": ["--no-clean"], "non-manifold edge": ["--no-clean"]}
 
 
 @pytest.mark.parametrize("kind", ["nan vertex", "huge vertex", "all at one point",
@@ -160,8 +165,8 @@ def test_malformed_mesh_for_gg(tmp_path, capsys, ext, kind):
 def test_malformed_mesh_for_phlw_and_ncp(tmp_path, capsys, command, kind):
     src = tmp_path / "reference.obj"
     words = _write_hostile(src, kind)
-    run_hostile(capsys, tmp_path, [command, str(src), "-o", str(tmp_path / "out")], 2,
-                words + [src.name])
+    run_hostile(capsys, tmp_path, [command, str(src), "-o", str(tmp_path / "out"),
+                                   *_UNCLEANED.get(kind, [])], 2, words + [src.name])
 
 
 def test_lying_ply_headers(tmp_path, capsys):
