@@ -65,7 +65,10 @@ class InputGeometry:
                                                else "")]
         if self.surface is not None:
             parts.append("NURBS surface")
-        parts.append(self.clean.summary() if self.clean is not None else "not cleaned (--no-clean)")
+        elif self.clean is not None:
+            parts.append(self.clean.summary())
+        else:
+            parts.append("not cleaned (--no-clean)")
         return "; ".join(parts + self.notes)
 
 
