@@ -176,7 +176,7 @@ def verify_bundle(path: str | Path) -> dict[str, Any]:
     design.json cannot be read raises :class:`~gridshell.errors.InputError`.
     """
     from .bundle import check_collapse, lamellae_from_design, read_design_json, read_net_mesh
-    from .errors import InputError, MeshError
+    from .errors import InputError
     from .metrics import (alignability_error, alignability_error_arc,
                            crossing_normal_curvature_on_mesh, delta_l, delta_n,
                            deviation, geodesic_turning, summary)
