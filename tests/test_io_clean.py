@@ -88,3 +88,16 @@ def test_coincident_vertices_of_an_edge_are_a_degenerate_face_not_a_seam():
     V[b] = V[a]                                    # an edge of zero length
     assert coincident_vertices(V, 1e-6) == 1
     assert coincident_vertices(V, 1e-6, _as_padded(T)[0]) == 0
+
+
+def test_a_quad_grid_exported_face_by_face_welds_back_to_the_same_grid():
+    from gridshell.grid import grid_from_quads
+
+    R, C = 7, 5
+    u, v = np.meshgrid(np.linspace(0, 3, R), np.linspace(0, 2, C), indexing="ij")
+    V = np.stack([u, v, 0.2 * np.sin(u)], -1).reshape(-1, 3)
+    S, SQ = soup(V, grid_quads(R, C))
+    P, sz = _as_padded(SQ)
+    V2, P2, _, _ = clean_mesh(S, P, sz)
+    G = grid_from_quads(P2, len(V2))      # the gg target grid: same corner, same direction
+    np.testing.assert_array_equal(V2[G].reshape(-1, 3), V)

@@ -6,8 +6,8 @@ fanned into triangles that carry its index as their face quality and every verte
 own index as vertex quality; after pymeshlab's filters the polygons are rebuilt from the
 original ones, with the surviving vertices (found by those indices; a welded vertex maps to the
 survivor within the weld tolerance) and each polygon flipped when pymeshlab flipped its
-triangles. Coordinates stay exact: pymeshlab keeps one vertex of each welded cluster, unmoved,
-and the rebuilt mesh takes the original float64 coordinates of the survivors.
+triangles. Coordinates stay exact: each welded vertex is the first copy of its group in the
+file (its float64 coordinates and its place in the order).
 """
 from __future__ import annotations
 
@@ -113,8 +113,8 @@ def clean_mesh(V: np.ndarray, P: np.ndarray, sizes: np.ndarray, *, name: str = "
 
     Returns
     -------
-    V, P, sizes : the cleaned mesh (vertices in their original order among the survivors;
-        faces in their original order among the kept ones)
+    V, P, sizes : the cleaned mesh (each vertex the first copy of its welded group, in file
+        order; faces in file order among the kept ones)
     report : CleanReport
     """
     V = np.asarray(V, dtype=np.float64)
@@ -197,9 +197,18 @@ def clean_mesh(V: np.ndarray, P: np.ndarray, sizes: np.ndarray, *, name: str = "
     Pm, sz, flipped = Pm[keep_rows], sz[keep_rows], flipped[keep_rows]
     used = np.zeros(len(keep), bool)
     used[Pm[Pm >= 0]] = True
-    renum = np.cumsum(used) - 1
+    # canonical numbering: each welded vertex is its first copy in the file (its coordinates,
+    # its place in the order), so a grid exported face by face keeps its first corner first
+    # (gridshell.grid.grid_from_quads starts from the corner of smallest index)
+    first_copy = np.full(len(keep), np.iinfo(np.int64).max)
+    ok = vmap >= 0
+    np.minimum.at(first_copy, vmap[ok], np.flatnonzero(ok))
+    surv = np.flatnonzero(used)
+    order = surv[np.argsort(first_copy[surv], kind="stable")]
+    renum = np.full(len(keep), -1, np.int64)
+    renum[order] = np.arange(len(order))
     Pout = np.where(Pm >= 0, renum[np.maximum(Pm, 0)], -1)
-    Vout = V[keep[used]]
+    Vout = V[first_copy[order]]
     welded = n0 - len(keep) - _unreferenced_count(P, n0)
     rep = CleanReport(vertices=(n0, len(Vout)), faces=(m0, len(Pout)), tolerance=tol,
                       duplicate_faces=dup, degenerate_faces=degenerate,
