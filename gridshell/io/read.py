@@ -160,7 +160,10 @@ def read_input(source: Any, *, units: Units | str | None = None, clean: bool = T
     if clean:
         from .clean import clean_mesh
 
-        _check_areas(V, P, name)  # a weld must not hide a degenerate face of the file
+        from ..quadmesh import check_face_areas
+
+        if len(P):  # a weld must not hide a degenerate face of the file (welding its corners
+            check_face_areas(V, P, name)  # would drop it; a mesh at one point would vanish)
 
         V, P, sizes, report = clean_mesh(V, P, sizes, name=name)
     from ..quadmesh import validate_mesh
@@ -172,22 +175,6 @@ def read_input(source: Any, *, units: Units | str | None = None, clean: bool = T
         check_disk(V, F, name, report, what=what)
     return InputGeometry(V=V, F=F, units=u, name=name, path=path_s, object=obj_label,
                          object_query=obj, clean=report, notes=notes, units_source=src)
-
-
-def _check_areas(V: np.ndarray, P: np.ndarray, name: str) -> None:
-    """:class:`MeshError` for faces of (near) zero area, as :func:`validate_mesh` names them:
-    checked before cleaning, since welding their coincident corners would drop them (a mesh
-    all at one point would weld into nothing)."""
-    from ..quadmesh import DEGENERATE_AREA, bbox_diagonal, polygon_vector_areas
-
-    if not len(P):
-        return
-    A = np.linalg.norm(polygon_vector_areas(V, P), axis=1)
-    tiny = (A < DEGENERATE_AREA * bbox_diagonal(V) ** 2) | (A == 0)
-    if tiny.any():
-        f = int(np.flatnonzero(tiny)[0])
-        raise MeshError(f"{name}: {int(tiny.sum())} faces are degenerate, with (near) zero area "
-                        f"(the first is face {f}); remove or repair them")
 
 
 def _arrays(source: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
