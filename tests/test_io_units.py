@@ -34,9 +34,16 @@ def test_units_record():
             Units.from_json(bad)
 
 
-def test_to_metres_is_exact_scaling():
-    V = np.random.default_rng(0).normal(size=(10, 3)) * 1000
-    np.testing.assert_array_equal(to_metres(V, parse_units("mm")), V * 0.001)
+def test_to_metres_is_correctly_rounded_and_round_trips():
+    X = np.random.default_rng(0).normal(size=(2000, 3)) * 10   # metres
+    for unit, k in (("mm", 1000.0), ("cm", 100.0)):
+        P = X * k                                              # exported in mm / cm
+        M = to_metres(P, parse_units(unit))
+        assert np.all(np.abs(M - P / k) <= np.spacing(np.abs(P / k)))  # within an ulp
+        assert np.all(M * k == P)                              # and back to the file's numbers
+        assert np.mean(M == X) > 0.8                           # mostly the very metres
+    V = np.random.default_rng(1).normal(size=(10, 3))
+    np.testing.assert_array_equal(to_metres(V, parse_units("ft")), V * 0.3048)
     assert to_metres(V, METRES) is not V
 
 
