@@ -2,7 +2,9 @@
 
 Layout (all geometry in metres)::
 
-    design.json     kind, units, lamellae, metrics, params, collapse curve
+    design.json     kind, units (the unit the input was drawn in: {"name", "metres_per_unit"};
+                    absent = metres; the geometry itself is always metres), lamellae, metrics,
+                    params, collapse curve
     net.obj         joints as vertices, net-loops as quad faces
     axes.obj        one dense polyline (``l`` record) per lamella axis, in design.json order
     aligned.obj     net.obj's vertices and faces in the collapsed configuration
@@ -24,6 +26,7 @@ import numpy as np
 
 from .atomic import atomic_dir
 from .errors import InputError
+from .io.units import METRES, Units
 from .net import Lamella, Net
 
 FORMAT = "gridshell.design"
@@ -79,9 +82,11 @@ class DesignBundle:
     collapse_s: dict[int, np.ndarray] | None = None
     revolution_V: np.ndarray | None = None
     revolution_F: np.ndarray | None = None
-    units: str = "m"
+    units: Units = METRES  # the unit the input was drawn in (geometry stays metres)
 
     def __post_init__(self) -> None:
+        if not isinstance(self.units, Units):
+            self.units = Units.from_json(self.units)
         if self.kind not in KINDS:
             raise InputError(f"design kind must be one of {', '.join(KINDS)}, got {self.kind!r}")
         self.aligned = np.asarray(self.aligned, float).reshape(-1, 3)
@@ -99,7 +104,8 @@ class DesignBundle:
             if self.collapse_s is not None and lam.id in self.collapse_s:
                 rec["collapse_s"] = np.asarray(self.collapse_s[lam.id]).tolist()
             lams.append(rec)
-        d = {"format": FORMAT, "version": VERSION, "kind": self.kind, "units": self.units,
+        d = {"format": FORMAT, "version": VERSION, "kind": self.kind,
+             "units": self.units.to_json(),
              "n_joints": int(len(self.net.joints)), "n_loops": int(len(self.net.loops)),
              "lamellae": lams, "metrics": _jsonable(self.metrics), "params": _jsonable(self.params)}
         if self.collapse is not None:
@@ -348,4 +354,5 @@ def read_bundle(path: str | Path) -> DesignBundle:
     return DesignBundle(kind=d["kind"], net=net, aligned=aligned, surface_V=surf.V,
                         surface_F=surf.F, metrics=d.get("metrics", {}),
                         params=d.get("params", {}), collapse=collapse, collapse_s=collapse_s,
-                        revolution_V=rev_V, revolution_F=rev_F, units=d.get("units", "m"))
+                        revolution_V=rev_V, revolution_F=rev_F,
+                        units=Units.from_json(d.get("units")))

@@ -223,6 +223,12 @@ def validate_mesh(V: np.ndarray, F: np.ndarray | Sequence[Sequence[int]],
     problem = _topology_problem(P, n, vertices=manifold_vertices)
     if problem is not None:
         raise MeshError(f"{name}: {problem}")
+    check_face_areas(V, P, name)
+
+
+def check_face_areas(V: np.ndarray, P: np.ndarray, name: str = "mesh") -> None:
+    """:class:`MeshError` naming the faces of padded ``P`` with (near) zero area (below
+    ``DEGENERATE_AREA * bbox_diagonal**2``)."""
     A = np.linalg.norm(polygon_vector_areas(V, P), axis=1)
     tiny = (A < DEGENERATE_AREA * bbox_diagonal(V) ** 2) | (A == 0)
     if tiny.any():

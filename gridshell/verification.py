@@ -176,7 +176,7 @@ def verify_bundle(path: str | Path) -> dict[str, Any]:
     design.json cannot be read raises :class:`~gridshell.errors.InputError`.
     """
     from .bundle import check_collapse, lamellae_from_design, read_design_json, read_net_mesh
-    from .errors import InputError, MeshError
+    from .errors import InputError
     from .metrics import (alignability_error, alignability_error_arc,
                            crossing_normal_curvature_on_mesh, delta_l, delta_n,
                            deviation, geodesic_turning, summary)
@@ -215,9 +215,15 @@ def verify_bundle(path: str | Path) -> dict[str, Any]:
         dv = deviation(net.joints, surf.V, surf.F)
         out["deviation"] = {"mean": dv["mean"], "max": dv["max"]}
     elif target:
-        try:
-            t = read_mesh(target, kind="any")
-        except MeshError as exc:
+        try:  # read as the design read it: the recorded unit, object and cleaning
+            from .io.read import read_input
+            from .io.units import Units
+
+            given = (d.get("params") or {}).get("input") or {}
+            t = read_input(target, units=Units.from_json(d.get("units")),
+                           obj=given.get("object_query"),
+                           clean=given.get("clean", True) is not None, require_disk=False)
+        except InputError as exc:
             out["deviation"] = {"skipped": f"target {target} unreadable: {exc}"}
         else:
             dv = deviation(surf.V, t.V, t.F)

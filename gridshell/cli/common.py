@@ -39,6 +39,51 @@ def choice_help(descriptions: Mapping[str, str], choices: Iterable[str], default
     return "; ".join(parts) + f" (default {default})"
 
 
+def add_input_args(p: Any) -> None:
+    """``--units``, ``--no-clean`` and ``--object``: how a command reads the user's geometry
+    (:func:`gridshell.io.read.read_input`)."""
+    from ..io.units import UNITS
+
+    p.add_argument("--units", choices=tuple(UNITS), metavar="|".join(UNITS),
+                   help="the unit the input is drawn in (default: a .3dm's own unit system, "
+                        "else metres; a model whose size reads as another unit is refused "
+                        "until this is given). Everything inside is metres; the bundle records "
+                        "the unit")
+    p.add_argument("--no-clean", action="store_true",
+                   help="do not weld coincident vertices, drop duplicate faces and unreferenced "
+                        "vertices, or orient the faces consistently before the checks "
+                        "(pymeshlab; default: clean, and say what was done)")
+    p.add_argument("--object", metavar="NAME|ID|LAYER",
+                   help=".3dm input: the object to read (a mesh, NURBS surface or single-face "
+                        "Brep) by name, id or layer, when the file holds several")
+
+
+def input_options(args: Any) -> dict[str, Any]:
+    """The keyword arguments of :func:`gridshell.io.read.read_input` given on the command
+    line (:func:`add_input_args`)."""
+    return {"units": getattr(args, "units", None), "clean": not getattr(args, "no_clean", False),
+            "obj": getattr(args, "object", None)}
+
+
+def input_line(info: dict | None) -> str:
+    """The summary's input line from ``params["input"]`` (:meth:`gridshell.io.read.
+    InputGeometry.info`): the object, the unit, what cleaning did, notes."""
+    if not info:
+        return "-"
+    units = (info.get("units") or {}).get("name", "m")
+    if info.get("surface"):
+        clean = "NURBS surface"
+    elif info.get("clean"):
+        clean = info["clean"].get("summary", "-")
+    else:
+        clean = "not cleaned (--no-clean)"
+    parts = [f"units {units}" + (" (the file's)" if info.get("units_source") == "file" else ""),
+             clean, *(info.get("notes") or [])]
+    if info.get("object"):
+        parts.insert(0, str(info["object"]))
+    return "; ".join(parts)
+
+
 def print_summary(args: Any, title: str, summary: dict[str, Any]) -> None:
     """One-screen summary on stdout, or JSON with ``--json``."""
     if getattr(args, "json", False):  # strict JSON: a figure not measured is null, not NaN

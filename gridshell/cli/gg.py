@@ -9,7 +9,11 @@ HELP = "design a geodesic (GG) alignable gridshell on a target surface and write
 
 
 def add_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("target", help="target surface mesh (OBJ, PLY, OFF), metres, one disk")
+    from .common import add_input_args
+
+    p.add_argument("target", help="target surface: a mesh (OBJ, PLY, OFF) or a Rhino .3dm (mesh, "
+                                  "NURBS surface or single-face Brep), one disk")
+    add_input_args(p)
     p.add_argument("-o", "--output", required=True, metavar="DIR",
                    help="output design bundle directory (replaced atomically)")
     p.add_argument("--meridians", choices=("rows", "cols"), default="cols",
@@ -78,7 +82,7 @@ def run(args: Any) -> int:
     from ..atomic import check_output
     from ..gg.pipeline import design_gg, write_gg
     from ..quality import Gate, gate_lines
-    from .common import Progress, print_summary
+    from .common import Progress, input_line, input_options, print_summary
 
     offsets = _offsets(args)
     if not 0 <= args.frames <= 1000:
@@ -94,7 +98,8 @@ def run(args: Any) -> int:
                                offsets=offsets, crossing_angle=args.angle, at_parallel=args.at,
                                rounds=args.rounds, polish_iter=args.polish,
                                allow_unconverged=args.allow_unconverged,
-                               frames=args.frames, progress=progress.callback)
+                               frames=args.frames, **input_options(args),
+                               progress=progress.callback)
     progress(f"writing {args.output}")
     out = write_gg(args.output, bundle, preview=not args.no_preview,
                    sequence=report["sequence"], frames=0, progress=progress.callback)
@@ -105,6 +110,7 @@ def run(args: Any) -> int:
     surf = bundle.params["surface"]
     summary = {
         "bundle": str(out),
+        "input": input_line(bundle.params.get("input")),
         "surface optimization": f"geodesic residual {surf['geodesic_residual_max']:.2e} rad, "
                                 f"edge-length spread {surf['length_residual_rel_max']:.2e}, "
                                 f"polish stopped: {surf['polish_stop']}",
@@ -134,3 +140,4 @@ def run(args: Any) -> int:
             print(f"    {line}")
         print(f"  verdict: {verdict}")
     return 0
+

@@ -18,8 +18,12 @@ MODE_HELP = {"phlw": "normal curvature per principal line",
 def add_args(p: argparse.ArgumentParser) -> None:
     from ..ncp.pipeline import KIND
 
+    from .common import add_input_args
+
     p.add_argument("reference", help="a surface.json written by 'gridshell phlw', or a reference "
-                                     "mesh (OBJ, PLY, OFF): the PHLW step runs first")
+                                     "mesh (OBJ, PLY, OFF) or Rhino .3dm (a NURBS surface is "
+                                     "the initial B-spline): the PHLW step runs first")
+    add_input_args(p)
     p.add_argument("-o", "--output", required=True, metavar="DIR",
                    help="output design bundle directory (replaced atomically)")
     modes = tuple(KIND)
@@ -80,7 +84,7 @@ def _unconverged(bundle: Any, report: dict) -> list[str]:
 def run(args: Any) -> int:
     from ..atomic import check_output
     from ..ncp.pipeline import design_ncp, write_ncp
-    from .common import Progress, print_gates
+    from .common import Progress, input_line, input_options, print_gates
 
     check_output(args.output, marker="design.json")
     progress = Progress(args)
@@ -96,7 +100,7 @@ def run(args: Any) -> int:
                                 postopt_rounds=args.rounds, frames=args.frames,
                                 phlw_options=phlw, strict=args.strict,
                                 allow_unconverged=args.allow_unconverged,
-                                progress=progress.callback)
+                                **input_options(args), progress=progress.callback)
     failed = _unconverged(bundle, report)
     for name in failed:
         progress(f"note: the {name} stopped short of its own tolerances; the figures below "
@@ -112,6 +116,7 @@ def run(args: Any) -> int:
     summary = {
         "bundle": str(out),
         "kind": bundle.kind,
+        "input": input_line(bundle.params.get("input")),
         "converged": not failed,
         "not converged": ", ".join(failed) or "none",
         "joints / loops / lamellae": f"{m['n_joints']} / {m['n_loops']} / "

@@ -20,8 +20,13 @@ MODE_HELP = {"phlw": "(n_u, t_u) per principal line",
 def add_args(p: argparse.ArgumentParser) -> None:
     from ..ncp.phlw import MODES
 
+    from .common import add_input_args
+
     p.add_argument("reference", help="reference surface: a mesh (OBJ, PLY, OFF; a structured quad "
-                                     "grid is fitted directly, rows -> u) or a B-spline .json")
+                                     "grid is fitted directly, rows -> u), a Rhino .3dm (a NURBS "
+                                     "surface is the initial B-spline as it is) or a B-spline "
+                                     ".json")
+    add_input_args(p)
     p.add_argument("-o", "--output", required=True, metavar="DIR",
                    help="output directory (replaced atomically)")
     p.add_argument("--mode", choices=MODES, default=MODES[0],
@@ -57,20 +62,32 @@ def add_args(p: argparse.ArgumentParser) -> None:
                             "DEFAULT_WEIGHTS)")
 
 
-def _load_reference(path: str, args: Any) -> tuple[Any, Any, Any]:
-    """(initial surface, V, F) from a mesh or a B-spline JSON."""
+def _load_reference(path: str, args: Any) -> tuple[Any, Any, Any, Any]:
+    """(initial surface, V, F, input) from a mesh, a .3dm or a B-spline JSON; ``input`` is the
+    :class:`gridshell.io.read.InputGeometry` (None for a JSON)."""
     from ..bspline import BSplineSurface
+    from ..io.read import read_input
     from ..ncp.reference import initial_surface
-    from ..meshfile import read_mesh
+    from .common import input_options
 
     if str(path).lower().endswith(".json"):
+        if args.units is not None or args.object is not None:
+            from ..errors import InputError
+
+            raise InputError(f"{path}: a B-spline .json is in metres: drop --units / --object")
         surf = BSplineSurface.load(path)
         mesh = surf.sample(*args.check_samples)
-        return surf, mesh.V, mesh.F
-    mesh = read_mesh(path, kind="any")
-    fit = initial_surface(mesh.V, mesh.F, n_ctrl=tuple(args.ctrl), degree=tuple(args.degree),
+        return surf, mesh.V, mesh.F, None
+    geo = read_input(path, **input_options(args), what="the reference")
+    if geo.surface is not None:  # a NURBS surface is the initial B-spline as it is
+        from ..io.read import swap_uv
+
+        srf = swap_uv(geo.surface) if args.transpose else geo.surface
+        mesh = srf.sample(*args.check_samples)
+        return srf, mesh.V, mesh.F, geo
+    fit = initial_surface(geo.V, geo.F, n_ctrl=tuple(args.ctrl), degree=tuple(args.degree),
                           transpose=args.transpose, align=args.align)
-    return fit, mesh.V, mesh.F
+    return fit, geo.V, geo.F, geo
 
 
 def run(args: Any) -> int:
@@ -79,13 +96,14 @@ def run(args: Any) -> int:
     from ..errors import ConvergenceError
     from ..ncp.phlw import optimize_phlw, row_relation_residual, write_phlw
     from ..ncp.phlw_gates import phlw_gates
-    from .common import Progress
-    from .common import print_gates
+    from .common import Progress, input_line, print_gates
 
     check_output(args.output, marker="report.json")
     progress = Progress(args)
     progress(f"reading {args.reference}")
-    init, V, F = _load_reference(args.reference, args)
+    init, V, F, geo = _load_reference(args.reference, args)
+    if geo is not None:
+        progress(f"input: {geo.summary()}")
     surf = getattr(init, "surface", init)
     if hasattr(init, "rms"):
         progress(f"initial B-spline: {init.method} fit, rms {init.rms:.3g} m")
@@ -113,11 +131,14 @@ def run(args: Any) -> int:
     u, v = uniform_params(res.surface, tuple(args.check_samples))
     dense = row_relation_residual(res.surface, u, v, mode=args.mode)
     progress(f"writing {args.output}")
-    files = write_phlw(args.output, res, sample_grid=tuple(args.check_samples))
+    files = write_phlw(args.output, res, sample_grid=tuple(args.check_samples),
+                       units=geo.units if geo is not None else None,
+                       source=geo.info() if geo is not None else None)
     _add_quality(args.output, quality)
     b, a = res.report_before, res.report_after
     summary = {
         "output": args.output,
+        "input": input_line(geo.info() if geo is not None else None),
         "mode": args.mode,
         "converged": res.converged,
         "E_PHLW before -> after": f"{b['E_PHLW']['total']:.4g} -> {a['E_PHLW']['total']:.4g}",

@@ -214,7 +214,8 @@ def _pct(d: dict[str, float]) -> dict[str, float]:
 
 
 def gg_metrics(net: Net, V: np.ndarray, F: np.ndarray, *, net_rev: Net | None = None,
-               target: tuple[np.ndarray, np.ndarray] | None = None) -> dict[str, Any]:
+               target: tuple[np.ndarray, np.ndarray] | None = None,
+               target_samples: tuple[np.ndarray, np.ndarray] | None = None) -> dict[str, Any]:
     """Paper 5.1 metrics of a GG net on its surface ``(V, F)``; percentages.
 
     Returns
@@ -224,7 +225,9 @@ def gg_metrics(net: Net, V: np.ndarray, F: np.ndarray, *, net_rev: Net | None = 
         ``alignability_revolution`` (the same net on the surface of revolution, if given),
         ``geodesic_turning`` (ratio, %, with the normals of the smooth surface through the grid
         when ``(V, F)`` is one, see :func:`gridshell.metrics.geodesic_turning`), and with a
-        target: ``deviation`` (the surface's vertices from the target), ``deviation_joints``
+        target: ``deviation`` (the surface's vertices from the target; ``target_samples``, a
+        working copy of a big target, if given, is what the target -> surface figures
+        ``deviation_target`` and ``coverage`` sample), ``deviation_joints``
         (the joints from the target), ``deviation_target`` (the target from the surface: large
         where the design does not reach the target's boundary), all ``{"mean", "max"}`` in % of
         the target's bounding-box diagonal, and ``coverage`` (area of the surface / area of the
@@ -244,9 +247,10 @@ def gg_metrics(net: Net, V: np.ndarray, F: np.ndarray, *, net_rev: Net | None = 
         dj = deviation(net.joints, tV, tF)
         out["deviation"] = {"mean": dv["mean"], "max": dv["max"]}
         out["deviation_joints"] = {"mean": dj["mean"], "max": dj["max"]}
-        dt = target_deviation(V, F, tV, tF)
+        sV, sF = target_samples if target_samples is not None else target
+        dt = target_deviation(V, F, sV, sF)
         out["deviation_target"] = {"mean": dt["mean"], "max": dt["max"]}
-        out["coverage"] = coverage(V, F, tV, tF)
+        out["coverage"] = coverage(V, F, sV, sF)
     out["n_joints"] = int(len(net.joints))
     out["n_loops"] = int(len(net.loops))
     out["n_lamellae"] = {"C1": len(net.family(1)), "C3": len(net.family(3))}
@@ -281,17 +285,16 @@ def gg_score(P: np.ndarray, **net_options: Any) -> float:
 # ----------------------------------------------------------------------------- the pipeline
 
 
-def _load_target(target: Any) -> tuple[np.ndarray, np.ndarray, str | None]:
-    from ..meshfile import read_mesh
+def _load_target(target: Any, units: Any = None, clean: bool = True, obj: str | None = None,
+                 progress: Progress = None) -> tuple[np.ndarray, np.ndarray, Any]:
+    """``(V, F, input)`` of a target (path, InputGeometry, mesh or ``(V, F)``), metres, read
+    through :func:`gridshell.io.read.read_input` (units, cleaning, the disk check)."""
+    from ..io.read import read_input
 
-    if isinstance(target, (str, Path)):
-        m = read_mesh(target, kind="any")
-        return m.V, m.F, str(Path(target).resolve())
-    if hasattr(target, "V") and hasattr(target, "F"):
-        return np.asarray(target.V, float), np.asarray(target.F, np.int64), None
-    if isinstance(target, tuple) and len(target) == 2:
-        return np.asarray(target[0], float), np.asarray(target[1], np.int64), None
-    raise InputError("the target must be a mesh file path, a QuadMesh/TriMesh or a (V, F) pair")
+    geo = read_input(target, units=units, clean=clean, obj=obj)
+    if progress is not None and geo.path is not None:
+        progress(f"input: {geo.summary()}")
+    return geo.V, geo.F, geo
 
 
 def design_gg(target: Any, *, meridians: str = "cols", grid: tuple[int, int] | None = None,
@@ -301,14 +304,19 @@ def design_gg(target: Any, *, meridians: str = "cols", grid: tuple[int, int] | N
               offsets: tuple[Sequence[float], Sequence[float]] | None = None,
               weights: dict[str, float] | None = None, angle: float | None = None,
               rounds: int = 10, polish_iter: int = 20, allow_unconverged: bool = False,
-              frames: int = 12, progress: Progress = None
+              frames: int = 12, units: Any = None, clean: bool = True,
+              obj: str | None = None, progress: Progress = None
               ) -> tuple[DesignBundle, dict[str, Any]]:
     """Design a geodesic alignable gridshell on (an approximation of) a target surface.
 
     Parameters
     ----------
-    target : path, QuadMesh/TriMesh or (V, F)
-        The target surface, metres; one disk.
+    target : path (OBJ, PLY, OFF, 3DM), InputGeometry, QuadMesh/TriMesh or (V, F)
+        The target surface, one disk (a .3dm NURBS surface is sampled).
+    units, clean, obj
+        The unit the target is drawn in (None: a .3dm's own, else metres if plausible),
+        cleaning (weld, de-duplicate, orient) and the .3dm object to read: see
+        :func:`gridshell.io.read.read_input`. The bundle records the unit.
     meridians : {"rows", "cols"}
         For a structured quad-grid target: which grid lines become the meridians (geodesics
         of the designed surface); passed to :func:`gridshell.gg.initial.initial_grid`.
@@ -358,17 +366,26 @@ def design_gg(target: Any, *, meridians: str = "cols", grid: tuple[int, int] | N
     if offsets is not None:
         offsets = check_offsets(offsets)  # before the long surface optimization
         n_lamellae = spacing = None       # the offsets place every lamella
-    V, F, target_path = _load_target(target)
+    V, F, geo = _load_target(target, units, clean, obj, progress)
+    target_path = geo.path
     from .design import design_gg_surface
     from .initial import initial_grid
 
     _say(progress, f"target: {len(V)} vertices, {len(F)} faces")
-    P0 = initial_grid(V, F, meridians=meridians, grid=grid, direction=direction)
+    from ..io.working import working_mesh
+
+    # a big target: the grid is sampled and projected on a working copy; the deviations
+    # below are measured against the full target
+    Vw, Fw, work = working_mesh(V, F)
+    if work is not None:
+        _say(progress, f"designing on a working copy of {work['faces'][1]} faces "
+             f"({work['method']}); deviations measured against all {len(F)}")
+    P0 = initial_grid(Vw, Fw, meridians=meridians, grid=grid, direction=direction)
     _say(progress, f"initial grid {P0.shape[0]} x {P0.shape[1]}; designing the GG surface")
     net_options = {"n_lamellae": n_lamellae, "spacing": spacing,
                    "crossing_angle": crossing_angle, "at_parallel": at_parallel,
                    "offsets": offsets, "angle": angle}
-    design = design_gg_surface(V, F, P0, weights=weights, outer=rounds,
+    design = design_gg_surface(Vw, Fw, P0, weights=weights, outer=rounds,
                                polish_iter=polish_iter, progress=progress,
                                evaluate=lambda P: gg_score(P, **net_options))
     P, design_report = design.P, dict(design.report, converged=design.converged,
@@ -382,7 +399,8 @@ def design_gg(target: Any, *, meridians: str = "cols", grid: tuple[int, int] | N
     aligned, collapse_info = collapse_gg(net)
     R, C = P.shape[:2]
     sV, sF = P.reshape(-1, 3), grid_quads(R, C)
-    metrics = gg_metrics(net, sV, sF, net_rev=stage["net_rev"], target=(V, F))
+    metrics = gg_metrics(net, sV, sF, net_rev=stage["net_rev"], target=(V, F),
+                         target_samples=(Vw, Fw) if work is not None else None)
     metrics["collapse_mismatch_max"] = collapse_info["mismatch_max"]
     gates = gg_gates(metrics)
     quality = {"ok": passed(gates), "gates": [g.as_dict() for g in gates],
@@ -411,6 +429,7 @@ def design_gg(target: Any, *, meridians: str = "cols", grid: tuple[int, int] | N
               "crossing_angle": crossing_angle, "at_parallel": at_parallel,
               "offsets": [list(map(float, o)) for o in offsets] if offsets else None,
               "weights": weights, "converged": quality["ok"], "quality": quality,
+              "input": {**geo.info(), "working_mesh": work},
               "surface": {"geodesic_residual_max": design.geodesic_residual_max,
                           "length_residual_rel_max": design.length_residual_rel_max,
                           "residuals_at_round_off": design.converged, "polish_stop": design.stop,
@@ -419,7 +438,8 @@ def design_gg(target: Any, *, meridians: str = "cols", grid: tuple[int, int] | N
               "total_angle": rev.total_angle,
               "clairaut_c": inet.c, "s_star": inet.s_star, "frames": int(frames)}
     bundle = DesignBundle(kind="GG", net=net, aligned=aligned, surface_V=sV, surface_F=sF,
-                          metrics=metrics, params=params, revolution_V=rV, revolution_F=rF)
+                          metrics=metrics, params=params, revolution_V=rV, revolution_F=rF,
+                          units=geo.units)
     report = {"design": design_report, "revolution": rev.info, "collapse": collapse_info,
               "net": inet.info, "sequence": seq}
     return bundle, report

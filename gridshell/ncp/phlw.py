@@ -634,8 +634,13 @@ def result_summary(res: PHLWResult) -> dict[str, Any]:
 
 
 def write_phlw(directory: str | Any, res: PHLWResult, sample_grid: tuple[int, int] = (60, 60),
-               overwrite: bool = True) -> dict[str, str]:
+               overwrite: bool = True, units: Any = None,
+               source: dict | None = None) -> dict[str, str]:
     """Write a PHLW design into ``directory`` atomically (all files or none).
+
+    ``units`` (:class:`gridshell.io.Units`, None: metres) is the unit the reference was drawn
+    in, recorded in report.json as ``"units": {"name", "metres_per_unit"}`` (the geometry is
+    metres); ``source`` (``InputGeometry.info()``) as ``"input"``.
 
     Files: ``surface.json`` (:meth:`BSplineSurface.save`), ``surface.obj`` (quad mesh sampled
     ``sample_grid`` over the domain: rows = u, columns = v, so principal lines are mesh
@@ -667,7 +672,12 @@ def write_phlw(directory: str | Any, res: PHLWResult, sample_grid: tuple[int, in
             f"{u:.12g},{n:.12g},{t:.12g},{a:.12g},{b:.12g},{c:.12g}"
             for u, n, t, (a, b, c) in zip(res.u_rows, res.n_rows, res.t_rows, res.abc)]
         write_text(tmp / "rows.csv", "\n".join(lines) + "\n")
-        write_text(tmp / "report.json", json.dumps(finite_json(result_summary(res)), indent=1,
+        from ..io.units import METRES
+
+        summary = {**result_summary(res), "units": (units or METRES).to_json()}
+        if source is not None:
+            summary["input"] = source
+        write_text(tmp / "report.json", json.dumps(finite_json(summary), indent=1,
                                                      allow_nan=False) + "\n")
         g = _grid_geometry(res.surface, res.u_rows, res.v_samples)
         curvature_diagram(tmp / "curvature_diagram.png", g["H"], g["K"], res.n_rows, res.t_rows,

@@ -49,41 +49,63 @@ class NCPState:
 
 
 def load_surface(source: Any, *, mode: str, phlw_options: dict | None = None,
-                 progress: Callable[[str], None] | None = None
+                 progress: Callable[[str], None] | None = None, units: Any = None,
+                 clean: bool = True, obj: str | None = None
                  ) -> tuple[BSplineSurface, float | None, dict]:
     """``(surface, n, info)`` from a B-spline JSON path, a :class:`BSplineSurface`, a
-    ``PHLWResult`` or a reference mesh path / ``(V, F)`` (optimized with
-    :func:`gridshell.ncp.phlw.optimize_phlw` first). ``n`` is the CNC normal curvature when the
-    source provides it."""
+    ``PHLWResult`` or a reference (mesh or .3dm path, ``InputGeometry`` or ``(V, F)``, read
+    through :func:`gridshell.io.read.read_input` with ``units``, ``clean``, ``obj``; optimized
+    with :func:`gridshell.ncp.phlw.optimize_phlw` first: a .3dm NURBS surface is its initial
+    B-spline directly, a mesh is fitted). ``n`` is the CNC normal curvature when the source
+    provides it. ``info["units"]`` is the unit of the input (:class:`gridshell.io.Units`)."""
+    from ..io.read import InputGeometry, read_input
+    from ..io.units import METRES
     from .phlw import PHLWResult, optimize_phlw
 
     if isinstance(source, BSplineSurface):
-        return source, None, {"source": "bspline"}
+        return source, None, {"source": "bspline", "units": METRES}
     if isinstance(source, PHLWResult):
         n = float(source.n_rows[0]) if source.mode == "cnc" else None
-        return source.surface, n, {"source": "phlw-result", "phlw_mode": source.mode}
+        return source.surface, n, {"source": "phlw-result", "phlw_mode": source.mode,
+                                   "units": METRES}
     if isinstance(source, (str, Path)) and str(source).lower().endswith(".json"):
-        return BSplineSurface.load(source), None, {"source": str(source)}
-    from ..meshfile import read_mesh
+        if units is not None or obj is not None:
+            raise InputError(f"{Path(source).name} is a B-spline in metres written by 'gridshell "
+                             "phlw' (its input unit is in report.json): drop --units / --object")
+        return BSplineSurface.load(source), None, {"source": str(source),
+                                                   "units": _phlw_units(Path(source))}
     from .reference import initial_surface
 
     opts = dict(phlw_options or {})
-    if isinstance(source, (str, Path)):
-        mesh = read_mesh(source, kind="any")
-        V, F = mesh.V, mesh.F
-        name = str(source)
+    if isinstance(source, (str, Path, InputGeometry)) or hasattr(source, "V"):
+        geo = read_input(source, units=units, clean=clean, obj=obj, what="the reference")
     else:
         try:
             V, F = source
         except (TypeError, ValueError):
             raise InputError("the NCP source must be a B-spline .json, a mesh file, (V, F), a "
                              "BSplineSurface or a PHLWResult") from None
-        name = "(V, F)"
-    init = initial_surface(V, F, n_ctrl=tuple(opts.pop("ctrl", (9, 9))),
-                           degree=tuple(opts.pop("degree", (4, 4))),
-                           transpose=bool(opts.pop("transpose", False)),
-                           align=bool(opts.pop("align", False)))
-    if progress is not None:
+        geo = read_input((V, F), units=units, clean=clean, what="the reference")
+    V, F = geo.V, geo.F
+    name = geo.path or "(V, F)"
+    if progress is not None and geo.path is not None:
+        progress(f"input: {geo.summary()}")
+    ctrl, degree = tuple(opts.pop("ctrl", (9, 9))), tuple(opts.pop("degree", (4, 4)))
+    transpose, align = bool(opts.pop("transpose", False)), bool(opts.pop("align", False))
+    if geo.surface is not None:  # a NURBS surface is the initial B-spline as it is
+        from .reference import InitialFit
+
+        from ..io.read import swap_uv
+
+        srf = swap_uv(geo.surface) if transpose else geo.surface
+        init = InitialFit(surface=srf, rms=0.0, method="NURBS")
+        if progress is not None:
+            progress(f"PHLW step: initial B-spline = the NURBS surface ({srf.shape[0]} x "
+                     f"{srf.shape[1]} control points, degree {srf.degree_u} x {srf.degree_v})")
+    else:
+        init = initial_surface(V, F, n_ctrl=ctrl, degree=degree, transpose=transpose,
+                               align=align)
+    if progress is not None and geo.surface is None:
         turned = (f", parameter plane turned {init.rotated_deg:.1f} deg onto the principal "
                   "directions" if init.rotated_deg else "")
         progress(f"PHLW step: initial B-spline ({init.method} fit, rms {init.rms:.3g} m{turned})")
@@ -107,7 +129,20 @@ def load_surface(source: Any, *, mode: str, phlw_options: dict | None = None,
                             "phlw_converged": res.converged, "phlw_diagnostics": res.diagnostics,
                             "phlw_energy": [e0, e1],
                             "phlw_figures": {k: f["value"] for k, f in (res.figures or {}).items()},
-                            "phlw_aligned_deg": float(init.rotated_deg)}
+                            "phlw_aligned_deg": float(init.rotated_deg),
+                            "units": geo.units, "input": geo.info()}
+
+
+def _phlw_units(path: Path) -> Any:
+    """The input unit recorded in the ``report.json`` beside a ``surface.json`` written by
+    ``gridshell phlw`` (metres when there is none)."""
+    from ..io.units import METRES, Units
+
+    report = path.parent / "report.json"
+    try:
+        return Units.from_json(json.loads(report.read_text()).get("units"))
+    except (OSError, ValueError, AttributeError):
+        return METRES
 
 
 def _phlw_failure(info: dict, mode: str, exc: Exception) -> ConvergenceError:
@@ -177,14 +212,17 @@ def design_ncp(source: Any, *, mode: str = "phlw", curves: int | tuple[int, int]
                postopt_weights: dict[str, float] | None = None, postopt_rounds: int = 3,
                frames: int = 12, sim_weights: dict[str, float] | None = None,
                surface_samples: tuple[int, int] = (100, 100), phlw_options: dict | None = None,
-               allow_unconverged: bool = False, strict: bool = False,
+               allow_unconverged: bool = False, strict: bool = False, units: Any = None,
+               clean: bool = True, obj: str | None = None,
                progress: Callable[[str], None] | None = None) -> tuple[DesignBundle, dict]:
     """Design a normal-curvature-preserving alignable gridshell (paper 4.2.2-4.2.4, 5.1).
 
     Parameters
     ----------
     source : B-spline JSON written by ``gridshell phlw`` (or a BSplineSurface / PHLWResult), or
-        a reference mesh (path or ``(V, F)``): the PHLW step runs first
+        a reference (mesh or .3dm path, or ``(V, F)``): the PHLW step runs first
+    units, clean, obj : how a reference is read (:func:`gridshell.io.read.read_input`: the unit
+        it is drawn in, cleaning, the .3dm object); the bundle records the unit
     mode : "phlw" (kind NCP), "cnc" (kind CNC, one normal curvature), "aa" (kind AA, n = 0)
     curves : curves per family (or a pair), or ``spacing`` in metres; default 10 curves
     n : CNC normal curvature (default: from the PHLW result or fitted), 1/m
@@ -232,7 +270,8 @@ def design_ncp(source: Any, *, mode: str = "phlw", curves: int | tuple[int, int]
 
     t0 = time.perf_counter()
     surf, n_src, info = load_surface(source, mode=mode, phlw_options=phlw_options,
-                                     progress=progress)
+                                     progress=progress, units=units, clean=clean, obj=obj)
+    input_units = info.pop("units")
     timings["surface"] = time.perf_counter() - t0
     if strict and info.get("phlw_converged") is False:
         raise ConvergenceError(
@@ -378,7 +417,7 @@ def design_ncp(source: Any, *, mode: str = "phlw", curves: int | tuple[int, int]
     out_net = move_joints(net, post.V)
     bundle = DesignBundle(kind=KIND[mode], net=out_net, aligned=seq.aligned, surface_V=mesh.V,
                           surface_F=mesh.F, metrics=metrics, params=params, collapse=curve,
-                          collapse_s=_collapse_s(traced, col, A2))
+                          collapse_s=_collapse_s(traced, col, A2), units=input_units)
     report = {"metrics": metrics,
               "levelset": {f: {"align_rms_sin": fit.align_rms, "density": fit.density,
                                "converged": fit.converged} for f, fit in traced.fits.items()},

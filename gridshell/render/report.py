@@ -270,7 +270,7 @@ def report_html(bundle_dir: str | os.PathLike) -> str:
     fam = {f: sum(1 for r in lams if int(r["family"]) == f) for f in (1, 3)}
     total = sum(float(r.get("length", 0.0)) for r in lams)
     title = f"{kind} alignable lamella gridshell &mdash; {html.escape(d.resolve().name)}"
-    overview = [("kind", kind), ("units", design.get("units", "m")),
+    overview = [("kind", kind), ("units", _units_name(design.get("units"))),
                 ("joints", design.get("n_joints")), ("net-loops", design.get("n_loops")),
                 ("lamellae", f"{len(lams)} (C1: {fam[1]}, C3: {fam[3]})"),
                 ("total lamella length [m]", f"{total:.4g}")]
@@ -344,3 +344,10 @@ def write_report(bundle_dir: str | os.PathLike, path: str | os.PathLike | None =
         progress(f"writing {out}")
     write_text(out, report_html(bundle_dir))
     return out
+
+
+def _units_name(units: object) -> str:
+    """The input unit recorded in design.json (a record, a legacy string, or absent: metres)."""
+    if isinstance(units, dict):
+        return f"input in {units.get('name', '?')} (geometry in metres)"
+    return str(units or "m")

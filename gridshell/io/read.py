@@ -1,0 +1,301 @@
+"""What users bring, read once: a mesh file (OBJ, PLY, OFF) or a Rhino .3dm, in the user's
+units, cleaned, checked, as metres (:func:`read_input`).
+
+Order: parse (:func:`gridshell.meshfile.read_polygons` / :func:`gridshell.io.rhino.read_3dm`),
+units (the .3dm's own, ``units``, or metres after the plausibility check of
+:func:`gridshell.io.units.check_plausible`), conversion to metres, cleaning
+(:func:`gridshell.io.clean.clean_mesh`), the mesh checks (:func:`gridshell.quadmesh.
+validate_mesh`), the extent and, with ``require_disk``, one disk-like patch (the message says
+whether the mesh looked unwelded).
+"""
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import InputError, MeshError
+from .units import METRES, Units, check_plausible, parse_units, to_metres
+
+#: a NURBS surface is sampled for mesh uses (gg's target, deviations) with this many vertices
+#: along its longer side (gg's default grid, so its design grid is the sampling itself)
+SURFACE_SAMPLES = 64
+
+
+@dataclass
+class InputGeometry:
+    """A user's geometry in metres: ``V (n,3)``, ``F (m,3|4)`` (quads when every face is a
+    quad), and for a NURBS input its :class:`~gridshell.bspline.BSplineSurface` (``F`` then a
+    sampling of it). ``units`` is the unit the user drew in; ``info()`` goes into bundles."""
+
+    V: np.ndarray
+    F: np.ndarray
+    units: Units = METRES
+    name: str = "(V, F)"
+    path: str | None = None
+    surface: Any = None
+    object: str | None = None
+    object_query: str | None = None  # --object as given
+    clean: Any = None  # CleanReport, or None when not cleaned
+    notes: list[str] = field(default_factory=list)
+    units_source: str = "default"  # "file", "option", "default"
+
+    def info(self) -> dict[str, Any]:
+        """The record of the input kept in a bundle's params (``params["input"]``)."""
+        d: dict[str, Any] = {"file": self.path, "units": self.units.to_json(),
+                             "units_source": self.units_source,
+                             "vertices": int(len(self.V)), "faces": int(len(self.F))}
+        if self.object is not None:
+            d["object"] = self.object
+            d["object_query"] = self.object_query
+        if self.surface is not None:
+            d["surface"] = "NURBS"
+        d["clean"] = self.clean.to_json() if self.clean is not None else None
+        if self.notes:
+            d["notes"] = list(self.notes)
+        return d
+
+    def summary(self) -> str:
+        """One line for the CLI summary: units, what cleaning did, notes."""
+        parts = [f"{self.name}" + (f" ({self.object})" if self.object else ""),
+                 f"units {self.units.name}" + (" (from the file)" if self.units_source == "file"
+                                               else "")]
+        if self.surface is not None:
+            parts.append("NURBS surface")
+        elif self.clean is not None:
+            parts.append(self.clean.summary())
+        else:
+            parts.append("not cleaned (--no-clean)")
+        return "; ".join(parts + self.notes)
+
+
+def resolve_units(units: Units | str | None) -> Units | None:
+    """``--units`` as :class:`Units` (None stays None: not given)."""
+    if units is None or isinstance(units, Units):
+        return units
+    return parse_units(units)
+
+
+def read_input(source: Any, *, units: Units | str | None = None, clean: bool = True,
+               obj: str | None = None, require_disk: bool = True,
+               what: str = "the target") -> InputGeometry:
+    """Read a user's surface as metres.
+
+    Parameters
+    ----------
+    source : path of an OBJ / PLY / OFF / 3DM file, an :class:`InputGeometry` (returned as it
+        is), a QuadMesh / TriMesh or a ``(V, F)`` pair (in ``units``)
+    units : the unit the geometry is drawn in (``"m"``, ``"cm"``, ``"mm"``, ``"in"``, ``"ft"``);
+        None: a .3dm's own unit system, else metres after :func:`check_plausible`
+    clean : weld, de-duplicate and orient first (:func:`gridshell.io.clean.clean_mesh`)
+    obj : a .3dm's object to read (name, id or layer) when it holds several
+    require_disk : refuse anything but one disk-like patch
+    what : the name of the surface in messages
+
+    Raises
+    ------
+    InputError / MeshError : unreadable files, unit conflicts or implausible sizes, meshes that
+        fail the checks.
+    """
+    if isinstance(source, InputGeometry):
+        return source
+    given = resolve_units(units)
+    surface, notes, obj_label, file_u = None, [], None, None
+    if isinstance(source, (str, os.PathLike)):
+        path = Path(source)
+        name = path.name
+        if path.suffix.lower() == ".3dm":
+            from .rhino import read_3dm
+
+            r = read_3dm(path, obj)
+            file_u, obj_label, notes = r.units, r.object.label(), list(r.notes)
+            if r.surface is not None:
+                surface = r.surface
+            else:
+                V, P, sizes = r.V, r.P, r.sizes
+        else:
+            if obj is not None:
+                raise InputError(f"{name}: --object picks an object of a .3dm file; a mesh file "
+                                 "holds one mesh - drop --object")
+            from ..meshfile import read_polygons
+
+            V, P, sizes = read_polygons(path)
+        path_s = str(path.resolve())
+    else:
+        name, path_s = "(V, F)", None
+        V, P, sizes = _arrays(source)
+    # the unit: the file's own, the option's, or metres if plausible
+    if file_u is not None:
+        if given is not None and given != file_u:
+            raise InputError(f"{name}: the model is drawn in {file_u.long_name} (its unit "
+                             f"system) but --units {given.name} was given; drop --units or set "
+                             "the model's units in Rhino")
+        u, src = file_u, "file"
+    elif given is not None:
+        u, src = given, "option"
+    else:
+        u, src = METRES, "default"
+    if surface is not None:
+        surface = _scaled_surface(surface, u.metres_per_unit)
+        if src == "default":
+            from ..quadmesh import bbox_diagonal
+
+            check_plausible(bbox_diagonal(surface.ctrl.reshape(-1, 3)), name)
+        mesh = _sample_surface(surface)
+        return InputGeometry(V=mesh.V, F=mesh.F, units=u, name=name, path=path_s,
+                             surface=surface, object=obj_label, object_query=obj, clean=None,
+                             notes=notes, units_source=src)
+    if src == "default":
+        from ..quadmesh import bbox_diagonal
+
+        check_plausible(bbox_diagonal(V), name)
+    V = to_metres(V, u)
+    from ..meshfile import _check_extent, check_coordinates
+
+    check_coordinates(V, name)
+    report = None
+    if clean:
+        from .clean import clean_mesh
+
+        from ..quadmesh import check_face_areas
+
+        if len(P):  # a weld must not hide a degenerate face of the file (welding its corners
+            check_face_areas(V, P, name)  # would drop it; a mesh at one point would vanish)
+
+        V, P, sizes, report = clean_mesh(V, P, sizes, name=name)
+    from ..quadmesh import validate_mesh
+
+    validate_mesh(V, P, name=name)
+    _check_extent(V, name)
+    F = _faces(V, P, sizes)
+    if require_disk:
+        check_disk(V, F, name, report, what=what)
+    return InputGeometry(V=V, F=F, units=u, name=name, path=path_s, object=obj_label,
+                         object_query=obj, clean=report, notes=notes, units_source=src)
+
+
+def _arrays(source: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    from ..quadmesh import _as_padded
+
+    if hasattr(source, "V") and hasattr(source, "F"):
+        V, F = source.V, source.F
+    elif isinstance(source, tuple) and len(source) == 2:
+        V, F = source
+    else:
+        raise InputError("the surface must be a mesh file path (OBJ, PLY, OFF, 3DM), a "
+                         "QuadMesh / TriMesh or a (V, F) pair")
+    V = np.asarray(V, dtype=np.float64)
+    if V.ndim != 2 or V.shape[1] != 3:
+        raise MeshError(f"vertices must have shape (n, 3), got {V.shape}")
+    if not np.all(np.isfinite(V)):
+        raise MeshError("the vertices hold NaN or infinite coordinates; repair the mesh")
+    P, sizes = _as_padded(F)
+    if len(P) and (P.max() >= len(V) or P[P >= 0].min() < 0):
+        raise MeshError(f"faces refer to vertices outside 0 .. {len(V) - 1}")
+    return V, P, sizes
+
+
+def _faces(V: np.ndarray, P: np.ndarray, sizes: np.ndarray) -> np.ndarray:
+    """Quads when every face is a quad, triangles when every face is one, else triangulated."""
+    from ..quadmesh import _triangulate_padded
+
+    if np.all(sizes == 4):
+        return P[:, :4].copy()
+    if np.all(sizes == 3):
+        return P[:, :3].copy()
+    return _triangulate_padded(V, P, sizes)
+
+
+def _scaled_surface(surface: Any, factor: float) -> Any:
+    from ..bspline import BSplineSurface
+
+    if factor == 1.0:
+        return surface
+    return BSplineSurface(surface.degree_u, surface.degree_v, surface.knots_u, surface.knots_v,
+                          surface.ctrl * float(factor))
+
+
+def swap_uv(surface: Any) -> Any:
+    """The same B-spline surface with ``u`` and ``v`` exchanged (``--transpose`` of a NURBS
+    input: the PHLW rows follow the other family)."""
+    from ..bspline import BSplineSurface
+
+    return BSplineSurface(surface.degree_v, surface.degree_u, surface.knots_v, surface.knots_u,
+                          surface.ctrl.transpose(1, 0, 2).copy())
+
+
+def surface_grid(surface: Any, longest: int = SURFACE_SAMPLES) -> tuple[int, int]:
+    """Rows x columns of a sampling of ``surface`` with ``longest`` samples along its longer
+    side (mean iso-curve lengths through the control net), at least 8 along the other."""
+    C = surface.ctrl
+    lu = float(np.linalg.norm(np.diff(C, axis=0), axis=-1).sum(axis=0).mean())
+    lv = float(np.linalg.norm(np.diff(C, axis=1), axis=-1).sum(axis=1).mean())
+    if lu >= lv:
+        return longest, max(8, int(round(longest * lv / max(lu, 1e-300))))
+    return max(8, int(round(longest * lu / max(lv, 1e-300)))), longest
+
+
+def _sample_surface(surface: Any) -> Any:
+    return surface.sample(*surface_grid(surface))
+
+
+def check_disk(V: np.ndarray, F: np.ndarray, name: str, report: Any = None, *,
+               what: str = "the target", tolerance: float | None = None,
+               weld_hint: bool = True) -> None:
+    """:class:`MeshError` unless ``(V, F)`` (checked manifold and oriented) is one disk: one
+    connected piece, Euler characteristic 1, one boundary loop. The message says whether the
+    mesh looked unwelded: with ``report`` (the cleaning done) what the weld did; without it
+    (``--no-clean``) how many vertices coincide."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    F = np.asarray(F, dtype=np.int64)
+    n = len(V)
+    k = F.shape[1]
+    src = F.ravel()
+    dst = np.roll(F, -1, axis=1).ravel()
+    a, b = np.minimum(src, dst), np.maximum(src, dst)
+    key = a * n + b
+    uk, cnt = np.unique(key, return_counts=True)
+    used = np.unique(F)
+    chi = len(used) - len(uk) + len(F)
+    g = coo_matrix((np.ones(len(src)), (src, dst)), shape=(n, n))
+    n_comp = connected_components(g, directed=False)[0] - (n - len(used))
+    bk = uk[cnt == 1]
+    loops = 0
+    if len(bk):
+        ba, bb = bk // n, bk % n
+        gb = coo_matrix((np.ones(len(bk)), (ba, bb)), shape=(n, n))
+        on = np.unique(np.concatenate([ba, bb]))
+        loops = connected_components(gb, directed=False)[0] - (n - len(on))
+    if n_comp == 1 and chi == 1 and loops == 1:
+        return
+    del k
+    if n_comp > 1:
+        fix = "keep the one patch to design on (or weld the pieces)"
+    elif loops == 0:
+        fix = "the surface is closed (no boundary): cut it open"
+    else:
+        fix = "cut the surface open (e.g. a cylinder along a generator) or fill its holes"
+    if not weld_hint:
+        weld = "a working copy of the target"
+    elif report is not None:
+        weld = (f"it was welded ({report.summary()}) and is still not one disk" if report.welded
+                else "it is not an unwelded mesh (no coincident vertices to weld)")
+    else:
+        from .clean import WELD_TOLERANCE, coincident_vertices, mean_edge_length
+        from ..quadmesh import _as_padded
+
+        P, sizes = _as_padded(F)
+        tol = tolerance if tolerance is not None else \
+            WELD_TOLERANCE * mean_edge_length(np.asarray(V, float), P, sizes)
+        c = coincident_vertices(np.asarray(V, float), tol, P)
+        weld = (f"it looks unwelded: {c} of its {n} vertices coincide with others - weld it "
+                "(drop --no-clean)" if c else
+                "it is not an unwelded mesh (no coincident vertices)")
+    raise MeshError(f"{name}: {what} is not a disk ({n_comp} connected component"
+                    f"{'s' if n_comp != 1 else ''}, Euler characteristic {chi}, {loops} "
+                    f"boundary loop(s)); a design needs one disk-like patch: {fix}; {weld}")
