@@ -85,11 +85,11 @@ def _finish(d: Path, label: str, name: str, fab_params: dict, progress) -> dict[
 
     progress(f"{label}: rendering render.png (lamellae as ribbons)")
     render_bundle(d)
-    progress(f"{label}: exporting {name}.3dm (Rhino)")
-    export_3dm(d, d / f"{name}.3dm")
     progress(f"{label}: cut files ({fab_params['scale']}, {fab_params['thickness']:g} mm "
              "polypropylene)")
     fab = fabricate(d, d / "fabrication", fab_params, progress=progress.detail)
+    progress(f"{label}: exporting {name}.3dm (Rhino: strips, holes, surface, cut sheets)")
+    export_3dm(d, d / f"{name}.3dm", params=fab_params, progress=progress.detail)
     progress(f"{label}: writing report.html")
     write_report(d)
     return fab

@@ -15,7 +15,8 @@ def add_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--report", action="store_true",
                    help="also write DIR/report.html: one self-contained page of the design")
     p.add_argument("--3dm", dest="rhino", metavar="PATH",
-                   help="also export net, surface and lamellae to this Rhino .3dm file")
+                   help="also export the design to this Rhino .3dm file ('gridshell export' "
+                        "with its defaults: strips, holes, surface, collapsed state, cut sheets)")
     p.add_argument("--width", type=float, metavar="MM",
                    help="ribbon width in mm of the model (default a quarter of the joint "
                         "spacing)")
