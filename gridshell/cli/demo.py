@@ -97,18 +97,19 @@ def _finish(d: Path, label: str, name: str, fab_params: dict, progress) -> dict[
 
 def _gg(root: Path, sizes: dict, progress) -> dict[str, Any]:
     from .. import data
-    from ..gg.pipeline import design_gg, write_gg
+    from ..api import design_gg, write
     from ..verification import verify_bundle
 
     t0 = time.perf_counter()
     target = data.path("dome.obj")
     progress(f"GG: designing a geodesic gridshell on {target.name} (grid "
              f"{sizes['grid'][0]} x {sizes['grid'][1]}, {sizes['n_lamellae']} lamellae)")
-    bundle, report = design_gg(target, grid=sizes["grid"], n_lamellae=sizes["n_lamellae"],
-                               frames=sizes["frames"], progress=progress.detail)
+    design = design_gg(target, grid=sizes["grid"], n_lamellae=sizes["n_lamellae"],
+                       frames=sizes["frames"], progress=progress.detail)
+    bundle, report = design
     d = root / "gg"
     progress("GG: writing the bundle, the alignment sequence, alignment.gif and states.png")
-    write_gg(d, bundle, sequence=report["sequence"], progress=progress.detail)
+    write(d, design, progress=progress.detail)
     progress("GG: verifying the bundle from its files")
     v = verify_bundle(d)
     fab = _finish(d, "GG", "gg", FABRICATION, progress)
@@ -132,7 +133,7 @@ def _ncp(root: Path, sizes: dict, progress) -> dict[str, Any]:
     from .. import data
     from ..atomic import write_bytes
     from ..ncp.phlw import optimize_phlw, write_phlw
-    from ..ncp.pipeline import design_ncp, write_ncp
+    from ..api import design_ncp, write
     from ..ncp.reference import initial_surface
     from ..meshfile import read_mesh
     from ..verification import verify_bundle
@@ -151,14 +152,15 @@ def _ncp(root: Path, sizes: dict, progress) -> dict[str, Any]:
     nc = sizes["ncp"]
     progress(f"CNC: tracing the net ({nc['curves']} curves per family), collapse circle, "
              "post-optimization, alignment simulation")
-    bundle, report = design_ncp(res, mode="cnc", curves=nc["curves"], samples=nc["samples"],
-                                collapse_samples=nc["collapse_samples"], frames=nc["frames"],
-                                postopt_rounds=nc["postopt_rounds"], progress=progress.detail)
+    design = design_ncp(res, mode="cnc", curves=nc["curves"], samples=nc["samples"],
+                        collapse_samples=nc["collapse_samples"], frames=nc["frames"],
+                        postopt_rounds=nc["postopt_rounds"], progress=progress.detail)
+    bundle, report = design
     bundle.params.update(source=str(ref), phlw_deviation=res.deviation,
                          phlw_converged=res.converged)
     d = root / "ncp"
     progress("CNC: writing the bundle, the alignment sequence, alignment.gif and colour maps")
-    write_ncp(d, bundle, report, render=True, progress=progress.detail)
+    write(d, design, progress=progress.detail)
     write_bytes(d / "curvature_diagram.png", (root / "phlw" / "curvature_diagram.png").read_bytes())
     progress("CNC: verifying the bundle from its files")
     v = verify_bundle(d)

@@ -337,22 +337,6 @@ def _check_finite(bundle) -> None:
                                  "this is a bug, please report it")
 
 
-def _design_verdict(bundle, bundle_dir: Path | None) -> tuple[bool, str]:
-    """Whether the design holds its figures: recomputed from the files for a directory
-    (:func:`gridshell.verification.verify_bundle`), from the stored metrics otherwise."""
-    if bundle_dir is not None:
-        from ..verification import verify_bundle
-
-        res = verify_bundle(bundle_dir)
-        bad = [line.split("  ", 1)[-1] for line in res["checks"] if line.startswith("FAIL")]
-        return bool(res["ok"]), "; ".join(bad + list(res["problems"]))
-    from ..quality import design_gates, failing
-
-    gates = design_gates(bundle.kind, bundle.metrics)
-    bad = failing(gates)
-    return not bad, "; ".join(g.line().split("  ", 1)[-1] for g in bad)
-
-
 def write_3dm(bundle, path: str | os.PathLike, *, width: float | None = None,
               thickness: float | None = None, hole: float | None = None,
               scale: Any = None, sheet: Any = None, params: Any = None, units: Any = None,
@@ -403,7 +387,9 @@ def write_3dm(bundle, path: str | os.PathLike, *, width: float | None = None,
     notes: list[str] = []
     layout = None
     if sheets:
-        ok, why = _design_verdict(bundle, bundle_dir)
+        from ..verification import design_verdict
+
+        ok, why = design_verdict(bundle_dir if bundle_dir is not None else bundle)
         if ok or force:
             _say(progress, "planning the cut sheets")
             layout, fab = plan_sheets(bundle, fab)
