@@ -82,10 +82,13 @@ def run(args: Any) -> int:
 
     rhino = None
     if args.rhino:
-        from ..export.rhino import export_3dm
+        from ..export.rhino import write_3dm
 
         progress(f"exporting {args.rhino}")
-        rhino = export_3dm(bundle, args.rhino)
+        info = write_3dm(bundle, args.rhino, progress=progress.detail)
+        rhino = info["path"]
+        for note in info["notes"]:
+            progress(f"note: {note}")
         written.append(str(rhino))
 
     summary = {
