@@ -10,7 +10,8 @@ moved. Lengths in user strings are in the same unit (``units`` names it) and in 
 
     surface           the designed surface as a mesh
     B-spline surface  NCP kinds: the PHLW B-spline of surface.json as a NURBS surface
-    family 1          one closed mesh per C^1 lamella: the strip as built, real width x
+    family 1          one closed mesh per C^1 lamella (each side its own vertices, shaded
+                      flat; see unwelded_sides): the strip as built, real width x
                       thickness (gridshell.strips3d), tangent to the surface for GG (stacked:
                       family 1 on the side the surface.obj normals point to, family 3 on the
                       other, so that crossing strips touch on the surface), standing on
@@ -135,6 +136,20 @@ def _clean_polyline(P: np.ndarray) -> np.ndarray:
     return P[keep]
 
 
+def unwelded_sides(V: np.ndarray, F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The closed strip mesh of :func:`gridshell.strips3d.strip_solid` (``V (4k,3)``,
+    ``F (8(k-1)+4, 3)``: the four long sides, two triangles per segment each, then the two end
+    caps) with its own vertices for each of its six sides, so that a renderer shades the
+    sides flat instead of smoothing the normals round the strip's edges. The shape is the
+    same, the mesh still closed (Rhino joins coincident vertices for its topology)."""
+    F = np.asarray(F, np.int64)
+    n_side = (len(F) - 4) // 4
+    side = np.concatenate([np.repeat(np.arange(4), n_side), [4, 4, 5, 5]])
+    key = np.stack([np.repeat(side, 3), F.reshape(-1)], axis=1)
+    uniq, inverse = np.unique(key, axis=0, return_inverse=True)
+    return np.asarray(V, float)[uniq[:, 1]], inverse.reshape(-1, 3)
+
+
 def _strips(m: _Model, bundle, params, with_holes: bool) -> dict[str, Any]:
     """Strip solids on the family layers, axes, and the holes; returns figures."""
     from ..net import polyline_arclength
@@ -172,6 +187,7 @@ def _strips(m: _Model, bundle, params, with_holes: bool) -> dict[str, Any]:
                    "width": m.fmt(w), "thickness": m.fmt(t),
                    "width_m": f"{w:.9g}", "thickness_m": f"{t:.9g}"}
         layer = f"family {lam.family}"
+        V, F = unwelded_sides(V, F)
         m.model.Objects.AddMesh(geo.mesh(m.u(V), F, what=f"lamella {lam.id} strip"),
                                 m.attrs(layer, f"L{lam.id}", **strings))
         m.model.Objects.AddPolyline(geo.point_list(m.u(P)), m.attrs("axes", f"L{lam.id} axis",
