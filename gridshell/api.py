@@ -19,17 +19,31 @@ import os
 from pathlib import Path
 from typing import Any, Callable
 
+import functools
+
 from .bundle import Design, DesignBundle, read_bundle, write_bundle
 from .errors import InputError
-from .gg.pipeline import design_gg
+from .gg import pipeline as _gg
+from .ncp import pipeline as _ncp
 from .ncp.phlw import optimize_phlw
-from .ncp.pipeline import design_ncp
 from .verification import design_verdict, verify_bundle
 
 __all__ = ["Design", "DesignBundle", "design_gg", "design_ncp", "export_3dm", "fabricate",
            "optimize_phlw", "read", "verify", "write"]
 
 Progress = Callable[[str], None] | None
+
+
+# the pipelines' functions, looked up at each call (a test or a plug-in replacing
+# gridshell.gg.pipeline.design_gg reaches the CLI and the API alike)
+@functools.wraps(_gg.design_gg)
+def design_gg(*args: Any, **kwargs: Any) -> Design:
+    return _gg.design_gg(*args, **kwargs)
+
+
+@functools.wraps(_ncp.design_ncp)
+def design_ncp(*args: Any, **kwargs: Any) -> Design:
+    return _ncp.design_ncp(*args, **kwargs)
 
 
 def _parts(design: Any, report: dict | None = None) -> tuple[DesignBundle, dict | None]:

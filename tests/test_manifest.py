@@ -96,7 +96,7 @@ def test_rerunning_gg_keeps_the_users_notes_and_replaces_its_own_output(tmp_path
 
 def test_a_directory_appearing_during_the_run_is_not_swapped_away(tmp_path, capsys,
                                                                    monkeypatch):
-    import gridshell.api as pipeline     # the CLI designs through the API
+    import gridshell.gg.pipeline as pipeline
 
     target, out = _helicoid(tmp_path), tmp_path / "design"
     real = pipeline.design_gg
