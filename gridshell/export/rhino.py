@@ -152,9 +152,9 @@ def unwelded_sides(V: np.ndarray, F: np.ndarray) -> tuple[np.ndarray, np.ndarray
 
 def _strips(m: _Model, bundle, params, with_holes: bool) -> dict[str, Any]:
     """Strip solids on the family layers, axes, and the holes; returns figures."""
+    from ..igl_adapter import closest_points_with_normals
     from ..net import polyline_arclength
-    from ..strips3d import is_tangent, nearest_vertex_normals, real_section_m, strip_frame, \
-        strip_solid
+    from ..strips3d import is_tangent, real_section_m, strip_frame, strip_solid
 
     tangent = is_tangent(bundle.kind)
     w, t = real_section_m(params.width, params.thickness, params.scale)
@@ -163,8 +163,11 @@ def _strips(m: _Model, bundle, params, with_holes: bool) -> dict[str, Any]:
     lams = [(lam, P) for lam, P in lams if len(P) >= 2]
     if not lams:
         return {"strips": 0, "holes": 0, "width_m": w, "thickness_m": t}
-    normals = nearest_vertex_normals(np.concatenate([P for _, P in lams]), bundle.surface_V,
-                                     bundle.surface_F)
+    # the surface normal interpolated at the closest point (smooth along the axis; the nearest
+    # vertex's normal jumps from vertex to vertex and crinkles the strip: +1.7 % of area on
+    # the demo dome, 0.2 % with these)
+    normals = closest_points_with_normals(np.concatenate([P for _, P in lams]),
+                                          bundle.surface_V, bundle.surface_F)[1]
     n_holes, at = 0, 0
     for lam, P in lams:
         N = normals[at:at + len(P)]
