@@ -118,6 +118,23 @@ def test_export_3dm_of_a_design(designs, tmp_path):
     import rhino3dm
 
     info = api.export_3dm(designs["GG"], tmp_path / "gg.3dm", sheets=False)
-    assert info["strips"] == len(designs["GG"].bundle.net.lamellae)
+    lams = designs["GG"].bundle.net.lamellae
+    assert info["strips"] == len(lams)
     model = rhino3dm.File3dm.Read(str(tmp_path / "gg.3dm"))
     assert model.Settings.ModelUnitSystem == rhino3dm.UnitSystem.Meters
+    # a designed net's strips are smooth ribbons: a closed box of the lamella's length
+    # (a frame that jumps along the axis crinkles the strip and adds area)
+    w, t = info["strip_width_m"], info["strip_thickness_m"]
+    names = [layer.Name for layer in model.Layers]
+    strips = [o for o in model.Objects if names[o.Attributes.LayerIndex].startswith("family")]
+    assert len(strips) == len(lams)
+    by_id = {lam.id: lam for lam in lams}
+    for o in strips:
+        m = o.Geometry
+        V = np.array([[p.X, p.Y, p.Z] for p in m.Vertices.ToPoint3dArray()])
+        F = np.array([m.Faces[i][:3] for i in range(m.Faces.Count)])
+        tri = V[F]
+        area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]),
+                                    axis=1).sum()
+        L = by_id[int(o.Attributes.GetUserString("lamella_id"))].length
+        assert area == pytest.approx(2 * L * (w + t) + 2 * w * t, rel=0.01)
