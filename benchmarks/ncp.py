@@ -22,7 +22,8 @@ from gridshell.ncp.collapse import collapse_curve
 from gridshell.bspline import uniform_params
 from gridshell.ncp.directions import net_directions
 from gridshell.ncp.levelset import trace
-from gridshell.ncp.pipeline import design_ncp, write_ncp
+from gridshell.api import write
+from gridshell.ncp.pipeline import design_ncp
 from gridshell.ncp.postopt import post_optimize
 from gridshell.ncp.simulate import collapse_direction, simulate_alignment
 
@@ -74,10 +75,10 @@ def stages(name, surf, mode, curves, m):
     (bundle, report), t_all = timed(design_ncp, surf, mode=mode, curves=curves,
                                     collapse_samples=(m, m))
     with tempfile.TemporaryDirectory() as tmp:
-        _, t_w = timed(write_ncp, f"{tmp}/b", bundle, report)
+        _, t_w = timed(write, f"{tmp}/b", (bundle, report))
     print(f"  design_ncp total:                         {t_all:6.2f} s  "
           f"(stages {', '.join(f'{k} {v:.2f}' for k, v in bundle.metrics['timings'].items())})")
-    print(f"  write_ncp with pictures + GIF:            {t_w:6.2f} s")
+    print(f"  write with pictures + GIF:                {t_w:6.2f} s")
     mm = bundle.metrics
     extra = {k: mm[k] for k in ("aligned_radius_error", "aligned_line_error") if k in mm}
     print(f"  deviation max {mm['deviation']['max']:.4f} % diag, crossing kn max "

@@ -194,23 +194,22 @@ def _tmpdir() -> Path:
 
 
 def _ncp_write(curves: int) -> Callable[[], Any]:
-    from gridshell.ncp.pipeline import design_ncp, write_ncp
+    from gridshell.api import design_ncp, write
 
-    bundle, report = design_ncp(_pseudosphere(), mode="aa", curves=curves)
+    design = design_ncp(_pseudosphere(), mode="aa", curves=curves)
     out = _tmpdir() / "ncp"
-    return lambda: write_ncp(out, bundle, report, render=True)
+    return lambda: write(out, design, render=True)
 
 
 def _outputs(curves: int) -> Callable[[], Any]:
     """render.png, report.html and the .3dm of a written NCP bundle (``gridshell render
     --report --3dm``)."""
     from gridshell.export import export_3dm
-    from gridshell.ncp.pipeline import design_ncp, write_ncp
+    from gridshell.api import design_ncp, write
     from gridshell.render.report import write_report
     from gridshell.render.ribbons import render_bundle
 
-    bundle, report = design_ncp(_pseudosphere(), mode="aa", curves=curves)
-    out = write_ncp(_tmpdir() / "ncp", bundle, report, render=True)
+    out = write(_tmpdir() / "ncp", design_ncp(_pseudosphere(), mode="aa", curves=curves))
 
     def run() -> Any:
         render_bundle(out)
@@ -302,7 +301,7 @@ STAGES: list[Stage] = [
                 capped="post-optimization + simulation are > 95 % of it and are measured at "
                        "40 curves above (74 s in all on 2026-11-23); run it with --only "
                        "ncp_pipeline --full")]),
-    Stage("ncp_write", "NCP bundle written with pictures, frames and GIF (write_ncp)", _ncp_write,
+    Stage("ncp_write", "NCP bundle written with pictures, frames and GIF (write)", _ncp_write,
           [Size("paper", 10, "10 curves per family, 12 frames"), Size("4x", 20, "20 curves"),
            Size("16x", 40, "40 curves",
                 capped="design_ncp at 40 curves takes ~74 s to build the input; the write "

@@ -1,2 +1,22 @@
-"""Inverse design of alignable lamella gridshells."""
+"""Inverse design of alignable lamella gridshells.
+
+The Python API (:mod:`gridshell.api`), loaded on first use so that ``import gridshell`` stays
+cheap: ``design_gg``, ``design_ncp``, ``optimize_phlw``, ``write``, ``read``, ``verify``,
+``fabricate``, ``export_3dm``, ``Design``, ``DesignBundle``.
+"""
 __version__ = "0.1.0"
+
+__all__ = ["Design", "DesignBundle", "design_gg", "design_ncp", "export_3dm", "fabricate",
+           "optimize_phlw", "read", "verify", "write"]
+
+
+def __getattr__(name: str):
+    if name in __all__:
+        from . import api
+
+        return getattr(api, name)
+    raise AttributeError(f"module 'gridshell' has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(list(globals()) + __all__)

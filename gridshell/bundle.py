@@ -20,7 +20,7 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any, Callable, NamedTuple
 
 import numpy as np
 
@@ -111,6 +111,38 @@ class DesignBundle:
         if self.collapse is not None:
             d["collapse"] = self.collapse.to_json()
         return d
+
+
+class Design(NamedTuple):
+    """What a design function returns (:func:`gridshell.gg.pipeline.design_gg`,
+    :func:`gridshell.ncp.pipeline.design_ncp`): the bundle and the report of the run (figures,
+    timings, stage details; for writing also the arrays: ``"sequence"`` (GG), ``"state"``
+    (NCP)). A tuple: ``bundle, report = design_gg(...)`` unpacks it. Written by
+    :func:`gridshell.api.write`."""
+
+    bundle: DesignBundle
+    report: dict
+
+
+#: report entries that hold arrays for the writers, not figures (left out of report.json)
+REPORT_ARRAYS = ("state", "sequence")
+
+
+def report_json(report: dict) -> str:
+    """``report.json`` of a design run: the report without :data:`REPORT_ARRAYS`, strict JSON
+    (a figure that could not be measured is null, never a NaN token)."""
+    figures = {k: v for k, v in report.items() if k not in REPORT_ARRAYS}
+    return json.dumps(finite_json(figures), indent=1, allow_nan=False, default=_json_default) \
+        + "\n"
+
+
+def _json_default(o: Any) -> Any:
+    """JSON for what :func:`finite_json` leaves: numbers as float, anything else by name."""
+    try:
+        x = float(o)
+    except (TypeError, ValueError):
+        return str(o)
+    return x if np.isfinite(x) else None
 
 
 def finite_json(obj: Any) -> Any:

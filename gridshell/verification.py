@@ -270,3 +270,19 @@ def verify_bundle(path: str | Path) -> dict[str, Any]:
     out["problems"] = problems
     out["ok"] = not bad and not problems
     return out
+
+
+def design_verdict(bundle: Any) -> tuple[bool, str]:
+    """``(ok, why)``: whether a design holds the paper's figures, for writers of cut geometry
+    (which refuse it unless forced). A bundle directory is judged on the figures recomputed
+    from its files (:func:`verify_bundle`); an in-memory
+    :class:`~gridshell.bundle.DesignBundle` on its metrics
+    (:func:`gridshell.quality.design_gates`). ``why`` names the failing figures and problems."""
+    if isinstance(bundle, (str, Path)):
+        res = verify_bundle(bundle)
+        bad = [line.split("  ", 1)[-1] for line in res["checks"] if line.startswith("FAIL")]
+        return bool(res["ok"]), "; ".join(bad + list(res["problems"]))
+    from .quality import design_gates, failing
+
+    bad = failing(design_gates(bundle.kind, bundle.metrics))
+    return not bad, "; ".join(g.line().split("  ", 1)[-1] for g in bad)

@@ -1,16 +1,15 @@
 # Shows an asymptotic (AA) gridshell for a canopy, through the Python API: design_ncp in mode
 # "aa" from a reference mesh (samples/pseudosphere.obj, a patch of constant negative Gaussian
 # curvature: the PHLW step keeps it a PK surface) -> the asymptotic net (normal curvature 0),
-# which collapses into a straight line -> post-optimization, alignment simulation -> write_ncp
-# -> verify_bundle. Asymptotic lamellae stand orthogonal to the surface and are cut straight.
+# which collapses into a straight line -> post-optimization, alignment simulation -> write
+# -> verify. Asymptotic lamellae stand orthogonal to the surface and are cut straight.
 #
 #     .venv/bin/python samples/asymptotic_canopy.py [OUT] [--quick]
 #                                                   # default out/samples/asymptotic_canopy
 import sys
 from pathlib import Path
 
-from gridshell.verification import verify_bundle
-from gridshell.ncp.pipeline import design_ncp, write_ncp
+import gridshell as gs
 
 HERE = Path(__file__).resolve().parent
 
@@ -20,11 +19,12 @@ def main(argv: list[str]) -> int:
     args = [a for a in argv if a != "--quick"]
     out = Path(args[0]) if args else Path("out/samples/asymptotic_canopy")
     phlw = {"samples": (12, 12), "outer": 2, "max_iter": 10 if quick else 15}
-    bundle, report = design_ncp(HERE / "pseudosphere.obj", mode="aa", curves=10,
-                                phlw_options=phlw, frames=6 if quick else 12,
-                                collapse_samples=(600, 600) if quick else (1200, 1200))
-    write_ncp(out, bundle, report)
-    v = verify_bundle(out)
+    design = gs.design_ncp(HERE / "pseudosphere.obj", mode="aa", curves=10,
+                           phlw_options=phlw, frames=6 if quick else 12,
+                           collapse_samples=(600, 600) if quick else (1200, 1200))
+    gs.write(out, design)
+    v = gs.verify(out)
+    bundle = design.bundle
 
     m = bundle.metrics
     print(f"AA canopy: {out}")

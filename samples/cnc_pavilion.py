@@ -2,15 +2,14 @@
 # pavilion vault, through the Python API: design_ncp in mode "cnc" from a reference mesh
 # (samples/torus_patch.obj: the PHLW step fits and optimizes a B-spline first) -> the net, the
 # collapse curve (a circle of radius 1/n), post-optimization and the alignment simulation ->
-# write_ncp (bundle with sequence/frame_*.obj, alignment.gif, colour maps) -> verify_bundle.
+# write (bundle with sequence/frame_*.obj, alignment.gif, colour maps) -> verify.
 # Every lamella collapses onto one circle: all strips are arcs of that circle, cut flat.
 #
 #     .venv/bin/python samples/cnc_pavilion.py [OUT] [--quick]   # default out/samples/cnc_pavilion
 import sys
 from pathlib import Path
 
-from gridshell.verification import verify_bundle
-from gridshell.ncp.pipeline import design_ncp, write_ncp
+import gridshell as gs
 
 HERE = Path(__file__).resolve().parent
 
@@ -21,11 +20,12 @@ def main(argv: list[str]) -> int:
     out = Path(args[0]) if args else Path("out/samples/cnc_pavilion")
     # the reference is already a CNC surface (a torus zone): a light PHLW step suffices
     phlw = {"samples": (12, 12), "outer": 2, "max_iter": 10 if quick else 20}
-    bundle, report = design_ncp(HERE / "torus_patch.obj", mode="cnc", curves=12,
-                                phlw_options=phlw, frames=6 if quick else 12,
-                                collapse_samples=(600, 600) if quick else (1200, 1200))
-    write_ncp(out, bundle, report)              # bundle + sequence/, alignment.gif, maps
-    v = verify_bundle(out)
+    design = gs.design_ncp(HERE / "torus_patch.obj", mode="cnc", curves=12,
+                           phlw_options=phlw, frames=6 if quick else 12,
+                           collapse_samples=(600, 600) if quick else (1200, 1200))
+    gs.write(out, design)                       # bundle + sequence/, alignment.gif, maps
+    v = gs.verify(out)
+    bundle = design.bundle
 
     m = bundle.metrics
     print(f"CNC pavilion: {out}")

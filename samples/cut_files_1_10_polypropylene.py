@@ -12,9 +12,8 @@
 import sys
 from pathlib import Path
 
-from fabrication import FabParams, fabricate
-from gridshell.verification import verify_bundle
-from gridshell.gg.pipeline import design_gg, write_gg
+import gridshell as gs
+from fabrication import FabParams
 
 HERE = Path(__file__).resolve().parent
 
@@ -39,12 +38,12 @@ def main(argv: list[str]) -> int:
         argv = argv[:k] + argv[k + 2:]
     out = Path(argv[0]) if argv else Path("out/samples/cut_files_1_10_polypropylene")
     if bundle_dir is None:
-        bundle, _ = design_gg(HERE / "helicoid.obj", n_lamellae=8, crossing_angle=70.0,
-                              at_parallel=0.3)
+        design = gs.design_gg(HERE / "helicoid.obj", n_lamellae=8, crossing_angle=70.0,
+                                  at_parallel=0.3)
         bundle_dir = out / "design"
-        write_gg(bundle_dir, bundle, preview=False)
-    v = verify_bundle(bundle_dir)
-    rep = fabricate(bundle_dir, out / "fabrication", POLYPROPYLENE_1_10)
+        gs.write(bundle_dir, design, render=False)
+    v = gs.verify(bundle_dir)
+    rep = gs.fabricate(bundle_dir, out / "fabrication", POLYPROPYLENE_1_10)
 
     p = POLYPROPYLENE_1_10
     print(f"cut files, 1:10 model in {p.thickness:g} mm polypropylene: {out / 'fabrication'}")

@@ -1,13 +1,25 @@
-"""Round trip of gridshell.export.rhino: write a .3dm, read it back with rhino3dm."""
+"""gridshell.export.rhino: write a .3dm, read it back with rhino3dm, measure what came back.
+
+The bundles are the paraboloid cases of render_cases (z = 0.3 (x^2 + y^2), closed-form normal);
+the strip section is checked against the fabrication parameters (cut width / scale), the
+strips' faces against length x width, the sheets against fabricate()'s own report.
+"""
 from __future__ import annotations
+
+import json
 
 import numpy as np
 import pytest
 import rhino3dm
 from render_cases import N, make_bundle, write_case
 
+from gridshell.bundle import write_bundle
 from gridshell.errors import InputError
 from gridshell.export import export_3dm
+from gridshell.export.rhino import write_3dm
+from gridshell.export.units import parse_units
+
+MM = {"name": "mm", "metres_per_unit": 0.001}
 
 
 def _by_layer(model):
@@ -18,52 +30,348 @@ def _by_layer(model):
     return names, out
 
 
-def test_3dm_round_trip(tmp_path):
-    d = write_case(tmp_path / "gg", "GG")  # aligned.obj is degenerate (collapsed)
-    out = export_3dm(d, tmp_path / "gg.3dm")
-    model = rhino3dm.File3dm.Read(str(out))
-    assert model.Settings.ModelUnitSystem == rhino3dm.UnitSystem.Meters
-    names, objs = _by_layer(model)
-    assert names == ["surface", "family 1", "family 3", "joints", "aligned"]
-    assert {n: len(o) for n, o in objs.items()} == {
-        "surface": 1, "family 1": N, "family 3": N, "joints": N * N, "aligned": 2 * N}
+def _read(path):
+    model = rhino3dm.File3dm.Read(str(path))
+    return (model, *_by_layer(model))
 
-    b = make_bundle("GG")
-    mesh = objs["surface"][0].Geometry
-    assert isinstance(mesh, rhino3dm.Mesh)
-    assert len(mesh.Vertices) == len(b.surface_V) and mesh.Faces.QuadCount == len(b.surface_F)
-    assert objs["surface"][0].Attributes.GetUserString("kind") == "GG"
 
+def _mesh_arrays(mesh):
+    V = np.array([[p.X, p.Y, p.Z] for p in (mesh.Vertices.Point3dAt(i)
+                                             for i in range(len(mesh.Vertices)))])
+    F = []
+    for i in range(mesh.Faces.Count):
+        f = mesh.Faces[i]
+        F.append(f[:3] if f[2] == f[3] else f)
+    return V, F
+
+
+def _tri_areas(V, F):
+    out = []
+    for f in F:
+        tris = [f] if len(f) == 3 else [f[:3], [f[0], f[2], f[3]]]
+        out.append(sum(0.5 * np.linalg.norm(np.cross(V[b] - V[a], V[c] - V[a]))
+                       for a, b, c in tris))
+    return np.array(out)
+
+
+def _volume(V, F):
+    """Signed volume of a closed triangle mesh (divergence theorem)."""
+    return sum(np.dot(V[a], np.cross(V[b], V[c])) / 6.0 for a, b, c in F)
+
+
+def _paraboloid_normal(P):
+    n = np.column_stack([-0.6 * P[:, 0], -0.6 * P[:, 1], np.ones(len(P))])
+    return n / np.linalg.norm(n, axis=1, keepdims=True)
+
+
+def _points(crv):
+    if isinstance(crv, rhino3dm.PolylineCurve):
+        return np.array([[crv.Point(i).X, crv.Point(i).Y, crv.Point(i).Z]
+                         for i in range(crv.PointCount)])
+    raise TypeError(type(crv))
+
+
+def _foot(X, axis):
+    """Foot points on the polyline ``axis`` (densely resampled) of the points ``X (m,3)``, and
+    the unit tangent there."""
+    from scipy.spatial import cKDTree
+
+    s = np.concatenate([[0], np.cumsum(np.linalg.norm(np.diff(axis, axis=0), axis=1))])
+    d = np.linspace(0, s[-1], 200 * len(axis))
+    A = np.stack([np.interp(d, s, axis[:, c]) for c in range(3)], axis=1)
+    T = np.gradient(A, axis=0)
+    _, k = cKDTree(A).query(X)
+    return A[k], T[k] / np.linalg.norm(T[k], axis=1, keepdims=True)
+
+
+def _faces(V, F, lam, kind):
+    """Triangle areas, centroids, and which triangles are wide faces, narrow edges, end caps:
+    from the triangle normals against the paraboloid's normal and the axis tangent."""
+    A = _tri_areas(V, F)
+    tri = V[np.asarray(F)]
+    c = tri.mean(axis=1)
+    nt = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    nt /= np.linalg.norm(nt, axis=1, keepdims=True)
+    _, T = _foot(c, lam.axis)
+    along_n = np.abs(np.sum(nt * _paraboloid_normal(c), axis=1))
+    cap = np.abs(np.sum(nt * T, axis=1)) > 0.7
+    across = (along_n > 0.7) if kind == "GG" else (along_n < 0.3)   # normal along thickness
+    return A, c, across & ~cap, ~across & ~cap, cap
+
+
+@pytest.mark.parametrize("kind", ["GG", "CNC"])
+def test_strips_have_the_real_section(tmp_path, kind):
+    """Each lamella is a closed strip of width 20 mm / 0.1 = 0.2 m and thickness 0.01 m
+    (fabrication defaults): its two wide faces each have the area length x width (1 %), its
+    edges length x thickness, its volume length x width x thickness; the wide faces lie
+    tangent to the surface for GG (normal along the surface normal) and across it for CNC."""
+    d = write_case(tmp_path / "b", kind)
+    info = write_3dm(d, tmp_path / "m.3dm", sheets=False)
+    assert info["params_source"] == "defaults"
+    model, names, objs = _read(tmp_path / "m.3dm")
+    b = make_bundle(kind)
+    w, t = 0.2, 0.01
+    assert len(objs["family 1"]) == N and len(objs["family 3"]) == N
     for fam in (1, 3):
         for obj, lam in zip(objs[f"family {fam}"], b.net.family(fam)):
             a = obj.Attributes
             assert a.GetUserString("lamella_id") == str(lam.id)
             assert a.GetUserString("family") == str(fam)
-            assert float(a.GetUserString("length_m")) == pytest.approx(lam.length, rel=1e-6)
+            assert float(a.GetUserString("length")) == pytest.approx(lam.length, rel=1e-6)
             assert a.GetUserString("joints").split() == [str(j) for j in lam.joints]
-            crv = obj.Geometry
-            assert crv.PointCount == len(lam.axis)
-            pts = [crv.Point(i) for i in range(crv.PointCount)]
-            P = np.array([[q.X, q.Y, q.Z] for q in pts])
-            np.testing.assert_allclose(P, lam.axis, atol=1e-12)
+            assert float(a.GetUserString("width")) == pytest.approx(w)
+            assert float(a.GetUserString("thickness")) == pytest.approx(t)
+            mesh = obj.Geometry
+            assert isinstance(mesh, rhino3dm.Mesh) and mesh.IsClosed
+            V, F = _mesh_arrays(mesh)
+            L = lam.length
+            A, c, wide, edge, cap = _faces(V, F, lam, kind)
+            assert A.sum() == pytest.approx(2 * L * (w + t) + 2 * w * t, rel=0.01)
+            assert abs(_volume(V, F)) == pytest.approx(L * w * t, rel=0.01)
+            assert A[wide].sum() == pytest.approx(2 * L * w, rel=0.01)
+            assert A[edge].sum() == pytest.approx(2 * L * t, rel=0.01)
+            assert A[cap].sum() == pytest.approx(2 * w * t, rel=0.01)
+            if kind != "GG":
+                # standing, centred on the axis (the area centroid moves off it only by the
+                # bending of the axis: ~ kappa w^2 / 12, 1 % of w here; an edge axis: 50 %)
+                foot, _ = _foot(c, lam.axis)
+                off = np.sum(A[:, None] * (c - foot), axis=0) / A.sum()
+                assert np.linalg.norm(off) < 0.02 * w
 
+
+def test_gg_families_are_stacked_on_the_surface(tmp_path):
+    """GG strips lie tangent, family 1 on the side of the surface normal and family 3 on the
+    other: their centre lines are offset by +-t/2 along the normal, so crossing strips touch,
+    not cross."""
+    info = write_3dm(make_bundle("GG"), tmp_path / "m.3dm", sheets=False, thickness=2.0)
+    t = info["strip_thickness_m"]
+    assert t == pytest.approx(0.02)
+    _, _, objs = _read(tmp_path / "m.3dm")
+    b = make_bundle("GG")
+    a, c, e = b.surface_V[b.surface_F[0, :3]]   # the side the surface's normals point to
+    up = np.sign(np.cross(c - a, e - a)[2])
+    for fam, sign in ((1, up), (3, -up)):
+        for obj, lam in zip(objs[f"family {fam}"], b.net.family(fam)):
+            V, F = _mesh_arrays(obj.Geometry)
+            A, c, _, _, _ = _faces(V, F, lam, "GG")
+            foot, _ = _foot(c, lam.axis)
+            off = np.sum(A * np.sum((c - foot) * _paraboloid_normal(foot), axis=1)) / A.sum()
+            assert off == pytest.approx(sign * t / 2, rel=0.02)
+
+
+def test_units_of_the_input_millimetres(tmp_path):
+    """A bundle whose design.json says mm: ModelUnitSystem Millimeters, every coordinate and
+    length x1000, the sheets at their physical size in mm beside the model."""
+    b = make_bundle("GG")
+    b.units = MM
+    d = write_bundle(tmp_path / "mm", b)
+    assert json.loads((d / "design.json").read_text())["units"] == MM
+    info = write_3dm(d, tmp_path / "mm.3dm", force=True)
+    write_3dm(write_case(tmp_path / "m", "GG"), tmp_path / "m.3dm", force=True)
+    model, names, objs = _read(tmp_path / "mm.3dm")
+    ref, _, robjs = _read(tmp_path / "m.3dm")
+    assert model.Settings.ModelUnitSystem == rhino3dm.UnitSystem.Millimeters
+    assert ref.Settings.ModelUnitSystem == rhino3dm.UnitSystem.Meters
+    assert info["units"] == "mm"
+    J = np.array([[o.Geometry.Location.X, o.Geometry.Location.Y, o.Geometry.Location.Z]
+                  for o in objs["joints"]])
+    np.testing.assert_allclose(J, 1000.0 * b.net.joints, rtol=1e-12, atol=1e-9)
+    V, _ = _mesh_arrays(objs["surface"][0].Geometry)
+    np.testing.assert_allclose(V, 1000.0 * b.surface_V, rtol=1e-12, atol=1e-9)
+    for obj, robj in zip(objs["family 1"], robjs["family 1"]):
+        a, ra = obj.Attributes, robj.Attributes
+        assert a.GetUserString("units") == "mm"
+        assert float(a.GetUserString("length")) == pytest.approx(
+            1000 * float(ra.GetUserString("length")), rel=1e-9)
+        assert float(a.GetUserString("width")) == pytest.approx(200.0)
+        np.testing.assert_allclose(_mesh_arrays(obj.Geometry)[0],
+                                   1000 * _mesh_arrays(robj.Geometry)[0], rtol=1e-9, atol=1e-6)
+    for layer, scale in ((objs["sheet 01"], 1.0), (robjs["sheet 01"], 1e-3)):
+        border = next(o for o in layer if o.Attributes.GetUserString("role") == "border")
+        bb = border.Geometry.GetBoundingBox()
+        assert (bb.Max.X - bb.Min.X, bb.Max.Y - bb.Min.Y) == pytest.approx(
+            (600 * scale, 400 * scale))
+        assert bb.Min.X > 1000 * b.surface_V[:, 0].max() * scale  # beside the model
+
+
+def test_units_override_and_unknown(tmp_path):
+    write_3dm(make_bundle("GG"), tmp_path / "ft.3dm", units="ft", sheets=False)
+    model, _, objs = _read(tmp_path / "ft.3dm")
+    assert model.Settings.ModelUnitSystem == rhino3dm.UnitSystem.Feet
+    loc = objs["joints"][5].Geometry.Location
+    np.testing.assert_allclose([loc.X, loc.Y, loc.Z], make_bundle("GG").net.joints[5] / 0.3048)
+    assert parse_units(None).metres_per_unit == 1.0
+    assert parse_units({"metres_per_unit": 0.01}).name == "cm"
+    assert parse_units("millimetres").name == "mm"
+    with pytest.raises(InputError, match="unknown unit"):
+        write_3dm(make_bundle("GG"), tmp_path / "x.3dm", units="furlong")
+    with pytest.raises(InputError, match="metres_per_unit"):
+        parse_units({"name": "mm", "metres_per_unit": -1})
+
+
+def test_layers_objects_and_user_strings(tmp_path):
+    d = write_case(tmp_path / "gg", "GG")
+    out = export_3dm(d, tmp_path / "gg.3dm", force=True)
+    model, names, objs = _read(out)
+    assert names[:8] == ["surface", "family 1", "family 3", "axes", "joints", "holes",
+                         "collapsed", "sheet 01"]
+    b = make_bundle("GG")
+    n_holes = sum(len(lam.joints) for lam in b.net.lamellae)
+    counts = {n: len(o) for n, o in objs.items()}
+    assert {k: counts[k] for k in ("surface", "family 1", "family 3", "axes", "joints",
+                                   "holes", "collapsed")} == {
+        "surface": 1, "family 1": N, "family 3": N, "axes": 2 * N, "joints": N * N,
+        "holes": n_holes, "collapsed": 2 * N}
+    mesh = objs["surface"][0].Geometry
+    assert len(mesh.Vertices) == len(b.surface_V) and mesh.Faces.QuadCount == len(b.surface_F)
+    for obj, lam in zip(objs["axes"], b.net.lamellae):
+        np.testing.assert_allclose(_points(obj.Geometry), lam.axis, atol=1e-12)
+        assert obj.Attributes.GetUserString("lamella_id") == str(lam.id)
     ids = [int(o.Attributes.GetUserString("joint_id")) for o in objs["joints"]]
     assert ids == list(range(N * N))
-    loc = objs["joints"][5].Geometry.Location
-    np.testing.assert_allclose([loc.X, loc.Y, loc.Z], b.net.joints[5])
-    al = objs["aligned"][0]
-    assert al.Attributes.GetUserString("state") == "aligned"
-    assert al.Geometry.PointCount == N
+    assert objs["joints"][5].Attributes.GetUserString("lamellae").split() == ["1", str(N + 1)]
+    # holes: 3 mm / 0.1 = 30 mm through each strip at its joints
+    hole = objs["holes"][0]
+    assert isinstance(hole.Geometry, rhino3dm.Brep) and hole.Geometry.IsSolid
+    assert float(hole.Attributes.GetUserString("diameter")) == pytest.approx(0.03)
+    bb = hole.Geometry.GetBoundingBox()
+    centre = np.array([(bb.Min.X + bb.Max.X) / 2, (bb.Min.Y + bb.Max.Y) / 2,
+                       (bb.Min.Z + bb.Max.Z) / 2])
+    j = int(hole.Attributes.GetUserString("joint_id"))
+    assert np.linalg.norm(centre - b.net.joints[j]) < 0.01
+    col = objs["collapsed"][0]
+    assert col.Attributes.GetUserString("state") == "collapsed"
+    np.testing.assert_allclose(_points(col.Geometry), b.aligned[b.net.lamellae[0].joints])
+    assert model.Strings["gridshell.kind"] == "GG"
     assert not list(tmp_path.glob(".gg.3dm*"))  # atomic
+
+
+def test_sheets_match_the_cut_files(tmp_path):
+    """The sheet layers hold what fabricate() writes: one layer per sheet, one outline per
+    piece on its sheet, outlines of the flat strip's size; parameters from fabrication.json."""
+    from fabrication import fabricate
+
+    d = write_case(tmp_path / "gg", "GG")
+    fab = fabricate(d, d / "fabrication", {"width": 30, "sheet": "300x200"}, plan=False)
+    info = write_3dm(d, tmp_path / "gg.3dm", force=True)
+    assert info["params_source"].endswith("fabrication.json")
+    assert info["strip_width_m"] == pytest.approx(0.3)
+    _, names, objs = _read(tmp_path / "gg.3dm")
+    sheets = [n for n in names if n.startswith("sheet ")]
+    assert sheets == [f"sheet {k:02d}" for k in range(1, fab["n_sheets"] + 1)]
+    assert fab["n_sheets"] >= 2
+    n_holes = 0
+    for k, name in enumerate(sheets, 1):
+        outlines = [o for o in objs[name] if o.Attributes.GetUserString("role") == "outline"]
+        pieces = [p for p in fab["pieces"] if p["sheet"] == k]
+        assert len(outlines) == len(pieces)
+        for o in outlines:
+            assert o.Geometry.IsClosed
+            p = next(p for p in pieces if p["lamella"] == int(o.Attributes.GetUserString(
+                "lamella_id")) and p["piece"] == int(o.Attributes.GetUserString("piece")))
+            bb = o.Geometry.GetBoundingBox()
+            dims = sorted([bb.Max.X - bb.Min.X, bb.Max.Y - bb.Min.Y])
+            assert dims == pytest.approx(sorted([1e-3 * p["flat_length_mm"], 0.03]), rel=1e-6)
+        holes = [o for o in objs[name] if o.Attributes.GetUserString("role") == "hole"]
+        n_holes += len(holes)
+        for h in holes:  # circles of 3 mm
+            assert h.Geometry.IsClosed
+            bb = h.Geometry.GetBoundingBox()
+            assert [bb.Max.X - bb.Min.X, bb.Max.Y - bb.Min.Y] == pytest.approx([0.003] * 2)
+    assert n_holes == fab["n_joint_marks"]
+
+
+def test_cnc_arcs_and_bspline_surface(tmp_path):
+    """CNC strips are arcs on the sheets (PolyCurves with arc spans), and surface.json comes
+    in as a NURBS surface that evaluates like the B-spline (in mm)."""
+    from gridshell.bspline import BSplineSurface
+
+    u = np.linspace(-1.2, 1.2, 6)
+    X, Y = np.meshgrid(u, u, indexing="ij")
+    S = BSplineSurface.from_control_grid(np.stack([X, Y, 0.3 * (X * X + Y * Y)], -1), 3, 3)
+    b = make_bundle("CNC")
+    b.units = MM
+    b.params["n"] = 0.5
+    b.metrics["n"] = 0.5
+    d = write_bundle(tmp_path / "cnc", b,
+                     extra={"surface.json": json.dumps(S.to_json()).encode()})
+    write_3dm(d, tmp_path / "cnc.3dm", force=True)
+    _, names, objs = _read(tmp_path / "cnc.3dm")
+    ns = objs["B-spline surface"][0].Geometry
+    for uu, vv in ((0.2, 0.7), (0.5, 0.5), (0.9, 0.1)):
+        p = ns.PointAt(uu, vv)
+        np.testing.assert_allclose([p.X, p.Y, p.Z], 1000 * S.evaluate(np.array([uu]),
+                                                                      np.array([vv]))[0],
+                                   rtol=1e-12, atol=1e-9)
+    outlines = [o for o in objs["sheet 01"] if o.Attributes.GetUserString("role") == "outline"]
+    assert outlines and all(isinstance(o.Geometry, rhino3dm.PolyCurve) for o in outlines)
+    assert all(o.Geometry.IsClosed for o in outlines)
+
+
+def test_failing_design_has_no_sheets_unless_forced(tmp_path):
+    d = write_case(tmp_path / "gg", "GG")  # made-up figures: verify finds a mismatch
+    info = write_3dm(d, tmp_path / "a.3dm")
+    assert info["sheets"] == [] and "fails its figures" in info["notes"][0]
+    _, names, _ = _read(tmp_path / "a.3dm")
+    assert not [n for n in names if n.startswith("sheet")]
+    assert write_3dm(d, tmp_path / "b.3dm", force=True)["sheets"]
 
 
 def test_3dm_with_revolution_and_errors(tmp_path):
     b = make_bundle("GG")
     b.revolution_V, b.revolution_F = b.surface_V + [0, 0, 1], b.surface_F
-    out = export_3dm(b, tmp_path / "rev.3dm")
-    names, objs = _by_layer(rhino3dm.File3dm.Read(str(out)))
-    assert names[-1] == "revolution" and len(objs["revolution"]) == 1
+    out = export_3dm(b, tmp_path / "rev.3dm", sheets=False)
+    _, names, objs = _read(out)
+    assert "revolution" in names and len(objs["revolution"]) == 1
     with pytest.raises(InputError, match=".3dm"):
         export_3dm(b, tmp_path / "model.obj")
     with pytest.raises(InputError, match="not a design bundle"):
         export_3dm(tmp_path, tmp_path / "x.3dm")
+    with pytest.raises(InputError, match="--width"):
+        export_3dm(b, tmp_path / "x.3dm", width=-1)
+    with pytest.raises(InputError, match="unknown fabrication parameter"):
+        from gridshell.export.fabparams import export_params
+        export_params(None, None, widht=3)
+
+
+def test_cli_export(tmp_path, capsys):
+    from gridshell.cli.main import main
+
+    b = make_bundle("GG")
+    b.units = MM
+    d = write_bundle(tmp_path / "gg", b)
+    assert main(["export", str(d), "--width", "40", "--thickness", "2", "--scale", "1:20",
+                 "--no-sheets", "-q"]) == 0
+    model, names, objs = _read(d / "gg.3dm")
+    assert model.Settings.ModelUnitSystem == rhino3dm.UnitSystem.Millimeters
+    a = objs["family 1"][0].Attributes
+    assert (float(a.GetUserString("width")), float(a.GetUserString("thickness"))) == \
+        pytest.approx((800.0, 40.0))
+    assert "gg.3dm" in json.loads((d / "manifest.json").read_text())["files"]
+    assert main(["export", str(d), "-o", str(tmp_path / "x.obj"), "-q"]) == 2
+    assert main(["export", str(d), "--units", "m", "-o", str(tmp_path / "m.3dm"), "-q",
+                 "--no-sheets"]) == 0
+    assert rhino3dm.File3dm.Read(str(tmp_path / "m.3dm")).Settings.ModelUnitSystem == \
+        rhino3dm.UnitSystem.Meters
+
+
+def test_unwelded_sides_and_edge_axis(tmp_path):
+    """Each side of a strip gets its own vertices (flat shading) and the triangles stay the
+    same; with the axis on the edge (standing lamellae) the strip moves half a width off it."""
+    from gridshell.export.rhino import unwelded_sides
+    from gridshell.strips3d import strip_solid
+
+    P = np.stack([np.linspace(0, 1, 9), np.zeros(9), np.zeros(9)], axis=1)
+    V, F = strip_solid(P, np.tile([0.0, 0.0, 1.0], (9, 1)), 0.2, 0.01, True)
+    V2, F2 = unwelded_sides(V, F)
+    np.testing.assert_array_equal(V[F], V2[F2])
+    assert len(V2) == 4 * 2 * 9 + 2 * 4             # 4 sides of 2 x 9 corners, 2 caps of 4
+    b = make_bundle("CNC")
+    write_3dm(b, tmp_path / "e.3dm", params={"axis": "edge"}, sheets=False)
+    _, _, objs = _read(tmp_path / "e.3dm")
+    lam = b.net.family(1)[1]
+    V, F = _mesh_arrays(objs["family 1"][1].Geometry)
+    A, c, _, _, _ = _faces(V, F, lam, "CNC")
+    foot, _ = _foot(c, lam.axis)
+    off = np.sum(A * np.sum((c - foot) * _paraboloid_normal(foot), axis=1)) / A.sum()
+    assert abs(off) == pytest.approx(0.1, rel=0.05)       # centred: 0 (see above)

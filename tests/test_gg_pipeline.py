@@ -1,13 +1,16 @@
 """Tests of gridshell.gg.pipeline: net from a GG mesh, collapse, metrics, the whole pipeline."""
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 from gg_cases import catenoid, helicoid_grid, hill_grid, revolution_grid
 
 from gridshell.errors import ConvergenceError, InputError
 from gridshell.grid import grid_quads
-from gridshell.gg.pipeline import collapse_gg, design_gg, gg_metrics, gg_net_from_mesh, write_gg
+from gridshell.api import write
+from gridshell.gg.pipeline import collapse_gg, design_gg, gg_metrics, gg_net_from_mesh
 
 
 def _mesh(P):
@@ -67,7 +70,7 @@ def test_write_gg_bundle(tmp_path):
     aligned, _ = collapse_gg(st["net"])
     b = DesignBundle(kind="GG", net=st["net"], aligned=aligned, surface_V=V, surface_F=F,
                      metrics=gg_metrics(st["net"], V, F))
-    out = write_gg(tmp_path / "b", b, frames=3)
+    out = write(tmp_path / "b", b, frames=3)
     assert (out / "preview.png").stat().st_size > 1000
     d = read_design_json(out)
     assert d["kind"] == "GG" and len(d["lamellae"]) == len(st["net"].lamellae)
@@ -84,7 +87,7 @@ def test_write_gg_bundle(tmp_path):
     from PIL import Image
     with Image.open(out / "states.png") as im:
         assert im.width > 2.5 * im.height          # deployed, two states, collapsed in a row
-    assert not (write_gg(tmp_path / "c", b, preview=False, frames=0) / "sequence").exists()
+    assert not (write(tmp_path / "c", b, render=False, frames=0) / "sequence").exists()
 
 
 # ----------------------------------------------------------------------------- whole pipeline
@@ -239,10 +242,13 @@ def test_every_obj_of_a_gg_bundle_is_consistently_oriented(tmp_path, meridians, 
     V, F = _mesh(P)
     if triangles:
         F = np.concatenate([F[:, [0, 1, 2]], F[:, [0, 2, 3]]])
-    bundle, report = design_gg((V, F), meridians=meridians, frames=2,
-                               grid=(14, 12) if triangles else None)
+    design = design_gg((V, F), meridians=meridians, frames=2,
+                       grid=(14, 12) if triangles else None)
+    bundle, report = design
     assert bundle.params["quality"]["ok"]
-    out = write_gg(tmp_path / "b", bundle, preview=False, sequence=report["sequence"])
+    out = write(tmp_path / "b", design, render=False)
+    assert json.loads((out / "report.json").read_text())["revolution"]["method"] == \
+        report["revolution"]["method"]
     objs = [out / n for n in ("net.obj", "aligned.obj", "surface.obj", "revolution.obj")]
     objs += sorted((out / "sequence").glob("frame_*.obj"))
     assert len(objs) == 7

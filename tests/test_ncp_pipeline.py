@@ -10,7 +10,8 @@ from gridshell.bundle import read_bundle, read_design_json
 from gridshell.verification import verify_bundle
 from gridshell.diffgeo import surface_curvature
 from gridshell.ncp.collapse import fit_circle, fit_plane, line_deviation
-from gridshell.ncp.pipeline import crossing_normal_curvature, design_ncp, write_ncp
+from gridshell.api import write
+from gridshell.ncp.pipeline import crossing_normal_curvature, design_ncp
 from gridshell.quadmesh import bbox_diagonal
 from gridshell.meshfile import read_configuration, write_mesh
 
@@ -56,7 +57,7 @@ def _tampered(src, tmp_path, move):
 def aa_bundle(tmp_path_factory):
     bundle, report = design_ncp(pseudosphere(), mode="aa", curves=10)
     out = tmp_path_factory.mktemp("aa") / "bundle"
-    write_ncp(out, bundle, report, render=True)
+    write(out, (bundle, report), render=True)
     return bundle, report, out
 
 
@@ -64,7 +65,7 @@ def aa_bundle(tmp_path_factory):
 def cnc_bundle(tmp_path_factory):
     bundle, report = design_ncp(torus(), mode="cnc", curves=8, frames=3)
     out = tmp_path_factory.mktemp("cnc") / "bundle"
-    write_ncp(out, bundle, report, render=False)
+    write(out, (bundle, report), render=False)
     return bundle, report, out
 
 

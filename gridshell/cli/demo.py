@@ -85,12 +85,12 @@ def _finish(d: Path, label: str, name: str, fab_params: dict, progress) -> dict[
 
     progress(f"{label}: rendering render.png (lamellae as strips of their real section)")
     render_bundle(d)
-    progress(f"{label}: exporting {name}.3dm (Rhino)")
-    export_3dm(d, d / f"{name}.3dm")
     progress(f"{label}: cut files ({fab_params['scale']}, {fab_params['thickness']:g} mm "
              "polypropylene)")
     fab = fabricate(d, d / "fabrication", fab_params, progress=progress.detail)
     fab = dict(fab, structure=_structure(d, label, fab_params, progress))
+    progress(f"{label}: exporting {name}.3dm (Rhino: strips, holes, surface, cut sheets)")
+    export_3dm(d, d / f"{name}.3dm", params=fab_params, progress=progress.detail)
     progress(f"{label}: writing report.html")
     write_report(d)
     return fab
@@ -122,18 +122,19 @@ def _strength(fab: dict) -> str:
 
 def _gg(root: Path, sizes: dict, progress) -> dict[str, Any]:
     from .. import data
-    from ..gg.pipeline import design_gg, write_gg
+    from ..api import design_gg, write
     from ..verification import verify_bundle
 
     t0 = time.perf_counter()
     target = data.path("dome.obj")
     progress(f"GG: designing a geodesic gridshell on {target.name} (grid "
              f"{sizes['grid'][0]} x {sizes['grid'][1]}, {sizes['n_lamellae']} lamellae)")
-    bundle, report = design_gg(target, grid=sizes["grid"], n_lamellae=sizes["n_lamellae"],
-                               frames=sizes["frames"], progress=progress.detail)
+    design = design_gg(target, grid=sizes["grid"], n_lamellae=sizes["n_lamellae"],
+                       frames=sizes["frames"], progress=progress.detail)
+    bundle, report = design
     d = root / "gg"
     progress("GG: writing the bundle, the alignment sequence, alignment.gif and states.png")
-    write_gg(d, bundle, sequence=report["sequence"], progress=progress.detail)
+    write(d, design, progress=progress.detail)
     progress("GG: verifying the bundle from its files")
     v = verify_bundle(d)
     fab = _finish(d, "GG", "gg", FABRICATION, progress)
@@ -157,7 +158,7 @@ def _ncp(root: Path, sizes: dict, progress) -> dict[str, Any]:
     from .. import data
     from ..atomic import write_bytes
     from ..ncp.phlw import optimize_phlw, write_phlw
-    from ..ncp.pipeline import design_ncp, write_ncp
+    from ..api import design_ncp, write
     from ..ncp.reference import initial_surface
     from ..meshfile import read_mesh
     from ..verification import verify_bundle
@@ -176,14 +177,15 @@ def _ncp(root: Path, sizes: dict, progress) -> dict[str, Any]:
     nc = sizes["ncp"]
     progress(f"CNC: tracing the net ({nc['curves']} curves per family), collapse circle, "
              "post-optimization, alignment simulation")
-    bundle, report = design_ncp(res, mode="cnc", curves=nc["curves"], samples=nc["samples"],
-                                collapse_samples=nc["collapse_samples"], frames=nc["frames"],
-                                postopt_rounds=nc["postopt_rounds"], progress=progress.detail)
+    design = design_ncp(res, mode="cnc", curves=nc["curves"], samples=nc["samples"],
+                        collapse_samples=nc["collapse_samples"], frames=nc["frames"],
+                        postopt_rounds=nc["postopt_rounds"], progress=progress.detail)
+    bundle, report = design
     bundle.params.update(source=str(ref), phlw_deviation=res.deviation,
                          phlw_converged=res.converged)
     d = root / "ncp"
     progress("CNC: writing the bundle, the alignment sequence, alignment.gif and colour maps")
-    write_ncp(d, bundle, report, render=True, progress=progress.detail)
+    write(d, design, progress=progress.detail)
     write_bytes(d / "curvature_diagram.png", (root / "phlw" / "curvature_diagram.png").read_bytes())
     progress("CNC: verifying the bundle from its files")
     v = verify_bundle(d)

@@ -80,7 +80,7 @@ def _offsets(args: Any) -> tuple[list[float], list[float]] | None:
 
 def run(args: Any) -> int:
     from ..atomic import check_output
-    from ..gg.pipeline import design_gg, write_gg
+    from ..api import design_gg, write
     from ..quality import Gate, gate_lines
     from .common import Progress, input_line, input_options, print_summary
 
@@ -92,17 +92,17 @@ def run(args: Any) -> int:
     check_output(args.output, marker="design.json")
     progress = Progress(args)
     n = args.lamellae if args.lamellae is not None or args.spacing is not None else 10
-    bundle, report = design_gg(args.target, meridians=args.meridians,
-                               grid=tuple(args.grid) if args.grid else None,
-                               direction=args.direction, n_lamellae=n, spacing=args.spacing,
-                               offsets=offsets, crossing_angle=args.angle, at_parallel=args.at,
-                               rounds=args.rounds, polish_iter=args.polish,
-                               allow_unconverged=args.allow_unconverged,
-                               frames=args.frames, **input_options(args),
-                               progress=progress.callback)
+    design = design_gg(args.target, meridians=args.meridians,
+                       grid=tuple(args.grid) if args.grid else None,
+                       direction=args.direction, n_lamellae=n, spacing=args.spacing,
+                       offsets=offsets, crossing_angle=args.angle, at_parallel=args.at,
+                       rounds=args.rounds, polish_iter=args.polish,
+                       allow_unconverged=args.allow_unconverged,
+                       frames=args.frames, **input_options(args),
+                       progress=progress.callback)
     progress(f"writing {args.output}")
-    out = write_gg(args.output, bundle, preview=not args.no_preview,
-                   sequence=report["sequence"], frames=0, progress=progress.callback)
+    out = write(args.output, design, render=not args.no_preview, progress=progress.callback)
+    bundle, report = design
     m = bundle.metrics
     seq = report["sequence"]
     quality = bundle.params["quality"]

@@ -18,6 +18,7 @@ SUBCOMMANDS: dict[str, str] = {
     "verify": "verify",
     "fabricate": "fabricate",
     "render": "render",
+    "export": "export",
     "demo": "demo",
     "check": "check",
 }

@@ -83,7 +83,7 @@ def _unconverged(bundle: Any, report: dict) -> list[str]:
 
 def run(args: Any) -> int:
     from ..atomic import check_output
-    from ..ncp.pipeline import design_ncp, write_ncp
+    from ..api import design_ncp, write
     from .common import Progress, input_line, input_options, print_gates
 
     check_output(args.output, marker="design.json")
@@ -93,14 +93,15 @@ def run(args: Any) -> int:
             "outer": args.phlw_outer, "max_iter": args.phlw_max_iter,
             "align": args.phlw_align}
     curves = args.curves if args.curves is not None or args.spacing is not None else 10
-    bundle, report = design_ncp(args.reference, mode=args.mode, curves=curves,
-                                spacing=args.spacing, n=args.n, samples=tuple(args.samples),
-                                levelset_ctrl=tuple(args.levelset_ctrl), omega_f=args.omega_f,
-                                collapse_samples=tuple(args.collapse_samples),
-                                postopt_rounds=args.rounds, frames=args.frames,
-                                phlw_options=phlw, strict=args.strict,
-                                allow_unconverged=args.allow_unconverged,
-                                **input_options(args), progress=progress.callback)
+    design = design_ncp(args.reference, mode=args.mode, curves=curves,
+                        spacing=args.spacing, n=args.n, samples=tuple(args.samples),
+                        levelset_ctrl=tuple(args.levelset_ctrl), omega_f=args.omega_f,
+                        collapse_samples=tuple(args.collapse_samples),
+                        postopt_rounds=args.rounds, frames=args.frames,
+                        phlw_options=phlw, strict=args.strict,
+                        allow_unconverged=args.allow_unconverged,
+                        **input_options(args), progress=progress.callback)
+    bundle, report = design
     failed = _unconverged(bundle, report)
     for name in failed:
         progress(f"note: the {name} stopped short of its own tolerances; the figures below "
@@ -110,8 +111,7 @@ def run(args: Any) -> int:
         progress(f"warning: the design misses the paper's figures ({quality['summary']}); "
                  "written because of --allow-unconverged, marked as failing")
     progress(f"writing {args.output}")
-    out = write_ncp(args.output, bundle, report, render=not args.no_render,
-                    progress=progress.callback)
+    out = write(args.output, design, render=not args.no_render, progress=progress.callback)
     m = bundle.metrics
     summary = {
         "bundle": str(out),

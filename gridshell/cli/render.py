@@ -16,7 +16,8 @@ def add_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--report", action="store_true",
                    help="also write DIR/report.html: one self-contained page of the design")
     p.add_argument("--3dm", dest="rhino", metavar="PATH",
-                   help="also export net, surface and lamellae to this Rhino .3dm file")
+                   help="also export the design to this Rhino .3dm file ('gridshell export' "
+                        "with its defaults: strips, holes, surface, collapsed state, cut sheets)")
     p.add_argument("--width", type=float, metavar="MM",
                    help="strip width in mm at full size (default the cut strip's width over "
                         "the scale, from DIR/fabrication/fabrication.json, else 20 mm at 1:10 "
@@ -83,10 +84,13 @@ def run(args: Any) -> int:
 
     rhino = None
     if args.rhino:
-        from ..export.rhino import export_3dm
+        from ..export.rhino import write_3dm
 
         progress(f"exporting {args.rhino}")
-        rhino = export_3dm(bundle, args.rhino)
+        info = write_3dm(bundle, args.rhino, progress=progress.detail)
+        rhino = info["path"]
+        for note in info["notes"]:
+            progress(f"note: {note}")
         written.append(str(rhino))
 
     summary = {

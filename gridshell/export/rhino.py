@@ -1,123 +1,352 @@
-"""Export a design bundle to a Rhino ``.3dm`` model through ``rhino3dm``.
+"""Export a design bundle to a Rhino ``.3dm`` model an architect can use, through ``rhino3dm``.
 
-Layers and objects (model units: metres)::
+**Units and frame.** The model is in the user's unit and frame: ``ModelUnitSystem`` is the
+bundle's input unit (``design.json`` ``"units"``, metres when absent; ``units=`` overrides it)
+and every coordinate is the bundle's metres divided by the unit's size in metres. Nothing is
+moved. Lengths in user strings are in the same unit (``units`` names it) and in metres
+(``*_m``).
 
-    surface     the designed surface as a mesh (user strings kind, bundle)
-    family 1    one polyline curve per C^1 lamella axis
-    family 3    one polyline curve per C^3 lamella axis
-    joints      one point per joint (user string joint_id)
-    aligned     one polyline per lamella through its joints in the aligned configuration
-    revolution  GG only: the isometric surface of revolution as a mesh
+**Layers and objects**::
 
-Lamella curves carry the user strings ``lamella_id``, ``family``, ``length_m`` (axis length,
-metres) and ``joints`` (joint ids along the lamella, space separated).
+    surface           the designed surface as a mesh
+    B-spline surface  NCP kinds: the PHLW B-spline of surface.json as a NURBS surface
+    family 1          one closed mesh per C^1 lamella (each side its own vertices, shaded
+                      flat; see unwelded_sides): the strip as built, real width x
+                      thickness (gridshell.strips3d), tangent to the surface for GG (stacked:
+                      family 1 on the side the surface.obj normals point to, family 3 on the
+                      other, so that crossing strips touch on the surface), standing on
+                      it for NCP / CNC / AA (on the centre line, or on its edge with axis "edge")
+    family 3          the same for C^3
+    axes              one polyline per lamella axis (the design's centre line)
+    joints            one point per joint (user strings joint_id, lamellae)
+    holes             joint style "hole": one capped cylinder per lamella and joint, the hole
+                      through the strip (real diameter = hole / scale)
+    collapsed         the collapsed (aligned) state: one polyline per lamella through its
+                      aligned joints (aligned.obj)
+    revolution        GG: the isometric surface of revolution as a mesh
+    sheet 01, ...     the cut sheets, one layer each, as curves in the XY plane beside the
+                      model: the sheet's border, each part's outline (arcs exact), holes,
+                      score marks and engraved labels, at the physical size of the cut files
+                      (mm of the model, converted to the user's unit)
+
+**User strings.** Strips and axes: ``lamella_id``, ``family``, ``length`` (axis length, user
+unit), ``length_m``, ``joints`` (joint ids along the lamella, space separated; also as
+``joint_ids``), ``joint_s`` (their arc lengths, user unit), ``width``, ``thickness`` (user unit)
+and ``width_m``, ``thickness_m``, ``units``, ``kind``. Sheet curves: ``sheet``, ``role``
+(``border``, ``outline``, ``hole``, ``score``, ``engrave``) and for parts ``lamella_id``,
+``family``, ``piece``, ``n_pieces``. The model's own strings (``model.Strings``): kind, units,
+fabrication parameters and where they came from.
+
+The strip section comes from the fabrication parameters (:mod:`.fabparams`): cut width and
+thickness divided by the scale (20 x 1 mm at 1:10 -> 200 x 10 mm). Cut sheets are left out of
+a design that fails its figures (as ``gridshell fabricate`` refuses it) unless ``force``.
 """
 from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import Callable
+from typing import Any, Callable
 
 import numpy as np
 
 from ..atomic import atomic_path
-from ..errors import InputError, OutputError
+from ..errors import GridshellError, InputError, OutputError
+from . import rhino_geometry as geo
+from .units import METRES, Units, bundle_units, parse_units
 
-__all__ = ["LAYERS", "export_3dm", "bundle_to_3dm"]
+__all__ = ["LAYERS", "RHINO_UNITS", "bundle_to_3dm", "export_3dm", "write_3dm"]
 
-#: layer name -> RGBA colour (0-255)
+#: fixed layer name -> RGBA colour (0-255); sheet layers ("sheet 01", ...) follow them
 LAYERS: dict[str, tuple[int, int, int, int]] = {
     "surface": (170, 175, 185, 255),
+    "B-spline surface": (150, 160, 175, 255),
     "family 1": (33, 107, 179, 255),
     "family 3": (219, 89, 31, 255),
+    "axes": (60, 60, 60, 255),
     "joints": (25, 25, 25, 255),
-    "aligned": (90, 150, 60, 255),
+    "holes": (200, 30, 30, 255),
+    "collapsed": (90, 150, 60, 255),
     "revolution": (150, 120, 190, 255),
 }
+SHEET_COLOUR = (200, 0, 0, 255)
 _FILE_VERSION = 8
 
-
-def _mesh(V: np.ndarray, F: np.ndarray):
-    import rhino3dm
-
-    m = rhino3dm.Mesh()
-    for x, y, z in np.asarray(V, float).reshape(-1, 3).tolist():
-        m.Vertices.Add(x, y, z)
-    F = np.asarray(F, np.int64)
-    for f in F.tolist():
-        f = [i for i in f if i >= 0]
-        if len(f) == 4:
-            m.Faces.AddFace(*f)
-        elif len(f) == 3:
-            m.Faces.AddFace(f[0], f[1], f[2])
-        else:
-            raise InputError(f"surface face {f} has {len(f)} corners; only triangles and quads "
-                             "can go into a Rhino mesh")
-    m.Normals.ComputeNormals()
-    m.Compact()
-    return m
+#: unit name -> rhino3dm.UnitSystem member name
+RHINO_UNITS = {"m": "Meters", "mm": "Millimeters", "cm": "Centimeters", "in": "Inches",
+               "ft": "Feet"}
 
 
-def _polyline(P: np.ndarray):
-    import rhino3dm
-
-    pts = rhino3dm.Point3dList()
-    for x, y, z in np.asarray(P, float).reshape(-1, 3).tolist():
-        pts.Add(x, y, z)
-    return pts
+def _say(progress: Callable[[str], None] | None, msg: str) -> None:
+    if progress is not None:
+        progress(msg)
 
 
-def bundle_to_3dm(bundle, name: str = ""):
-    """A ``rhino3dm.File3dm`` of a :class:`~gridshell.bundle.DesignBundle` (see the module
-    docstring for layers, objects and user strings)."""
-    import rhino3dm
+def sheet_layer(k: int) -> str:
+    """Layer name of the 0-based sheet ``k``: ``"sheet 01"``, ``"sheet 02"`` ..."""
+    return f"sheet {k + 1:02d}"
 
-    model = rhino3dm.File3dm()
-    model.Settings.ModelUnitSystem = rhino3dm.UnitSystem.Meters
-    model.ApplicationName = "gridshell"
-    layer_index: dict[str, int] = {}
-    names = [n for n in LAYERS if n != "revolution" or bundle.revolution_V is not None]
-    for n in names:
-        layer = rhino3dm.Layer()
-        layer.Name = n
-        layer.Color = LAYERS[n]
-        layer_index[n] = model.Layers.Add(layer)
 
-    def attrs(layer: str, obj_name: str = "", **strings: object):
-        a = rhino3dm.ObjectAttributes()
-        a.LayerIndex = layer_index[layer]
-        if obj_name:
-            a.Name = obj_name
+class _Model:
+    """A File3dm with named layers, object attributes and the user's unit."""
+
+    def __init__(self, units: Units) -> None:
+        import rhino3dm
+
+        self.r = rhino3dm
+        self.model = rhino3dm.File3dm()
+        self.units = units
+        self.model.Settings.ModelUnitSystem = getattr(rhino3dm.UnitSystem,
+                                                      RHINO_UNITS[units.name])
+        self.model.Settings.ModelAbsoluteTolerance = 1e-5 / units.metres_per_unit
+        self.model.ApplicationName = "gridshell"
+        self.layers: dict[str, int] = {}
+        self.counts: dict[str, int] = {}
+
+    def layer(self, name: str, colour: tuple[int, int, int, int]) -> None:
+        layer = self.r.Layer()
+        layer.Name = name
+        layer.Color = colour
+        self.layers[name] = self.model.Layers.Add(layer)
+        self.counts[name] = 0
+
+    def attrs(self, layer: str, name: str = "", **strings: object):
+        a = self.r.ObjectAttributes()
+        a.LayerIndex = self.layers[layer]
+        if name:
+            a.Name = name
         for k, v in strings.items():
             a.SetUserString(k, str(v))
+        self.counts[layer] += 1
         return a
 
-    model.Objects.AddMesh(_mesh(bundle.surface_V, bundle.surface_F),
-                          attrs("surface", "surface", kind=bundle.kind, bundle=name))
+    def u(self, X):
+        """Metres -> the user's unit."""
+        return np.asarray(X, float) / self.units.metres_per_unit
+
+    def fmt(self, metres: float) -> str:
+        return f"{metres / self.units.metres_per_unit:.9g}"
+
+
+def _clean_polyline(P: np.ndarray) -> np.ndarray:
+    """``P (k,3)`` without consecutive repeated points."""
+    P = np.asarray(P, float).reshape(-1, 3)
+    if len(P) < 2:
+        return P
+    keep = np.concatenate([[True], np.linalg.norm(np.diff(P, axis=0), axis=1) > 0])
+    return P[keep]
+
+
+def unwelded_sides(V: np.ndarray, F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The closed strip mesh of :func:`gridshell.strips3d.strip_solid` (``V (4k,3)``,
+    ``F (8(k-1)+4, 3)``: the four long sides, two triangles per segment each, then the two end
+    caps) with its own vertices for each of its six sides, so that a renderer shades the
+    sides flat instead of smoothing the normals round the strip's edges. The shape is the
+    same, the mesh still closed (Rhino joins coincident vertices for its topology)."""
+    F = np.asarray(F, np.int64)
+    n_side = (len(F) - 4) // 4
+    side = np.concatenate([np.repeat(np.arange(4), n_side), [4, 4, 5, 5]])
+    key = np.stack([np.repeat(side, 3), F.reshape(-1)], axis=1)
+    uniq, inverse = np.unique(key, axis=0, return_inverse=True)
+    return np.asarray(V, float)[uniq[:, 1]], inverse.reshape(-1, 3)
+
+
+def _strips(m: _Model, bundle, params, with_holes: bool) -> dict[str, Any]:
+    """Strip solids on the family layers, axes, and the holes; returns figures."""
+    from ..igl_adapter import closest_points_with_normals
+    from ..net import polyline_arclength
+    from ..strips3d import is_tangent, real_section_m, strip_frame, strip_solid
+
+    tangent = is_tangent(bundle.kind)
+    w, t = real_section_m(params.width, params.thickness, params.scale)
+    radius = 0.5 * 1e-3 * params.hole / params.scale
+    lams = [(lam, _clean_polyline(lam.axis)) for lam in bundle.net.lamellae]
+    lams = [(lam, P) for lam, P in lams if len(P) >= 2]
+    if not lams:
+        return {"strips": 0, "holes": 0, "width_m": w, "thickness_m": t}
+    # the surface normal interpolated at the closest point (smooth along the axis; the nearest
+    # vertex's normal jumps from vertex to vertex and crinkles the strip: +1.7 % of area on
+    # the demo dome, 0.2 % with these)
+    normals = closest_points_with_normals(np.concatenate([P for _, P in lams]),
+                                          bundle.surface_V, bundle.surface_F)[1]
+    n_holes, at = 0, 0
+    for lam, P in lams:
+        N = normals[at:at + len(P)]
+        at += len(P)
+        _, W, H = strip_frame(P, N, tangent)
+        if tangent:      # stacked: family 1 on the normals' side of the surface, 3 below
+            C = P + (0.5 * t if lam.family == 1 else -0.5 * t) * H
+        elif params.axis == "edge":    # the axis on the edge the strip stands on
+            C = P + 0.5 * w * W
+        else:
+            C = P
+        V, F = strip_solid(C, N, w, t, tangent)
+        s = polyline_arclength(P)
+        strings = {"lamella_id": int(lam.id), "family": int(lam.family), "kind": bundle.kind,
+                   "length": m.fmt(lam.length), "length_m": f"{lam.length:.9g}",
+                   "units": m.units.name,
+                   "joints": " ".join(str(j) for j in lam.joints.tolist()),
+                   "joint_ids": " ".join(str(j) for j in lam.joints.tolist()),
+                   "joint_s": " ".join(m.fmt(x) for x in lam.joint_s.tolist()),
+                   "width": m.fmt(w), "thickness": m.fmt(t),
+                   "width_m": f"{w:.9g}", "thickness_m": f"{t:.9g}"}
+        layer = f"family {lam.family}"
+        V, F = unwelded_sides(V, F)
+        m.model.Objects.AddMesh(geo.mesh(m.u(V), F, what=f"lamella {lam.id} strip"),
+                                m.attrs(layer, f"L{lam.id}", **strings))
+        m.model.Objects.AddPolyline(geo.point_list(m.u(P)), m.attrs("axes", f"L{lam.id} axis",
+                                                                    **strings))
+        if not with_holes or not len(lam.joints):
+            continue
+        js = np.clip(lam.joint_s, 0.0, s[-1])
+        centres = np.stack([np.interp(js, s, C[:, c]) for c in range(3)], axis=1)
+        axes = np.stack([np.interp(js, s, H[:, c]) for c in range(3)], axis=1)
+        for j, c, a in zip(lam.joints.tolist(), centres, axes):
+            brep = geo.cylinder_brep(m.u(c), a, radius / m.units.metres_per_unit,
+                                     t / m.units.metres_per_unit)
+            m.model.Objects.AddBrep(brep, m.attrs("holes", f"L{lam.id} J{j} hole",
+                                                  lamella_id=int(lam.id), joint_id=j,
+                                                  diameter=m.fmt(2 * radius)))
+            n_holes += 1
+    return {"strips": len(lams), "holes": n_holes, "width_m": w, "thickness_m": t}
+
+
+def _bbox(bundle) -> tuple[np.ndarray, np.ndarray]:
+    X = np.concatenate([np.asarray(bundle.surface_V, float).reshape(-1, 3), bundle.net.joints]
+                       + [lam.axis for lam in bundle.net.lamellae])
+    return X.min(axis=0), X.max(axis=0)
+
+
+def _sheets(m: _Model, bundle, layout, params) -> list[dict[str, Any]]:
+    """The cut sheets as curves on one layer each, in a row in the XY plane beside the model
+    (right of its bounding box, from its lowest corner), at their physical size."""
+    lo, hi = _bbox(bundle)
+    W, H = layout.sheet
+    to_unit = 1e-3 / m.units.metres_per_unit      # mm -> user unit
+    x = m.u(hi[0] + 0.1 * max(float(np.linalg.norm(hi - lo)), 1e-3))
+    y0, z = m.u(lo[1]), float(m.u(lo[2]))
+    out = []
+    for k in range(layout.n_sheets):
+        layer = sheet_layer(k)
+        m.layer(layer, SHEET_COLOUR)
+        origin = np.array([float(x), float(y0)])
+
+        def place(P):
+            return origin + np.asarray(P, float).reshape(-1, 2) * to_unit
+
+        border = place([[0, 0], [W, 0], [W, H], [0, H], [0, 0]])
+        m.model.Objects.AddCurve(geo.bulge_curve(border, None, False, z),
+                                 m.attrs(layer, layer, sheet=k + 1, role="border",
+                                         width_mm=f"{W:g}", height_mm=f"{H:g}",
+                                         scale=f"{params.scale:g}"))
+        parts = layout.on_sheet(k)
+        for p in parts:
+            st = p.strip
+            ids = {"sheet": k + 1, "lamella_id": int(st.lamella), "family": int(st.family),
+                   "piece": int(st.piece), "n_pieces": int(st.n_pieces)}
+            name = f"L{st.lamella}" + (f"-{st.piece}/{st.n_pieces}" if st.n_pieces > 1 else "")
+            m.model.Objects.AddCurve(geo.bulge_curve(place(p.outline.V), p.outline.B,
+                                                     p.outline.closed, z),
+                                     m.attrs(layer, name, role="outline", **ids))
+            for c, r in zip(p.holes, p.radii):
+                m.model.Objects.AddCircle(geo.circle(place(c)[0], float(r) * to_unit, z),
+                                         m.attrs(layer, f"{name} hole", role="hole", **ids))
+            for a, b in p.scores:
+                m.model.Objects.AddCurve(geo.bulge_curve(place([a, b]), None, False, z),
+                                         m.attrs(layer, f"{name} score", role="score", **ids))
+            for L in p.engrave:
+                m.model.Objects.AddCurve(geo.bulge_curve(place(L), None, False, z),
+                                         m.attrs(layer, f"{name} label", role="engrave", **ids))
+        out.append({"layer": layer, "parts": len(parts),
+                    "origin": [float(origin[0]), float(origin[1]), z]})
+        x = x + (W + 0.05 * W) * to_unit
+    return out
+
+
+def bundle_to_3dm(bundle, *, name: str = "", units: Any = None, params: Any = None,
+                  layout: Any = None, bspline: Any = None, params_source: str = ""
+                  ) -> tuple[Any, dict[str, Any]]:
+    """``(model, info)``: a ``rhino3dm.File3dm`` of a :class:`~gridshell.bundle.DesignBundle`
+    (layers, objects and user strings: the module docstring) and what went into it.
+
+    Parameters
+    ----------
+    units : unit name, ``{"name", "metres_per_unit"}`` or Units, optional
+        The model's unit; default the bundle's input unit (metres when it records none).
+    params : FabParams, optional
+        Strip section, holes and sheets (mm of the model); default
+        :class:`~fabrication.params.FabParams` ().
+    layout : fabrication.nesting.Layout, optional
+        Cut sheets to draw (:func:`gridshell.export.fabparams.plan_sheets`); None: none.
+    bspline : BSplineSurface, optional
+        The NURBS surface of the "B-spline surface" layer.
+    """
+    from fabrication.params import FabParams
+
+    units = parse_units(units) if units is not None else bundle_units(bundle)
+    note = ""
+    if units.name not in RHINO_UNITS:
+        note = f"unit {units.name} has no Rhino unit system: the model is in metres"
+        units = METRES
+    params = params or FabParams()
+    m = _Model(units)
+    with_holes = params.joints == "hole"
+    for n, colour in LAYERS.items():
+        if n == "revolution" and bundle.revolution_V is None:
+            continue
+        if n == "B-spline surface" and bspline is None:
+            continue
+        if n == "holes" and not with_holes:
+            continue
+        m.layer(n, colour)
+
+    m.model.Objects.AddMesh(geo.mesh(m.u(bundle.surface_V), bundle.surface_F),
+                            m.attrs("surface", "surface", kind=bundle.kind, bundle=name,
+                                    units=units.name))
+    if bspline is not None:
+        m.model.Objects.AddSurface(
+            geo.nurbs_surface(bspline.degree_u, bspline.degree_v, bspline.knots_u,
+                              bspline.knots_v, m.u(bspline.ctrl)),
+            m.attrs("B-spline surface", "B-spline surface", kind=bundle.kind))
     if bundle.revolution_V is not None:
-        model.Objects.AddMesh(_mesh(bundle.revolution_V, bundle.revolution_F),
-                              attrs("revolution", "surface of revolution", kind=bundle.kind))
+        m.model.Objects.AddMesh(geo.mesh(m.u(bundle.revolution_V), bundle.revolution_F),
+                                m.attrs("revolution", "surface of revolution", kind=bundle.kind))
+    strips = _strips(m, bundle, params, with_holes)
+
+    through: dict[int, list[int]] = {}
     for lam in bundle.net.lamellae:
-        strings = {"lamella_id": int(lam.id), "family": int(lam.family),
-                   "length_m": f"{lam.length:.6f}",
-                   "joints": " ".join(str(j) for j in lam.joints.tolist())}
-        if len(lam.axis) >= 2:
-            model.Objects.AddPolyline(_polyline(lam.axis),
-                                      attrs(f"family {lam.family}", f"L{lam.id}", **strings))
+        for j in lam.joints.tolist():
+            through.setdefault(j, []).append(int(lam.id))
         if len(lam.joints) >= 2:
-            model.Objects.AddPolyline(_polyline(bundle.aligned[lam.joints]),
-                                      attrs("aligned", f"L{lam.id} aligned", state="aligned",
-                                            **strings))
-    for j, (x, y, z) in enumerate(bundle.net.joints.tolist()):
-        model.Objects.AddPoint(rhino3dm.Point3d(x, y, z), attrs("joints", f"J{j}", joint_id=j))
-    return model
+            m.model.Objects.AddPolyline(
+                geo.point_list(m.u(bundle.aligned[lam.joints])),
+                m.attrs("collapsed", f"L{lam.id} collapsed", state="collapsed",
+                        lamella_id=int(lam.id), family=int(lam.family),
+                        joints=" ".join(str(j) for j in lam.joints.tolist())))
+    for j, p in enumerate(m.u(bundle.net.joints).tolist()):
+        m.model.Objects.AddPoint(m.r.Point3d(*p), m.attrs(
+            "joints", f"J{j}", joint_id=j, lamellae=" ".join(map(str, through.get(j, [])))))
+
+    sheets = _sheets(m, bundle, layout, params) if layout is not None else []
+    strings = {"gridshell.kind": bundle.kind, "gridshell.units": units.name,
+               "gridshell.metres_per_unit": f"{units.metres_per_unit:.12g}",
+               "gridshell.bundle": name,
+               "gridshell.strip_width_mm": f"{params.width:g}",
+               "gridshell.strip_thickness_mm": f"{params.thickness:g}",
+               "gridshell.hole_mm": f"{params.hole:g}",
+               "gridshell.scale": f"{params.scale:g}",
+               "gridshell.fabrication_parameters": params_source or "given"}
+    for k, v in strings.items():
+        m.model.Strings[k] = v
+    info = {"units": units.name, "metres_per_unit": units.metres_per_unit,
+            "layers": dict(m.counts), "strips": strips["strips"], "holes": strips["holes"],
+            "strip_width_m": strips["width_m"], "strip_thickness_m": strips["thickness_m"],
+            "sheets": sheets, "note": note}
+    return m.model, info
 
 
 def _check_finite(bundle) -> None:
     """:class:`GridshellError` (a bug: bundles are validated when read) unless every coordinate
     that goes into the .3dm file is finite: nothing non-finite is ever written."""
-    from ..errors import GridshellError
-
     arrays = {"net joints": bundle.net.joints, "aligned joints": bundle.aligned,
               "surface": bundle.surface_V}
     arrays.update({f"lamella {lam.id} axis": lam.axis for lam in bundle.net.lamellae})
@@ -127,38 +356,87 @@ def _check_finite(bundle) -> None:
                                  "this is a bug, please report it")
 
 
-def export_3dm(bundle_dir, path: str | os.PathLike, *,
-               progress: Callable[[str], None] | None = None) -> Path:
-    """Write the net, surface and lamellae of a design bundle to a Rhino ``.3dm`` file
-    (Rhino 8 format, metres), atomically.
+def write_3dm(bundle, path: str | os.PathLike, *, width: float | None = None,
+              thickness: float | None = None, hole: float | None = None,
+              scale: Any = None, sheet: Any = None, params: Any = None, units: Any = None,
+              sheets: bool = True, force: bool = False,
+              progress: Callable[[str], None] | None = None) -> dict[str, Any]:
+    """Write a design bundle to a Rhino ``.3dm`` file (Rhino 8 format), atomically; returns
+    what was written (``path``, ``units``, object counts per layer, ``sheets``, the
+    fabrication parameters and their source, and ``notes``).
 
     Parameters
     ----------
-    bundle_dir : path-like or DesignBundle
+    bundle : path-like or DesignBundle
         The design bundle directory (or an in-memory bundle).
     path : path-like
         Output ``.3dm`` file.
-
-    Returns
-    -------
-    Path
-        ``path``.
+    width, thickness, hole, scale, sheet : optional
+        Cut strip width, thickness and hole diameter (mm of the model), the model scale
+        (``"1:10"`` or 0.1) and the sheet size (``"600x400"`` mm); the strips' real section
+        is width / scale x thickness / scale. Default: the bundle's
+        ``fabrication/fabrication.json``, else FabParams defaults.
+    params : FabParams or dict, optional
+        All fabrication parameters at once (the values above still override them).
+    units : optional
+        The model's unit (``"mm"``, ``"m"`` ...); default the bundle's input unit.
+    sheets : bool
+        Draw the cut sheets (planned in memory as ``gridshell fabricate`` would).
+    force : bool
+        Draw the cut sheets of a design that fails its figures too.
     """
-    from ..bundle import read_bundle
+    from ..bundle import read_bundle, read_design_json
+    from .fabparams import export_params, plan_sheets
 
     path = Path(path)
     if path.suffix.lower() != ".3dm":
         raise InputError(f"{path.name}: a Rhino file needs the extension .3dm")
-    if isinstance(bundle_dir, (str, os.PathLike)):
-        bundle, name = read_bundle(bundle_dir), Path(bundle_dir).resolve().name
+    bundle_dir = None
+    if isinstance(bundle, (str, os.PathLike)):
+        bundle_dir = Path(bundle)
+        design = read_design_json(bundle_dir)
+        bundle, name = read_bundle(bundle_dir), bundle_dir.resolve().name
+        if units is None:
+            units = bundle_units(design)
     else:
-        bundle, name = bundle_dir, ""
+        name = ""
     _check_finite(bundle)
-    if progress is not None:
-        progress(f"writing {path}")
-    model = bundle_to_3dm(bundle, name)
+    fab, source = export_params(bundle_dir, params, width=width, thickness=thickness,
+                                hole=hole, scale=scale, sheet=sheet)
+    notes: list[str] = []
+    layout = None
+    if sheets:
+        from ..verification import design_verdict
+
+        ok, why = design_verdict(bundle_dir if bundle_dir is not None else bundle)
+        if ok or force:
+            _say(progress, "planning the cut sheets")
+            layout, fab = plan_sheets(bundle, fab)
+            if not ok:
+                notes.append(f"cut sheets of a design that fails its figures ({why}), "
+                             "drawn because of force")
+        else:
+            notes.append(f"no cut sheets: the design fails its figures ({why}); force draws "
+                         "them anyway")
+    bspline = None
+    if bundle_dir is not None and (bundle_dir / "surface.json").is_file():
+        from ..bspline import BSplineSurface
+
+        bspline = BSplineSurface.load(bundle_dir / "surface.json")
+    _say(progress, f"writing {path}")
+    model, info = bundle_to_3dm(bundle, name=name, units=units, params=fab, layout=layout,
+                                bspline=bspline, params_source=source)
+    if info["note"]:
+        notes.append(info["note"])
     with atomic_path(path) as tmp:
         if not model.Write(str(tmp), _FILE_VERSION):
             raise OutputError(f"rhino3dm could not write {path}; check the location is "
                               "writable")
-    return path
+    info.update(path=str(path), params=fab.to_json(), params_source=source, notes=notes)
+    return info
+
+
+def export_3dm(bundle, path: str | os.PathLike, **options: Any) -> Path:
+    """:func:`write_3dm`, returning ``path``."""
+    write_3dm(bundle, path, **options)
+    return Path(path)

@@ -21,7 +21,7 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 from scipy.sparse.linalg import lsqr
 
-from ..bundle import DesignBundle, write_bundle
+from ..bundle import Design, DesignBundle, report_json, write_bundle
 from ..errors import ConvergenceError, GridshellError, InputError, NoNetError
 from ..grid import grid_quads
 from ..metrics import (alignability_error, alignability_error_arc, coverage, delta_l, deviation,
@@ -33,7 +33,7 @@ from .mapback import map_back, map_to_revolution
 from .revolution import rebuild_revolution
 from .simulate import GGSequence, gg_alignment_sequence
 
-__all__ = ["check_offsets", "collapse_gg", "design_gg", "gg_gates", "gg_metrics",
+__all__ = ["check_offsets", "collapse_gg", "design_gg", "gg_files", "gg_gates", "gg_metrics",
            "gg_net_from_mesh", "gg_score", "write_gg"]
 
 Progress = Callable[[str], None] | None
@@ -306,7 +306,7 @@ def design_gg(target: Any, *, meridians: str = "cols", grid: tuple[int, int] | N
               rounds: int = 10, polish_iter: int = 20, allow_unconverged: bool = False,
               frames: int = 12, units: Any = None, clean: bool = True,
               obj: str | None = None, progress: Progress = None
-              ) -> tuple[DesignBundle, dict[str, Any]]:
+              ) -> Design:
     """Design a geodesic alignable gridshell on (an approximation of) a target surface.
 
     Parameters
@@ -442,7 +442,7 @@ def design_gg(target: Any, *, meridians: str = "cols", grid: tuple[int, int] | N
                           units=geo.units)
     report = {"design": design_report, "revolution": rev.info, "collapse": collapse_info,
               "net": inet.info, "sequence": seq}
-    return bundle, report
+    return Design(bundle, report)
 
 
 def _edge_families(net: Net, edges: np.ndarray) -> np.ndarray:
@@ -457,20 +457,35 @@ def _edge_families(net: Net, edges: np.ndarray) -> np.ndarray:
 def write_gg(path: str | Path, bundle: DesignBundle, *, preview: bool = True,
              sequence: GGSequence | None = None, frames: int = 12,
              progress: Progress = None) -> Path:
-    """Write a GG design bundle atomically.
+    """Deprecated: :func:`gridshell.api.write` writes GG and NCP designs alike
+    (``write(path, design_gg(...))``). Writes ``bundle`` with :func:`gg_files` (``preview``
+    is ``render``; ``sequence`` the states to write, else ``frames`` computed)."""
+    import warnings
 
-    Besides the bundle files (:func:`gridshell.bundle.write_bundle`): the alignment sequence
-    ``sequence/frame_000.obj ...`` (joints of every state with the net-loops as faces; the
-    first equals ``net.obj``, the last ``aligned.obj``), and with ``preview``: ``preview.png``
-    (the net on the designed surface, loops coloured by the straight-edge ``Delta_a`` in %),
-    ``sequence/frame_*.png``, ``alignment.gif`` and ``states.png`` (deployed, two intermediate
-    states and the collapsed net side by side).
+    warnings.warn("write_gg(path, bundle) is deprecated; use gridshell.write(path, design)",
+                  DeprecationWarning, stacklevel=2)
+    report = None if sequence is None else {"sequence": sequence}
+    return write_bundle(path, bundle, extra=gg_files(bundle, report, render=preview,
+                                                     frames=frames, progress=progress))
+
+
+def gg_files(bundle: DesignBundle, report: dict | None = None, *, render: bool = True,
+             frames: int = 12, progress: Progress = None) -> dict[str, Any]:
+    """The GG files of a design bundle beyond :func:`gridshell.bundle.write_bundle`'s, as its
+    ``extra`` (name -> bytes or writer); :func:`gridshell.api.write` writes them.
+
+    ``report.json`` (the report of :func:`design_gg` without its arrays, when given), the
+    alignment sequence ``sequence/frame_000.obj ...`` (joints of every state with the
+    net-loops as faces; the first equals ``net.obj``, the last ``aligned.obj``), and with
+    ``render``: ``preview.png`` (the net on the designed surface, loops coloured by the
+    straight-edge ``Delta_a`` in %), ``sequence/frame_*.png``, ``alignment.gif`` and
+    ``states.png`` (deployed, two intermediate states and the collapsed net side by side).
 
     Parameters
     ----------
-    sequence : GGSequence, optional
-        The states to write (``report["sequence"]`` of :func:`design_gg`); computed with
-        ``frames`` steps when not given.
+    report : dict, optional
+        The report of :func:`design_gg`; its ``"sequence"`` (None: no sequence) is written.
+        Without a report the sequence is computed with ``frames`` steps.
     frames : int
         Steps of a computed sequence; 0 writes none.
     """
@@ -478,16 +493,22 @@ def write_gg(path: str | Path, bundle: DesignBundle, *, preview: bool = True,
 
     net = bundle.net
     extra: dict[str, Any] = {}
-    if sequence is None and int(frames) > 0 and len(net.joints):
-        _say(progress, f"alignment sequence: {int(frames)} steps from deployed to collapsed")
-        sequence = gg_alignment_sequence(net.joints, bundle.aligned, net.edges(),
-                                         frames=int(frames), progress=progress)
+    if report is not None:
+        sequence = report.get("sequence")
+        if set(report) - {"sequence"}:
+            extra["report.json"] = report_json(report).encode()
+    else:
+        sequence = None
+        if int(frames) > 0 and len(net.joints):
+            _say(progress, f"alignment sequence: {int(frames)} steps from deployed to collapsed")
+            sequence = gg_alignment_sequence(net.joints, bundle.aligned, net.edges(),
+                                             frames=int(frames), progress=progress)
     if sequence is not None:
         width = max(3, len(str(len(sequence.V) - 1)))
         for k, V in enumerate(sequence.V):
             extra[f"sequence/frame_{k:0{width}d}.obj"] = (
                 lambda p, V=V: write_mesh(p, V, net.loops))
-    if preview:
+    if render:
         from ..render.net_preview import net_preview
 
         values = 100.0 * alignability_error(net.joints, net.loops)
@@ -520,4 +541,4 @@ def write_gg(path: str | Path, bundle: DesignBundle, *, preview: bool = True,
                 [sequence.V[k] for k in pick], sequence.edges, labels=labels, families=fam,
                 title=f"GG alignment: joint-to-joint lengths within {err:.2g} % of the "
                       "deployed net in every state")
-    return write_bundle(path, bundle, extra=extra)
+    return extra

@@ -17,7 +17,7 @@ from typing import Any, Callable
 import numpy as np
 
 from ..bspline import BSplineSurface
-from ..bundle import CollapseCurve, DesignBundle, write_bundle
+from ..bundle import CollapseCurve, Design, DesignBundle, report_json, write_bundle
 from ..errors import ConvergenceError, InputError, NoNetError
 from ..metrics import alignability_error, delta_l, delta_n, deviation, summary
 from ..quality import design_gates, gate_summary, passed
@@ -30,7 +30,7 @@ from .levelset import TracedNet, trace
 from .postopt import PostOptResult, interior_vertices, post_optimize
 from .simulate import AlignmentSequence, collapse_direction, plane_frame, simulate_alignment
 
-__all__ = ["KIND", "NCPState", "crossing_normal_curvature", "design_ncp", "write_ncp",
+__all__ = ["KIND", "NCPState", "crossing_normal_curvature", "design_ncp", "ncp_files", "write_ncp",
            "load_surface"]
 
 KIND = {"phlw": "NCP", "cnc": "CNC", "aa": "AA"}
@@ -214,7 +214,7 @@ def design_ncp(source: Any, *, mode: str = "phlw", curves: int | tuple[int, int]
                surface_samples: tuple[int, int] = (100, 100), phlw_options: dict | None = None,
                allow_unconverged: bool = False, strict: bool = False, units: Any = None,
                clean: bool = True, obj: str | None = None,
-               progress: Callable[[str], None] | None = None) -> tuple[DesignBundle, dict]:
+               progress: Callable[[str], None] | None = None) -> Design:
     """Design a normal-curvature-preserving alignable gridshell (paper 4.2.2-4.2.4, 5.1).
 
     Parameters
@@ -430,22 +430,29 @@ def design_ncp(source: Any, *, mode: str = "phlw", curves: int | tuple[int, int]
     say(f"Delta_a {metrics['delta_a_before']['mean']:.3g} % -> "
         f"{metrics['delta_a_after']['mean']:.3g} %, Delta_l max {metrics['delta_l']['max']:.3g} %, "
         f"Delta_n max {metrics['delta_n']['max']:.3g} %")
-    return bundle, report
-
-
-def _json_report(report: dict) -> str:
-    from ..bundle import finite_json
-
-    # strict JSON: a figure that could not be measured is null, never a NaN token
-    return json.dumps(finite_json({k: v for k, v in report.items() if k != "state"}), indent=1,
-                      allow_nan=False, default=float) + "\n"
+    return Design(bundle, report)
 
 
 def write_ncp(path: str | Path, bundle: DesignBundle, report: dict, *, render: bool = True,
               progress: Callable[[str], None] | None = None) -> Path:
-    """Write an NCP / CNC / AA design bundle atomically.
+    """Deprecated: :func:`gridshell.api.write` writes GG and NCP designs alike
+    (``write(path, design_ncp(...))``). Writes ``bundle`` with :func:`ncp_files`."""
+    import warnings
 
-    Besides the bundle files: ``surface.json`` (the PHLW B-spline), ``report.json``,
+    warnings.warn("write_ncp(path, bundle, report) is deprecated; use "
+                  "gridshell.write(path, design)", DeprecationWarning, stacklevel=2)
+    return write_bundle(path, bundle, extra=ncp_files(bundle, report, render=render,
+                                                      progress=progress))
+
+
+def ncp_files(bundle: DesignBundle, report: dict, *, render: bool = True,
+              progress: Callable[[str], None] | None = None) -> dict[str, Any]:
+    """The NCP / CNC / AA files of a design bundle beyond
+    :func:`gridshell.bundle.write_bundle`'s, as its ``extra`` (name -> bytes or writer);
+    :func:`gridshell.api.write` writes them. ``report``: the report of :func:`design_ncp`
+    (its ``"state"`` holds the arrays).
+
+    ``surface.json`` (the PHLW B-spline), ``report.json``,
     ``axes_r.npy`` (rotation axes of the post-optimized joints) and ``aligned_r.npy`` (of the
     aligned ones) for ``gridshell verify``, ``sequence/frame_000.obj ...`` (the alignment
     sequence; the last frame equals ``aligned.obj``), and with ``render``:
@@ -463,7 +470,7 @@ def write_ncp(path: str | Path, bundle: DesignBundle, report: dict, *, render: b
     loops = net.loops
     extra: dict[str, Any] = {}
     extra["surface.json"] = (json.dumps(st.surface.to_json(), indent=1) + "\n").encode()
-    extra["report.json"] = _json_report(report).encode()
+    extra["report.json"] = report_json(report).encode()
     for name, arr in (("axes_r.npy", st.post.r), ("aligned_r.npy", st.sequence.aligned_r)):
         buf = io.BytesIO()
         np.save(buf, np.asarray(arr, float))
@@ -506,4 +513,4 @@ def write_ncp(path: str | Path, bundle: DesignBundle, report: dict, *, render: b
         for k, b in enumerate(pngs):
             extra[f"sequence/frame_{k:0{width}d}.png"] = b
         extra["alignment.gif"] = ncp_maps.gif(pngs)
-    return write_bundle(path, bundle, extra=extra)
+    return extra

@@ -1,0 +1,135 @@
+"""The Python API: design, write, read, verify, cut and export, the same calls for GG and NCP.
+
+::
+
+    import gridshell as gs
+
+    design = gs.design_gg("target.obj", grid=(16, 16), n_lamellae=8)   # or gs.design_ncp(...)
+    gs.write("out/gg", design)                  # the design bundle (same layout for every kind)
+    gs.verify("out/gg")["ok"]                   # the figures recomputed from the files
+    gs.fabricate("out/gg", "out/gg/fabrication", {"width": 20, "scale": "1:10"})
+    gs.export_3dm("out/gg", "out/gg/gg.3dm")    # strips, holes, surface, cut sheets for Rhino
+
+The functions are those of the modules that implement them (named in each docstring); the
+``gridshell`` command calls the same ones.
+"""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Any, Callable
+
+import functools
+
+from .bundle import Design, DesignBundle, read_bundle, write_bundle
+from .errors import InputError
+from .gg import pipeline as _gg
+from .ncp import pipeline as _ncp
+from .ncp.phlw import optimize_phlw
+from .verification import design_verdict, verify_bundle
+
+__all__ = ["Design", "DesignBundle", "design_gg", "design_ncp", "export_3dm", "fabricate",
+           "optimize_phlw", "read", "verify", "write"]
+
+Progress = Callable[[str], None] | None
+
+
+# the pipelines' functions, looked up at each call (a test or a plug-in replacing
+# gridshell.gg.pipeline.design_gg reaches the CLI and the API alike)
+@functools.wraps(_gg.design_gg)
+def design_gg(*args: Any, **kwargs: Any) -> Design:
+    return _gg.design_gg(*args, **kwargs)
+
+
+@functools.wraps(_ncp.design_ncp)
+def design_ncp(*args: Any, **kwargs: Any) -> Design:
+    return _ncp.design_ncp(*args, **kwargs)
+
+
+def _parts(design: Any, report: dict | None = None) -> tuple[DesignBundle, dict | None]:
+    """``(bundle, report)`` of a :class:`Design` (or ``(bundle, report)`` pair) or a bare
+    bundle with an optional ``report``."""
+    if isinstance(design, DesignBundle):
+        return design, report
+    if isinstance(design, tuple) and len(design) == 2 and isinstance(design[0], DesignBundle):
+        return design[0], report if report is not None else design[1]
+    raise InputError(f"expected a design (the result of design_gg / design_ncp) or a "
+                     f"DesignBundle, got {type(design).__name__}")
+
+
+def write(path: str | os.PathLike, design: Design | DesignBundle, report: dict | None = None,
+          *, render: bool = True, frames: int = 12, progress: Progress = None) -> Path:
+    """Write a design to the bundle directory ``path`` atomically; returns ``path``.
+
+    One call and one layout for every kind (GG, NCP, CNC, AA): design.json, net.obj,
+    aligned.obj, axes.obj, surface.obj, report.json, the alignment sequence
+    ``sequence/frame_*.obj`` and, with ``render``, the pictures (``preview.png`` /
+    ``delta_*.png``, ``sequence/frame_*.png``, ``alignment.gif``); and what a kind has of its
+    own: revolution.obj and states.png (GG), surface.json, axes_r.npy, aligned_r.npy and
+    collapse.png (NCP kinds). See :func:`gridshell.gg.pipeline.gg_files` and
+    :func:`gridshell.ncp.pipeline.ncp_files`.
+
+    Parameters
+    ----------
+    design : Design (the result of :func:`design_gg` / :func:`design_ncp`) or DesignBundle
+    report : dict, optional
+        The run's report when ``design`` is a bare bundle. An NCP design needs it (its
+        ``"state"`` holds the surface and the rotation axes); for a GG bundle without one the
+        alignment sequence is computed (``frames`` steps; 0: none).
+    render : bool
+        Also draw the pictures and the animation (the slowest part).
+    """
+    from .gg.pipeline import gg_files
+    from .ncp.pipeline import ncp_files
+
+    bundle, report = _parts(design, report)
+    if bundle.kind == "GG":
+        extra = gg_files(bundle, report, render=render, frames=frames, progress=progress)
+    else:
+        if not isinstance(report, dict) or "state" not in report:
+            raise InputError(f"an {bundle.kind} design is written with the report of "
+                             "design_ncp (it holds the B-spline and the rotation axes): "
+                             "write(path, design_ncp(...))")
+        extra = ncp_files(bundle, report, render=render, progress=progress)
+    return write_bundle(path, bundle, extra=extra)
+
+
+def read(path: str | os.PathLike) -> DesignBundle:
+    """The design bundle at ``path`` (:func:`gridshell.bundle.read_bundle`), validated."""
+    return read_bundle(path)
+
+
+def verify(path: str | os.PathLike) -> dict[str, Any]:
+    """Every figure of the bundle at ``path`` recomputed from its files and gated by the
+    paper's thresholds (:func:`gridshell.verification.verify_bundle`): ``ok``, ``gates``,
+    ``checks``, ``problems`` and the figures."""
+    return verify_bundle(path)
+
+
+def fabricate(design: Any, out_dir: str | os.PathLike, params: Any = None, *,
+              force: bool = False, plan: bool = True, progress: Progress = None
+              ) -> dict[str, Any]:
+    """Cut files (DXF, SVG, PNG per sheet), cut list and plan of a design into ``out_dir``
+    (:func:`fabrication.pipeline.fabricate`; ``params``: a FabParams or a dict of its fields,
+    mm of the model). A design that fails its figures (recomputed from the files of a bundle
+    directory) is refused with :class:`~gridshell.errors.InputError` unless ``force``."""
+    from fabrication.pipeline import fabricate as _fabricate
+
+    bundle = design if isinstance(design, (str, os.PathLike)) else _parts(design)[0]
+    ok, why = design_verdict(Path(bundle) if isinstance(bundle, (str, os.PathLike)) else bundle)
+    if not ok and not force:
+        raise InputError(f"the design fails its checks ({why}); fabricate(..., force=True) "
+                         "cuts it anyway")
+    return _fabricate(bundle, out_dir, params, progress=progress, plan=plan)
+
+
+def export_3dm(design: Any, path: str | os.PathLike, **options: Any) -> dict[str, Any]:
+    """Write a design (bundle directory, Design or DesignBundle) to a Rhino ``.3dm`` file
+    (:func:`gridshell.export.rhino.write_3dm`: strips of their real width and thickness,
+    holes, surface, collapsed state and cut sheets, in the input's unit); returns what was
+    written (``path``, ``units``, ``layers`` ...). ``options``: ``width``, ``thickness``,
+    ``hole``, ``scale``, ``sheet``, ``params``, ``units``, ``sheets``, ``force``, ``progress``."""
+    from .export.rhino import write_3dm
+
+    bundle = design if isinstance(design, (str, os.PathLike)) else _parts(design)[0]
+    return write_3dm(bundle, path, **options)

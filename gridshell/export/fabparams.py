@@ -1,0 +1,89 @@
+"""The fabrication parameters an export builds its strips and sheets from, and the cut sheets.
+
+The strip's real section is the cut strip's (mm of the physical model) divided by the scale:
+20 mm x 1 mm at 1:10 is 200 mm x 10 mm. The parameters come from, in this order:
+
+1. the caller's values (``--width``, ``--thickness``, ``--hole``, ``--scale`` ...);
+2. the bundle's fabrication report ``DIR/fabrication/fabrication.json`` (the parameters the
+   cut files were written with), when there is one;
+3. :class:`fabrication.params.FabParams` defaults (20 x 1 mm, 3 mm holes, 1:10, 600 x 400 mm).
+
+The cut sheets are planned in memory with :func:`fabrication.pipeline.plan_parts` from these
+parameters: the same nesting as ``gridshell fabricate`` writes (deterministic).
+"""
+from __future__ import annotations
+
+import json
+from dataclasses import fields
+from pathlib import Path
+from typing import Any, Callable
+
+from ..errors import InputError
+
+__all__ = ["FABRICATION_REPORT", "export_params", "plan_sheets"]
+
+#: where a bundle's cut files and their report live (``gridshell fabricate`` default)
+FABRICATION_REPORT = Path("fabrication") / "fabrication.json"
+
+
+def _stored(bundle_dir: Path | None) -> dict[str, Any]:
+    """The parameters of ``bundle_dir/fabrication/fabrication.json`` ({} when absent)."""
+    if bundle_dir is None:
+        return {}
+    f = Path(bundle_dir) / FABRICATION_REPORT
+    if not f.is_file():
+        return {}
+    try:
+        p = json.loads(f.read_text(encoding="utf-8")).get("params", {})
+    except (OSError, ValueError, AttributeError) as exc:
+        raise InputError(f"{f} is not a readable fabrication report ({exc}); re-run "
+                         "'gridshell fabricate' or remove it") from None
+    return p if isinstance(p, dict) else {}
+
+
+def export_params(bundle_dir: str | Path | None = None, params: Any = None,
+                  **overrides: Any):
+    """``(FabParams, source)``: the fabrication parameters of an export (see the module
+    docstring for the order), ``source`` saying where they came from.
+
+    Parameters
+    ----------
+    bundle_dir : path, optional
+        The design bundle directory (its ``fabrication/fabrication.json`` is read).
+    params : FabParams or dict, optional
+        Parameters to start from instead of the stored ones.
+    **overrides
+        Fields of :class:`~fabrication.params.FabParams` (``width``, ``thickness``, ``hole``,
+        ``scale``, ``sheet`` ...; mm of the model); None values are ignored.
+    """
+    from fabrication.params import FabParams
+
+    names = {f.name for f in fields(FabParams)}
+    unknown = sorted(set(overrides) - names)
+    if unknown:
+        raise InputError(f"unknown fabrication parameter(s) {', '.join(unknown)}; known: "
+                         f"{', '.join(sorted(names))}")
+    if params is not None:
+        base = params.to_json() if isinstance(params, FabParams) else dict(params)
+        source = "given parameters"
+    else:
+        base = _stored(Path(bundle_dir) if bundle_dir is not None else None)
+        source = str(Path(bundle_dir) / FABRICATION_REPORT) if base else "defaults"
+    d = {k: v for k, v in base.items() if k in names}
+    given = {k: v for k, v in overrides.items() if v is not None}
+    if given:
+        source = f"{source} with {', '.join(sorted(given))} given"
+    d.update(given)
+    if d.get("sheet") is not None and not isinstance(d["sheet"], str):
+        d["sheet"] = tuple(d["sheet"])
+    return FabParams(**d), source
+
+
+def plan_sheets(bundle, params, progress: Callable[[str], None] | None = None):
+    """``(layout, params)``: the parts of ``bundle`` nested on sheets (mm, each sheet's own
+    frame ``[0, W] x [0, H]``), as :func:`fabrication.pipeline.plan_parts` plans them, and the
+    parameters it used (joints too close for holes become marks)."""
+    from fabrication.pipeline import plan_parts
+
+    _, layout, info = plan_parts(bundle, params, progress)
+    return layout, info["params"]

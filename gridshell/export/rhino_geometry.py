@@ -1,0 +1,127 @@
+"""rhino3dm geometry from numpy arrays: meshes, polylines, planar bulge paths, cylinders,
+NURBS surfaces. Coordinates are taken as given (the caller converts units).
+
+``rhino3dm`` is imported inside each function, so importing this module is cheap.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import InputError
+
+__all__ = ["mesh", "point_list", "bulge_curve", "circle", "cylinder_brep",
+           "nurbs_surface"]
+
+
+def mesh(V: np.ndarray, F: np.ndarray, what: str = "surface"):
+    """A ``rhino3dm.Mesh`` of vertices ``V (n,3)`` (double precision: read them back with
+    ``Vertices.Point3dAt``) and triangle / quad faces ``F (m,3|4)`` (negative indices pad a
+    triangle in a quad array)."""
+    import rhino3dm
+
+    m = rhino3dm.Mesh()
+    m.Vertices.UseDoublePrecisionVertices = True     # float64 coordinates, as the bundle's
+    for x, y, z in np.asarray(V, float).reshape(-1, 3).tolist():
+        m.Vertices.AddPoint3d(x, y, z)
+    for f in np.asarray(F, np.int64).tolist():
+        f = [i for i in f if i >= 0]
+        if len(f) == 4:
+            m.Faces.AddFace(*f)
+        elif len(f) == 3:
+            m.Faces.AddFace(f[0], f[1], f[2])
+        else:
+            raise InputError(f"{what} face {f} has {len(f)} corners; only triangles and quads "
+                             "can go into a Rhino mesh")
+    m.Normals.ComputeNormals()
+    m.Compact()
+    return m
+
+
+def point_list(P: np.ndarray):
+    """A ``rhino3dm.Point3dList`` of ``P (k,3)`` (or ``(k,2)``, z = 0)."""
+    import rhino3dm
+
+    P = np.asarray(P, float)
+    if P.ndim == 2 and P.shape[1] == 2:
+        P = np.column_stack([P, np.zeros(len(P))])
+    pts = rhino3dm.Point3dList()
+    for x, y, z in P.reshape(-1, 3).tolist():
+        pts.Add(x, y, z)
+    return pts
+
+
+def _p3(p, z: float):
+    import rhino3dm
+
+    return rhino3dm.Point3d(float(p[0]), float(p[1]), float(z))
+
+
+def bulge_curve(V: np.ndarray, B: np.ndarray, closed: bool, z: float = 0.0):
+    """A planar curve at height ``z`` through ``V (n,2)`` whose span after vertex ``i`` is a
+    straight segment (``B[i] = 0``) or the circular arc of bulge ``B[i]`` (DXF convention:
+    included angle ``4 atan(b)``, counter-clockwise for ``b > 0``): a ``PolylineCurve`` when
+    there is no arc, else a ``PolyCurve`` of lines and arcs (exact, as in the DXF)."""
+    import rhino3dm
+
+    from fabrication.path import arc_geometry
+
+    V = np.asarray(V, float).reshape(-1, 2)
+    B = np.zeros(len(V)) if B is None else np.asarray(B, float).reshape(-1)
+    n = len(V)
+    spans = n if closed else n - 1
+    if not np.any(B[:spans] != 0):
+        P = np.vstack([V, V[:1]]) if closed else V
+        return rhino3dm.PolylineCurve(point_list(P))
+    pc = rhino3dm.PolyCurve()
+    for i in range(spans):
+        a, b = V[i], V[(i + 1) % n]
+        if np.allclose(a, b):
+            continue
+        if B[i] == 0:
+            pc.Append(rhino3dm.Line(_p3(a, z), _p3(b, z)))
+            continue
+        centre, r, theta = arc_geometry(a, b, float(B[i]))
+        a0 = np.arctan2(a[1] - centre[1], a[0] - centre[0])
+        mid = centre + r * np.array([np.cos(a0 + theta / 2), np.sin(a0 + theta / 2)])
+        pc.Append(rhino3dm.Arc(_p3(a, z), _p3(mid, z), _p3(b, z)))
+    return pc
+
+
+def circle(centre, radius: float, z: float = 0.0):
+    """A ``rhino3dm.Circle`` in the plane ``z``, centre ``(x, y)`` (``Objects.AddCircle``)."""
+    import rhino3dm
+
+    return rhino3dm.Circle(_p3(centre, z), float(radius))
+
+
+def cylinder_brep(centre: np.ndarray, axis: np.ndarray, radius: float, height: float):
+    """A closed cylinder (``Brep``, capped) of ``radius`` and ``height`` centred at
+    ``centre (3,)`` along the unit ``axis (3,)``."""
+    import rhino3dm
+
+    axis = np.asarray(axis, float) / np.linalg.norm(axis)
+    base = np.asarray(centre, float) - 0.5 * height * axis
+    c = rhino3dm.Circle(rhino3dm.Point3d(*base.tolist()), float(radius))
+    c.Plane = rhino3dm.Plane(rhino3dm.Point3d(*base.tolist()), rhino3dm.Vector3d(*axis.tolist()))
+    return rhino3dm.Cylinder(c, float(height)).ToBrep(True, True)
+
+
+def nurbs_surface(degree_u: int, degree_v: int, knots_u: np.ndarray, knots_v: np.ndarray,
+                  ctrl: np.ndarray):
+    """A non-rational ``NurbsSurface`` from clamped full knot vectors (``n + degree + 1``
+    values each, as :class:`gridshell.bspline.BSplineSurface` holds them) and control points
+    ``ctrl (nu, nv, 3)``. Rhino drops the first and the last knot of each vector."""
+    import rhino3dm
+
+    ctrl = np.asarray(ctrl, float)
+    nu, nv, _ = ctrl.shape
+    ns = rhino3dm.NurbsSurface.Create(3, False, degree_u + 1, degree_v + 1, nu, nv)
+    for k, t in enumerate(np.asarray(knots_u, float)[1:-1].tolist()):
+        ns.KnotsU[k] = t
+    for k, t in enumerate(np.asarray(knots_v, float)[1:-1].tolist()):
+        ns.KnotsV[k] = t
+    for i in range(nu):
+        for j in range(nv):
+            x, y, z = ctrl[i, j].tolist()
+            ns.Points[i, j] = rhino3dm.Point4d(x, y, z, 1.0)
+    return ns
