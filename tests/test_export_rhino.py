@@ -18,6 +18,7 @@ from gridshell.errors import InputError
 from gridshell.export import export_3dm
 from gridshell.export.rhino import write_3dm
 from gridshell.export.units import parse_units
+from gridshell.io.units import Units
 
 MM = {"name": "mm", "metres_per_unit": 0.001}
 
@@ -163,7 +164,7 @@ def test_units_of_the_input_millimetres(tmp_path):
     """A bundle whose design.json says mm: ModelUnitSystem Millimeters, every coordinate and
     length x1000, the sheets at their physical size in mm beside the model."""
     b = make_bundle("GG")
-    b.units = MM
+    b.units = Units.from_json(MM)
     d = write_bundle(tmp_path / "mm", b)
     assert json.loads((d / "design.json").read_text())["units"] == MM
     info = write_3dm(d, tmp_path / "mm.3dm", force=True)
@@ -290,7 +291,7 @@ def test_cnc_arcs_and_bspline_surface(tmp_path):
     X, Y = np.meshgrid(u, u, indexing="ij")
     S = BSplineSurface.from_control_grid(np.stack([X, Y, 0.3 * (X * X + Y * Y)], -1), 3, 3)
     b = make_bundle("CNC")
-    b.units = MM
+    b.units = Units.from_json(MM)
     b.params["n"] = 0.5
     b.metrics["n"] = 0.5
     d = write_bundle(tmp_path / "cnc", b,
@@ -338,7 +339,7 @@ def test_cli_export(tmp_path, capsys):
     from gridshell.cli.main import main
 
     b = make_bundle("GG")
-    b.units = MM
+    b.units = Units.from_json(MM)
     d = write_bundle(tmp_path / "gg", b)
     assert main(["export", str(d), "--width", "40", "--thickness", "2", "--scale", "1:20",
                  "--no-sheets", "-q"]) == 0
