@@ -70,6 +70,8 @@ def plan_parts(bundle: DesignBundle, params: FabParams,
                           "overlaps_mm": [round(n["overlap"], 3) for n in notes],
                           "splice_joints": [n["splice_joint"] for n in notes
                                             if n["kind"] == "joint"],
+                          "splice_joint_names": [n["splice_name"] for n in notes
+                                                 if n["kind"] == "joint"],
                           "span_splices_mm": [round(n["at"], 3) for n in notes
                                               if n["kind"] == "span"]})
     if split:
