@@ -60,14 +60,15 @@ def set_extents(doc, sheet: tuple[float, float]) -> None:
     (ezdxf.bbox, bulge arcs included), mm; the sheet for an empty drawing."""
     from ezdxf import bbox
 
-    box = bbox.extents(doc.modelspace(), fast=False)
+    msp = doc.modelspace()
+    box = bbox.extents(msp, fast=False)
     if box.has_data:
-        lo, hi = box.extmin, box.extmax
-        doc.header["$EXTMIN"] = (float(lo.x), float(lo.y), 0.0)
-        doc.header["$EXTMAX"] = (float(hi.x), float(hi.y), 0.0)
+        lo = (float(box.extmin.x), float(box.extmin.y), 0.0)
+        hi = (float(box.extmax.x), float(box.extmax.y), 0.0)
     else:
-        doc.header["$EXTMIN"] = (0.0, 0.0, 0.0)
-        doc.header["$EXTMAX"] = (float(sheet[0]), float(sheet[1]), 0.0)
+        lo, hi = (0.0, 0.0, 0.0), (float(sheet[0]), float(sheet[1]), 0.0)
+    doc.header["$EXTMIN"], doc.header["$EXTMAX"] = lo, hi
+    msp.dxf.extmin, msp.dxf.extmax = lo, hi      # ezdxf copies these to the header on save
 
 
 def write_sheet_dxf(path: str | FsPath, parts: list[Part], sheet: tuple[float, float],

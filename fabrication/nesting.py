@@ -35,7 +35,7 @@ from .splice import chord_frame
 DROP_TOL = 0.1     # mm, growth and simplification of the rings the drop search uses
 FLAT_TOL = 0.01    # mm, chord tolerance of the part polygons (arcs bulge out by up to this)
 EPS = 1e-6         # mm
-COLUMN = 1.0       # mm, width of the columns of the part profiles (the step of the places)
+COLUMN = 2.0       # mm, width of the columns of the part profiles (the step of the places)
 
 
 @dataclass
@@ -112,15 +112,20 @@ def _shapes(part: Part, curved: bool) -> list[_Shape]:
     out = []
     for turn in ((0.0, np.pi) if curved else (0.0,)):
         p = base.moved(Motion(turn, 0.0, 0.0)) if turn else base
-        x0, y0, _, _ = p.polygon(FLAT_TOL).bounds
-        p = p.moved(Motion(0.0, -x0, -y0))
+        x0, y0, _, _ = p.polygon(FLAT_TOL).bounds      # arcs bulge out by up to FLAT_TOL
+        p = p.moved(Motion(0.0, FLAT_TOL - x0, FLAT_TOL - y0))
         poly = p.polygon(FLAT_TOL)
         _, _, w, h = poly.bounds
+        w, h = w + FLAT_TOL, h + FLAT_TOL
         ring = _outer_ring(poly, 0.0)
         ox = (float(ring[:, 0].min()), float(ring[:, 0].max()))
         n = int(np.ceil((ox[1] - ox[0]) / COLUMN)) + 1
-        out.append(_Shape(p, poly, w, h, ox, _columns(ring, ox[0], n, False),
-                          _columns(ring, ox[0], n, True)))
+        low, up = _columns(ring, ox[0], n, False), _columns(ring, ox[0], n, True)
+        # one column wider, each column also covering its left neighbour: the profile of the
+        # shape anywhere between two column offsets (so it may also touch the margins)
+        low = np.minimum(np.append(low, np.inf), np.insert(low, 0, np.inf))
+        up = np.maximum(np.append(up, -np.inf), np.insert(up, 0, -np.inf))
+        out.append(_Shape(p, poly, w, h, ox, low, up))
     return out
 
 
@@ -175,15 +180,15 @@ class _Sheet:
         if nb > n:
             return np.zeros(0), np.zeros(0)
         off = np.arange(n - nb + 1)
-        x = off * COLUMN - s.ox[0]
-        inside = (x >= self.g - 1e-9) & (x <= self.Lx - self.g - s.w + 1e-9)
+        x0 = off * COLUMN - s.ox[0]
+        x = np.clip(x0, self.g, self.Lx - self.g - s.w)   # the dilated profile covers
+        inside = (x >= x0 - 1e-9) & (x <= x0 + COLUMN + 1e-9)  # [x0, x0 + COLUMN]
         x, off = x[inside], off[inside]
         y = np.full((1, len(off)), self.g)
-        if len(self.placed):
-            cols = off[:, None] + np.arange(nb)
-            with np.errstate(invalid="ignore"):
-                hi = np.nan_to_num(self.top[:, cols] - s.low, nan=-np.inf).max(axis=2)
-                lo = np.nan_to_num(self.bot[:, cols] - s.up, nan=np.inf).min(axis=2)
+        if len(self.placed):       # (no inf - inf: tops and lows are never +inf, -inf)
+            view = np.lib.stride_tricks.sliding_window_view
+            hi = (view(self.top, nb, axis=1)[:, off] - s.low).max(axis=2)
+            lo = (view(self.bot, nb, axis=1)[:, off] - s.up).min(axis=2)
             y = np.vstack([y, hi])                                  # (parts + 1, offsets)
             blocked = ((y[:, None, :] > lo[None] + 1e-9) &
                        (y[:, None, :] < hi[None] - 1e-9)).any(axis=1)
@@ -226,6 +231,7 @@ def _frame_to_sheet(W: float, H: float) -> Motion:
 STRATEGIES = [("bottom-left", True, "length"), ("bottom-left", False, "length"),
               ("left-bottom", False, "length")]
 ROW_UNIT = 0.1     # mm, the length unit of the row filling
+RETRIES = 2        # passes more per strategy, with the last sheet's parts placed first
 
 
 def _fullest(lengths: np.ndarray, cap: float) -> list[int]:
@@ -288,15 +294,19 @@ def _key(key: str, x: np.ndarray, y: np.ndarray, h: float) -> np.ndarray:
     return np.lexsort((x, np.round(y + h, 6)))
 
 
-def _nest_once(shapes: list[list[_Shape]], Lx: float, Ly: float, g: float, key: str,
-               turn: bool, order: str) -> tuple[list[_Sheet], dict[int, tuple[int, Part]]]:
-    """One first-fit-decreasing pass under one strategy."""
-    n = len(shapes)
+def _order(shapes: list[list[_Shape]], order: str, first: list[int]) -> list[int]:
+    """The parts' order: ``first``, then the others by decreasing length (or area)."""
     if order == "length":
-        seq = sorted(range(n), key=lambda i: (-round(shapes[i][0].w, 6),
-                                              -shapes[i][0].poly.area, i))
+        key = lambda i: (-round(shapes[i][0].w, 6), -shapes[i][0].poly.area, i)  # noqa: E731
     else:
-        seq = sorted(range(n), key=lambda i: (-shapes[i][0].poly.area, i))
+        key = lambda i: (-shapes[i][0].poly.area, i)  # noqa: E731
+    rest = sorted((i for i in range(len(shapes)) if i not in set(first)), key=key)
+    return sorted(first, key=key) + rest
+
+
+def _nest_once(shapes: list[list[_Shape]], Lx: float, Ly: float, g: float, key: str,
+               turn: bool, seq: list[int]) -> tuple[list[_Sheet], dict[int, tuple[int, Part]]]:
+    """One first-fit pass under one strategy, parts in the order ``seq``."""
     sheets: list[_Sheet] = []
     placed: dict[int, tuple[int, Part]] = {}
     for i in seq:
@@ -333,8 +343,9 @@ def nest(parts: list[Part], params: FabParams) -> Layout:
     """Place ``parts`` on as many sheets as needed; see the module docstring.
 
     Each strategy of :data:`STRATEGIES` nests all parts, first fit decreasing: each part
-    goes onto the first sheet with room for it, at the best of its drop places there. The
-    layout with the fewest sheets wins, then the one whose last sheet is emptiest. Raises
+    goes onto the first sheet with room for it, at the best of its drop places there; then
+    again (:data:`RETRIES` times) with the parts the last sheet got placed first. The layout
+    with the fewest sheets wins, then the one whose last sheet is emptiest. Raises
     :class:`InputError` for a part that no empty sheet holds
     (:func:`fabrication.splice.split_strip` cuts such lamellae into pieces first)."""
     W, H = params.sheet
@@ -349,11 +360,18 @@ def nest(parts: list[Part], params: FabParams) -> Layout:
     for key, turn, order in STRATEGIES:
         if turn and not curved:
             continue
-        sheets, placed = _nest_once(shapes, Lx, Ly, g, key, turn, order)
-        last = sum(q.poly.area for q in sheets[-1].placed) if sheets else 0.0
-        score = (len(sheets), last)
-        if best is None or score < best[0]:
-            best = (score, sheets, placed)
+        first: list[int] = []
+        for _ in range(RETRIES + 1):      # the parts left on the last sheet go first next time
+            sheets, placed = _nest_once(shapes, Lx, Ly, g, key, turn,
+                                        _order(shapes, order, first))
+            last = sum(q.poly.area for q in sheets[-1].placed) if sheets else 0.0
+            score = (len(sheets), last)
+            if best is None or score < best[0]:
+                best = (score, sheets, placed)
+            if len(sheets) < 2:
+                break
+            first = first + [i for i, (k, _) in placed.items()
+                             if k == len(sheets) - 1 and i not in first]
     _, sheets, placed = best
     idx = sorted(placed)
     return Layout([placed[i][1].moved(to_sheet) for i in idx], [placed[i][0] for i in idx],

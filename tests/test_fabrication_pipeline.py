@@ -150,7 +150,7 @@ def test_dxf_header_layers_and_order(made):
     for doc, _ in sheets:
         assert doc.header["$INSUNITS"] == 4
         assert {l.dxf.name: l.dxf.color for l in doc.layers if l.dxf.name in
-                ("CUT", "SCORE", "ENGRAVE")} == {"CUT": 1, "SCORE": 5, "ENGRAVE": 7}
+                ("CUT", "SCORE", "ENGRAVE")} == {"CUT": 1, "SCORE": 5, "ENGRAVE": 3}
         types = [e.dxftype() for e in doc.modelspace() if e.dxf.layer == "CUT"]
         # holes (CIRCLE) come before every outline
         assert types.index("LWPOLYLINE") > max(i for i, t in enumerate(types) if t == "CIRCLE")
@@ -226,7 +226,7 @@ def test_plan_shows_every_lamella_id_at_its_place(tmp_path_factory):
 
 def test_sheet_previews(made):
     """sheet_NN.png: listed in the report, the drawn sheet has the sheet's aspect ratio, the
-    CUT red lines cover where the DXF parts are, labels engraved in black, the title names the
+    CUT red lines cover where the DXF parts are, labels engraved in green, the title names the
     sheet size and part count."""
     from PIL import Image
 
@@ -246,8 +246,8 @@ def test_sheet_previews(made):
         assert (c1 - c0) / (r1 - r0) == pytest.approx(W / H, rel=0.01)
         assert c1 - c0 >= 800                                   # a readable size
         red = (img[..., 0] > 200) & (img[..., 1] < 90) & (img[..., 2] < 90)
-        black = img.max(axis=2) < 90
-        assert red.sum() > 1000 and black[r0:r1, c0:c1].sum() > 100
+        green = (img[..., 1] > 150) & (img[..., 0] < 120) & (img[..., 2] < 120)
+        assert red.sum() > 1000 and green[r0:r1, c0:c1].sum() > 100
         # the red lines span the DXF parts' extent, mapped into the drawn sheet
         x0, y0, x1, y1 = shapely.unary_union([p["poly"] for p in parts]).bounds
         kx, ky = (c1 - c0) / W, (r1 - r0) / H
