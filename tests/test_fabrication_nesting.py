@@ -149,6 +149,27 @@ def test_long_lamellae_are_split_at_joints_with_the_stated_overlap(tmp_path):
     split_rows = [r for r in rows if r["piece"] != "1/1"]
     assert split_rows and all("overlaps piece" in r["splice"] for r in split_rows)
     assert {int(r["lamella"]) for r in split_rows} == {d["lamella"] for d in rep["pieces_split"]}
+    # splice joints named as engraved on the strips: the ids of the crossing lamellae there
+    # (the neighbours column of the same row), never positions along the lamella
+    net = {int(lam.id): lam for lam in b.net.lamellae}
+    cross = {}
+    for lam in b.net.lamellae:
+        for j in lam.joints:
+            cross.setdefault(int(j), []).append(int(lam.id))
+    for r in split_rows:
+        nbs = r["neighbours"].split("|")
+        for note in r["splice"].split("; "):
+            named = note.split("(shared joints ")[1].rstrip(")").split(" and ")
+            assert named and all(n in nbs for n in named), (named, nbs)
+        lam = net[int(r["lamella"])]
+        ids = {str(i) for j in lam.joints for i in cross[int(j)] if i != lam.id}
+        assert all(n in ids for note in r["splice"].split("; ")
+                   for n in note.split("(shared joints ")[1].rstrip(")").split(" and "))
+    for r in rows:        # the material used, per sheet and for all, in every row
+        assert int(r["n_sheets"]) == rep["n_sheets"]
+        assert float(r["material_used_pct"]) == pytest.approx(100 * rep["material_used"], abs=0.06)
+        assert float(r["sheet_used_pct"]) == pytest.approx(
+            100 * rep["material_used_per_sheet"][int(r["sheet"]) - 1], abs=0.06)
 
 
 def test_a_sheet_smaller_than_a_joint_spacing_is_an_input_error():
