@@ -197,3 +197,11 @@ def test_fabricate_of_a_failing_design_is_refused_unless_forced(client, gg_solve
     r, _ = solve(client, request("/fabricate", Bundle=text(str(bad))))
     assert "fails its checks" in r["errors"][0] and "Force" in r["errors"][0] or \
         "force" in r["errors"][0]
+
+
+def test_serve_command_refuses_a_bad_port(capsys):
+    from gridshell.cli.main import main
+
+    assert main(["serve", "--port", "70000"]) == 2
+    err = capsys.readouterr().err
+    assert "--port 70000 is not a TCP port" in err and "Traceback" not in err
