@@ -34,7 +34,7 @@ from .splice import chord_frame
 
 DROP_TOL = 0.1     # mm, growth and simplification of the rings the drop search uses
 FLAT_TOL = 0.01    # mm, chord tolerance of the part polygons (arcs bulge out by up to this)
-EPS = 1e-6         # mm
+SLACK = 0.011      # mm: a piece cut to fit the sheet (to 0.01 mm) fits it
 COLUMN = 2.0       # mm, width of the columns of the part profiles (the step of the places)
 
 
@@ -112,11 +112,12 @@ def _shapes(part: Part, curved: bool) -> list[_Shape]:
     out = []
     for turn in ((0.0, np.pi) if curved else (0.0,)):
         p = base.moved(Motion(turn, 0.0, 0.0)) if turn else base
-        x0, y0, _, _ = p.polygon(FLAT_TOL).bounds      # arcs bulge out by up to FLAT_TOL
-        p = p.moved(Motion(0.0, FLAT_TOL - x0, FLAT_TOL - y0))
+        pad = FLAT_TOL if curved else 0.0               # arcs bulge out by up to FLAT_TOL
+        x0, y0, _, _ = p.polygon(FLAT_TOL).bounds
+        p = p.moved(Motion(0.0, pad - x0, pad - y0))
         poly = p.polygon(FLAT_TOL)
         _, _, w, h = poly.bounds
-        w, h = w + FLAT_TOL, h + FLAT_TOL
+        w, h = w + pad, h + pad
         ring = _outer_ring(poly, 0.0)
         ox = (float(ring[:, 0].min()), float(ring[:, 0].max()))
         n = int(np.ceil((ox[1] - ox[0]) / COLUMN)) + 1
@@ -181,8 +182,9 @@ class _Sheet:
             return np.zeros(0), np.zeros(0)
         off = np.arange(n - nb + 1)
         x0 = off * COLUMN - s.ox[0]
-        x = np.clip(x0, self.g, self.Lx - self.g - s.w)   # the dilated profile covers
-        inside = (x >= x0 - 1e-9) & (x <= x0 + COLUMN + 1e-9)  # [x0, x0 + COLUMN]
+        x = np.clip(x0, self.g, max(self.g, self.Lx - self.g - s.w))  # dilated profile covers
+        inside = (x >= x0 - 1e-9) & (x <= x0 + COLUMN + 1e-9) & \
+            (x + s.w <= self.Lx - self.g + SLACK)          # [x0, x0 + COLUMN], in the sheet
         x, off = x[inside], off[inside]
         y = np.full((1, len(off)), self.g)
         if len(self.placed):       # (no inf - inf: tops and lows are never +inf, -inf)
@@ -195,7 +197,7 @@ class _Sheet:
             y = np.where(blocked, np.inf, y)
         X = np.broadcast_to(x, y.shape).ravel()
         Y = y.ravel()
-        ok = (Y >= self.g - 1e-9) & (Y <= self.Ly - self.g - s.h + 1e-9)
+        ok = (Y >= self.g - 1e-9) & (Y <= self.Ly - self.g - s.h + SLACK)
         return X[ok], Y[ok]
 
     def clear(self, poly: Polygon, x: float, y: float) -> bool:
@@ -267,7 +269,7 @@ def _rows(shapes: list[list[_Shape]], Lx: float, Ly: float, g: float
     y = np.inf
     while left:
         L = np.array([shapes[i][0].w + g for i in left])
-        row = [left[k] for k in _fullest(L, Lx - g)]
+        row = [left[k] for k in _fullest(L, Lx - g + SLACK)]
         if not row:
             raise InputError(f"lamella {shapes[left[0]][0].part.strip.lamella}: a piece does "
                              f"not fit an empty {Lx:g} x {Ly:g} mm sheet; use a larger --sheet")
@@ -379,9 +381,11 @@ def nest(parts: list[Part], params: FabParams) -> Layout:
 
 
 def check_layout(layout: Layout, gap: float, tol: float = 1e-3) -> None:
-    """Assert that parts keep ``gap`` mm from each other and from the sheet edges."""
+    """Assert that parts keep ``gap`` mm from each other and from the sheet edges (to SLACK:
+    a piece cut to fit the sheet fits it to 0.01 mm)."""
     W, H = layout.sheet
-    inner = shapely.box(gap - tol, gap - tol, W - gap + tol, H - gap + tol)
+    m = gap - tol - SLACK
+    inner = shapely.box(m, m, W - m, H - m)
     for k in range(layout.n_sheets):
         polys = [p.polygon(FLAT_TOL) for p in layout.on_sheet(k)]
         for P in polys:
