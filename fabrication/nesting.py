@@ -34,7 +34,7 @@ from .splice import chord_frame
 
 DROP_TOL = 0.1     # mm, growth and simplification of the rings the drop search uses
 FLAT_TOL = 0.01    # mm, chord tolerance of the part polygons (arcs bulge out by up to this)
-SLACK = 0.011      # mm: a piece cut to fit the sheet (to 0.01 mm) fits it
+SLACK = 0.05       # mm: a piece cut to fit the sheet (to 0.01 mm, arcs sampled) fits it
 COLUMN = 2.0       # mm, width of the columns of the part profiles (the step of the places)
 
 
