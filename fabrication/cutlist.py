@@ -1,10 +1,12 @@
 """The cut list (issue item 6): one CSV row per piece, in lamella order.
 
 Columns: ``lamella, family, piece, sheet, shape, radius_mm, flat_length_mm, axis_length_mm,
-n_joints, joint_positions_mm, neighbours, splice``. Joint positions are measured along the
+n_joints, joint_positions_mm, neighbours, splice, sheet_used_pct, n_sheets, material_used_pct``. Joint positions are measured along the
 axis from the piece's start (its end margin included); neighbours are the ids of the
 crossing lamellae at each joint (``|`` between joints); ``splice`` says, for split lamellae,
-which piece overlaps which, by how much and at which joints.
+which piece overlaps which, by how much and at which joints (named by the ids engraved beside
+them). ``sheet_used_pct``: the material used on the piece's sheet (part outlines over the
+sheet area, %); ``n_sheets`` and ``material_used_pct``: the same for all sheets.
 """
 from __future__ import annotations
 
@@ -17,13 +19,16 @@ from gridshell.atomic import atomic_path
 from .nesting import Layout
 
 COLUMNS = ("lamella", "family", "piece", "sheet", "shape", "radius_mm", "flat_length_mm",
-           "axis_length_mm", "n_joints", "joint_positions_mm", "neighbours", "splice")
+           "axis_length_mm", "n_joints", "joint_positions_mm", "neighbours", "splice",
+           "sheet_used_pct", "n_sheets", "material_used_pct")
 
 
 def splice_text(notes: list[dict]) -> str:
     """The splice column: for each splice of the piece, which piece it overlaps, by how
-    much, and where (shared joints; or, between joints, the splice label and its position
-    along the lamella's axis from the axis start, mm)."""
+    much, and where (the shared joints, each by the name engraved beside it on the strip: the
+    ids of the lamellae crossing there, :func:`fabrication.splice.joint_name`; or, between
+    joints, the splice label and its position along the lamella's axis from the axis start,
+    mm)."""
     parts = []
     for n in notes:
         if n.get("kind") == "span":
@@ -33,7 +38,7 @@ def splice_text(notes: list[dict]) -> str:
                          f"splice {n['label']} of lamella {n['lamella']} at {n['at']:.1f} mm "
                          f"along the lamella (fasteners at {fast} mm)")
             continue
-        joints = ",".join(str(j) for j in n["shared_joints"])
+        joints = " and ".join(n["shared_names"])
         parts.append(f"overlaps piece {n['with']} by {n['overlap']:.1f} mm "
                      f"(shared joints {joints})")
     return "; ".join(parts)
@@ -42,6 +47,8 @@ def splice_text(notes: list[dict]) -> str:
 def cutlist_rows(layout: Layout, axis_lengths: dict[int, float]) -> list[dict]:
     """Rows of the cut list, sorted by lamella id and piece."""
     rows = []
+    used = [100.0 * layout.used(k) for k in range(layout.n_sheets)]
+    total = 100.0 * layout.used()
     for part, sheet in zip(layout.parts, layout.sheet_of):
         s = part.strip
         r = s.axis.radius
@@ -55,6 +62,8 @@ def cutlist_rows(layout: Layout, axis_lengths: dict[int, float]) -> list[dict]:
             "joint_positions_mm": " ".join(f"{x - s.s0:.3f}" for x in s.joint_s),
             "neighbours": "|".join(",".join(map(str, nb)) for nb in s.neighbours),
             "splice": splice_text(s.splices),
+            "sheet_used_pct": f"{used[sheet]:.1f}", "n_sheets": layout.n_sheets,
+            "material_used_pct": f"{total:.1f}",
         })
     rows.sort(key=lambda d: (d["lamella"], d["piece"]))
     return rows

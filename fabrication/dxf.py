@@ -1,8 +1,11 @@
 """DXF cut files through ezdxf (issue item 5).
 
 R2010 by default, R12 through ezdxf's R12 export (``ezdxf.addons.r12export``); millimetres
-(``$INSUNITS = 4``); layers CUT (red, ACI 1), SCORE (blue, ACI 5), ENGRAVE (black/white,
-ACI 7), each entity also coloured explicitly for cutters that read entity colours. Outlines
+(``$INSUNITS = 4``); layers CUT (red, ACI 1), SCORE (blue, ACI 5), ENGRAVE (green, ACI 3; not
+ACI 7, which shows white on a dark background) from :mod:`fabrication.layers`, each with the
+same colour as a true colour too, and each entity also coloured explicitly (ACI and true
+colour) for cutters that read entity colours. ``$EXTMIN`` / ``$EXTMAX`` are the drawing's real
+extents in mm (the bounding box of the parts, arcs included). Outlines
 are closed LWPOLYLINEs with bulges for arcs (or short segments), holes CIRCLEs, score marks
 LINEs, labels open LWPOLYLINEs (never TEXT). Order in the file: ENGRAVE, SCORE, holes, then
 outlines - so that inner features are cut while the part still sits in the sheet.
@@ -16,10 +19,9 @@ from ezdxf import units
 
 from gridshell.atomic import atomic_path
 
+from .layers import LAYERS
 from .params import FabParams
 from .part import Part
-
-LAYERS = {"CUT": 1, "SCORE": 5, "ENGRAVE": 7}
 
 
 def sheet_document(parts: list[Part], sheet: tuple[float, float], params: FabParams):
@@ -27,14 +29,14 @@ def sheet_document(parts: list[Part], sheet: tuple[float, float], params: FabPar
     doc = ezdxf.new("R2010", setup=False)
     doc.units = units.MM
     doc.header["$MEASUREMENT"] = 1
-    doc.header["$EXTMIN"] = (0.0, 0.0, 0.0)
-    doc.header["$EXTMAX"] = (float(sheet[0]), float(sheet[1]), 0.0)
-    for name, color in LAYERS.items():
-        doc.layers.add(name, color=color)
+    for name, (aci, rgb) in LAYERS.items():
+        layer = doc.layers.add(name, color=aci)
+        layer.rgb = rgb
     msp = doc.modelspace()
 
     def att(layer):
-        return {"layer": layer, "color": LAYERS[layer]}
+        aci, rgb = LAYERS[layer]
+        return {"layer": layer, "color": aci, "true_color": ezdxf.rgb2int(rgb)}
 
     for p in parts:
         for L in p.engrave:
@@ -49,7 +51,24 @@ def sheet_document(parts: list[Part], sheet: tuple[float, float], params: FabPar
         path = p.outline.segments(params.tolerance) if params.segments else p.outline
         pts = [(float(x), float(y), float(b)) for (x, y), b in zip(path.V, path.B)]
         msp.add_lwpolyline(pts, format="xyb", close=True, dxfattribs=att("CUT"))
+    set_extents(doc, sheet)
     return doc
+
+
+def set_extents(doc, sheet: tuple[float, float]) -> None:
+    """``$EXTMIN`` / ``$EXTMAX`` of ``doc``: the bounding box of its modelspace entities
+    (ezdxf.bbox, bulge arcs included), mm; the sheet for an empty drawing."""
+    from ezdxf import bbox
+
+    msp = doc.modelspace()
+    box = bbox.extents(msp, fast=False)
+    if box.has_data:
+        lo = (float(box.extmin.x), float(box.extmin.y), 0.0)
+        hi = (float(box.extmax.x), float(box.extmax.y), 0.0)
+    else:
+        lo, hi = (0.0, 0.0, 0.0), (float(sheet[0]), float(sheet[1]), 0.0)
+    doc.header["$EXTMIN"], doc.header["$EXTMAX"] = lo, hi
+    msp.dxf.extmin, msp.dxf.extmax = lo, hi      # ezdxf copies these to the header on save
 
 
 def write_sheet_dxf(path: str | FsPath, parts: list[Part], sheet: tuple[float, float],

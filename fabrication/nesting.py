@@ -1,25 +1,30 @@
-"""Nesting parts on sheets (issue item 4): never overlapping, never outside a sheet.
+"""Nesting parts on sheets: first fit decreasing, bottom-left by dropping, polygons not boxes.
 
-* straight strips: rows along the sheet's long side, filled first-fit decreasing (the
-  longest strip goes into the first row, on any sheet, with room for it);
-* curved strips (arcs, collapse-curve pieces): turned so that their chord lies along the long
-  side (``+s`` along ``+x``, so labels read upright), then stacked across it - along the
-  symmetry direction of an arc: each part drops
-  onto the ones below it in its stack until it comes ``gap`` from them (the congruent pieces of
-  one curve nest into each other). Each part goes into the first stack with room for it, else
-  into a new stack right of the others on the first sheet with room, else on a new sheet.
+Every part is turned so that its chord lies along the sheet's long side (``+s`` along ``+x``,
+labels read upright; curved parts may also be turned by 180 degrees) and the parts are taken
+longest first. Each goes onto the first sheet with room for it, at the lowest, then leftmost,
+of its candidate places: at the sheet's left and right edges, right and left of every part
+already there, and aligned with its left end, right end and middle. At each candidate ``x``
+the part drops from above the sheet until it comes ``gap`` from a part below it (or the
+bottom margin) - the true outlines, not their bounding boxes: arcs of one radius fall into
+each other, a short strip goes into the room a row leaves. Sheets are opened as needed.
 
-All parts keep ``gap`` mm from each other and from the sheet edges. Sheets are filled in a
-frame whose x axis is the sheet's long side, then turned to the sheet as given.
+All parts keep ``gap`` mm from each other and from the sheet edges. The drop uses outer
+approximations of the outlines (grown by ``DROP_TOL``, simplified by as much), so a dropped
+part never comes closer than ``gap``; :func:`check_layout` checks the result with the fine
+outlines. Sheets are filled in a frame whose x axis is the sheet's long side, then turned to
+the sheet as given.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import shapely
 import shapely.affinity
 from shapely.geometry import Polygon
+
+from gridshell.errors import InputError
 
 from .params import FabParams
 from .part import Part
@@ -27,9 +32,10 @@ from .path import Motion
 from .splice import chord_frame
 
 
-DROP_TOL = 0.02    # mm, ring simplification for the drop search
-CHECK_TOL = 0.001  # mm, for the distance check that follows it
+DROP_TOL = 0.1     # mm, growth and simplification of the rings the drop search uses
 FLAT_TOL = 0.01    # mm, chord tolerance of the part polygons (arcs bulge out by up to this)
+SLACK = 0.05       # mm: a piece cut to fit the sheet (to 0.01 mm, arcs sampled) fits it
+COLUMN = 2.0       # mm, width of the columns of the part profiles (the step of the places)
 
 
 @dataclass
@@ -44,38 +50,177 @@ class Layout:
     def on_sheet(self, k: int) -> list[Part]:
         return [p for p, s in zip(self.parts, self.sheet_of) if s == k]
 
+    def used(self, k: int | None = None) -> float:
+        """Material used: the area of the part outlines (holes not subtracted) over the area
+        of sheet ``k`` (None: of all sheets), 0..1."""
+        W, H = self.sheet
+        parts = self.parts if k is None else self.on_sheet(k)
+        n = self.n_sheets if k is None else 1
+        return sum(p.polygon(FLAT_TOL).area for p in parts) / (n * W * H) if n else 0.0
 
-def _canonical(part: Part, curved: bool) -> Part:
-    """The part turned into the nesting orientation with its bounding box at the origin."""
+
+def sheet_bound(parts: list[Part], sheet: tuple[float, float], slack: float = 1.15) -> int:
+    """``ceil(slack * total part area / sheet area)``: the sheet count a nesting that
+    wastes at most ``slack - 1`` of the sheets would need (outline areas, mm^2)."""
+    area = sum(p.polygon(FLAT_TOL).area for p in parts)
+    return int(np.ceil(slack * area / (sheet[0] * sheet[1]) - 1e-9))
+
+
+@dataclass
+class _Shape:
+    """One orientation of a part in the nesting frame: fine polygon with its bounding box at
+    the origin, size ``w x h``; the outer approximation's x range ``ox`` and its lowest y per
+    column from ``ox[0]`` on (``low``; ``up``: the highest), which the placement uses."""
+
+    part: Part
+    poly: Polygon
+    w: float
+    h: float
+    ox: tuple[float, float]
+    low: np.ndarray
+    up: np.ndarray
+
+
+@dataclass
+class _Placed:
+    poly: Polygon              # fine polygon, placed
+    grown: np.ndarray          # closed ring containing poly grown by the gap
+    box: tuple[float, float, float, float] = field(init=False)   # of poly
+
+    def __post_init__(self) -> None:
+        self.box = self.poly.bounds
+
+
+def _outer_ring(poly: Polygon, grow: float) -> np.ndarray:
+    """A closed ring ``(k,2)`` of a polygon containing ``poly`` grown by ``grow`` mm (mitred
+    corners contain the rounded ones; the simplification cuts in by at most DROP_TOL, which
+    the extra growth pays for)."""
+    g = poly.buffer(grow + DROP_TOL, join_style="mitre", mitre_limit=3.0)
+    g = g.simplify(DROP_TOL, preserve_topology=True)
+    if g.geom_type != "Polygon":    # pragma: no cover - a strip outline stays one polygon
+        g = g.convex_hull
+    return np.asarray(g.exterior.coords)
+
+
+def _shapes(part: Part, curved: bool) -> list[_Shape]:
+    """The part in its nesting orientations (and turned by 180 degrees when curved)."""
     if curved:
         _, u = chord_frame(part.strip)
-        ang = -np.arctan2(u[1], u[0])
-        p = part.moved(Motion(ang, 0.0, 0.0))     # +s along +x: labels read upright
+        base = part.moved(Motion(-np.arctan2(u[1], u[0]), 0.0, 0.0))  # +s along +x
     else:
-        p = part
-    x0, y0, _, _ = p.polygon(FLAT_TOL).bounds
-    return p.moved(Motion(0.0, -x0, -y0))
+        base = part
+    out = []
+    for turn in ((0.0, np.pi) if curved else (0.0,)):
+        p = base.moved(Motion(turn, 0.0, 0.0)) if turn else base
+        pad = FLAT_TOL if curved else 0.0               # arcs bulge out by up to FLAT_TOL
+        x0, y0, _, _ = p.polygon(FLAT_TOL).bounds
+        p = p.moved(Motion(0.0, pad - x0, pad - y0))
+        poly = p.polygon(FLAT_TOL)
+        _, _, w, h = poly.bounds
+        w, h = w + pad, h + pad
+        ring = _outer_ring(poly, 0.0)
+        ox = (float(ring[:, 0].min()), float(ring[:, 0].max()))
+        n = int(np.ceil((ox[1] - ox[0]) / COLUMN)) + 1
+        low, up = _columns(ring, ox[0], n, False), _columns(ring, ox[0], n, True)
+        # one column wider, each column also covering its left neighbour: the profile of the
+        # shape anywhere between two column offsets (so it may also touch the margins)
+        low = np.minimum(np.append(low, np.inf), np.insert(low, 0, np.inf))
+        up = np.maximum(np.append(up, -np.inf), np.insert(up, 0, -np.inf))
+        out.append(_Shape(p, poly, w, h, ox, low, up))
+    return out
 
 
-def _drop(A: np.ndarray, B: np.ndarray) -> float:
-    """How far polygon ``B`` (closed ring ``(m,2)``) can fall in -y before touching polygon
-    ``A`` (ring ``(n,2)``); +inf if it passes by. Vertical rays from B's vertices down to A's
-    edges and from A's vertices up to B's edges."""
-    def rays(P, Q, sign):
-        q0, q1 = Q[:-1], Q[1:]
-        xa, xb = np.minimum(q0[:, 0], q1[:, 0]), np.maximum(q0[:, 0], q1[:, 0])
-        x = P[:, 0][:, None]
-        inside = (x >= xa) & (x <= xb) & (xb > xa)
-        f = np.where(inside, (x - q0[:, 0]) / np.where(xb > xa, q1[:, 0] - q0[:, 0], 1.0), 0.0)
-        y = q0[:, 1] + f * (q1[:, 1] - q0[:, 1])
-        d = sign * (P[:, 1][:, None] - y)
-        d = np.where(inside & (d >= -1e-9), d, np.inf)
-        return d.min(initial=np.inf)
-    return min(rays(B, A, 1.0), rays(A, B, -1.0))
+def _columns(ring: np.ndarray, x0: float, n: int, top: bool) -> np.ndarray:
+    """The highest (``top``) or lowest y of the closed ring ``(k,2)`` over each column
+    ``[x0 + j COLUMN, x0 + (j + 1) COLUMN]``, ``j < n``; -inf / +inf where it has no point.
+
+    Exact for the polyline: the extreme over a column is at a vertex inside it or where an
+    edge crosses one of its two bounds."""
+    out = np.full(n, -np.inf if top else np.inf)
+    at = np.maximum.at if top else np.minimum.at
+    j = np.floor((ring[:, 0] - x0) / COLUMN).astype(int)
+    keep = (j >= 0) & (j < n)
+    at(out, j[keep], ring[keep, 1])
+    a, b = ring[:-1], ring[1:]
+    lo, hi = np.minimum(a[:, 0], b[:, 0]), np.maximum(a[:, 0], b[:, 0])
+    m0 = np.ceil((lo - x0) / COLUMN).astype(int)
+    m1 = np.floor((hi - x0) / COLUMN).astype(int)
+    cnt = np.maximum(m1 - m0 + 1, 0) * (hi > lo)
+    if cnt.sum():
+        e = np.repeat(np.arange(len(a)), cnt)
+        m = m0[e] + np.arange(cnt.sum()) - np.repeat(np.cumsum(cnt) - cnt, cnt)
+        xb = x0 + m * COLUMN
+        t = (xb - a[e, 0]) / (b[e, 0] - a[e, 0])
+        y = a[e, 1] + t * (b[e, 1] - a[e, 1])
+        for col in (m - 1, m):
+            ok = (col >= 0) & (col < n)
+            at(out, col[ok], y[ok])
+    return out
 
 
-def _ring(poly: Polygon) -> np.ndarray:
-    return np.asarray(poly.exterior.coords)
+class _Sheet:
+    """One sheet being filled, in the nesting frame ``Lx x Ly`` (Lx >= Ly): the placed
+    polygons and, per column, the top and bottom of each placed part grown by the gap."""
+
+    def __init__(self, Lx: float, Ly: float, gap: float):
+        self.Lx, self.Ly, self.g = Lx, Ly, gap
+        self.placed: list[_Placed] = []
+        n = int(np.ceil(Lx / COLUMN)) + 1
+        self.top = np.zeros((0, n))
+        self.bot = np.zeros((0, n))
+
+    def places(self, s: _Shape) -> tuple[np.ndarray, np.ndarray]:
+        """Free places ``(x, y)`` (arrays) of the shape inside the sheet's margins: at every
+        column, on the bottom margin or resting on a placed part (its lowest point on the top
+        of that part), where it is clear of every placed part. Per column offset, a placed
+        part (grown by the gap) blocks the heights from where the shape would touch it from
+        below to where it rests on it (conservative: each column spans from its lowest to
+        its highest point, and a shape is either above or below a part in all columns they
+        share)."""
+        nb, n = len(s.low), self.top.shape[1]
+        if nb > n:
+            return np.zeros(0), np.zeros(0)
+        off = np.arange(n - nb + 1)
+        x0 = off * COLUMN - s.ox[0]
+        x = np.clip(x0, self.g, max(self.g, self.Lx - self.g - s.w))  # dilated profile covers
+        inside = (x >= x0 - 1e-9) & (x <= x0 + COLUMN + 1e-9) & \
+            (x + s.w <= self.Lx - self.g + SLACK)          # [x0, x0 + COLUMN], in the sheet
+        x, off = x[inside], off[inside]
+        y = np.full((1, len(off)), self.g)
+        if len(self.placed):       # (no inf - inf: tops and lows are never +inf, -inf)
+            view = np.lib.stride_tricks.sliding_window_view
+            hi = (view(self.top, nb, axis=1)[:, off] - s.low).max(axis=2)
+            lo = (view(self.bot, nb, axis=1)[:, off] - s.up).min(axis=2)
+            y = np.vstack([y, hi])                                  # (parts + 1, offsets)
+            blocked = ((y[:, None, :] > lo[None] + 1e-9) &
+                       (y[:, None, :] < hi[None] - 1e-9)).any(axis=1)
+            y = np.where(blocked, np.inf, y)
+        X = np.broadcast_to(x, y.shape).ravel()
+        Y = y.ravel()
+        ok = (Y >= self.g - 1e-9) & (Y <= self.Ly - self.g - s.h + SLACK)
+        return X[ok], Y[ok]
+
+    def clear(self, poly: Polygon, x: float, y: float) -> bool:
+        """Whether ``poly`` moved by ``(x, y)`` keeps the gap from every placed part (the check
+        with the fine outlines after the drop on their approximations)."""
+        cand = shapely.affinity.translate(poly, x, y)
+        b = cand.bounds
+        for q in self.placed:
+            if (q.box[0] - self.g < b[2] and q.box[2] + self.g > b[0]
+                    and q.box[1] - self.g < b[3] and q.box[3] + self.g > b[1]):
+                if cand.distance(q.poly) < self.g - 1e-6:
+                    return False
+        return True
+
+    def add(self, s: _Shape, x: float, y: float) -> Part:
+        q = s.part.moved(Motion(0.0, x, y))
+        poly = shapely.affinity.translate(s.poly, x, y)
+        grown = _outer_ring(poly, self.g)
+        self.placed.append(_Placed(poly, grown))
+        n = self.top.shape[1]
+        self.top = np.vstack([self.top, _columns(grown, 0.0, n, True)])
+        self.bot = np.vstack([self.bot, _columns(grown, 0.0, n, False)])
+        return q
 
 
 def _frame_to_sheet(W: float, H: float) -> Motion:
@@ -83,110 +228,172 @@ def _frame_to_sheet(W: float, H: float) -> Motion:
     return Motion() if W >= H else Motion(np.pi / 2, W, 0.0)
 
 
+#: the strategies tried: which place wins (lowest then leftmost, or leftmost then lowest),
+#: whether curved parts may turn by 180 degrees, and the order of the parts
+STRATEGIES = [("bottom-left", True, "length"), ("bottom-left", False, "length"),
+              ("left-bottom", False, "length")]
+ROW_UNIT = 0.1     # mm, the length unit of the row filling
+RETRIES = 2        # passes more per strategy, with the last sheet's parts placed first
+
+
+def _fullest(lengths: np.ndarray, cap: float) -> list[int]:
+    """Indices of a subset of ``lengths`` that contains the first and whose sum is largest
+    but at most ``cap`` (subset sum over ROW_UNIT steps, lengths rounded up)."""
+    units = np.ceil(lengths / ROW_UNIT - 1e-9).astype(int)
+    c = int(np.floor(cap / ROW_UNIT + 1e-9)) - units[0]
+    if c < 0:
+        return []
+    reach = np.zeros(c + 1, bool)
+    reach[0] = True
+    history = []
+    for u in units[1:]:
+        history.append(reach.copy())
+        if u <= c:
+            reach[u:] |= history[-1][:c + 1 - u]
+    total = int(np.flatnonzero(reach).max())
+    chosen = [0]
+    for k in range(len(units) - 1, 0, -1):      # walk back through the items
+        if not history[k - 1][total]:
+            chosen.append(k)
+            total -= units[k]
+    return sorted(chosen)
+
+
+def _rows(shapes: list[list[_Shape]], Lx: float, Ly: float, g: float
+          ) -> tuple[list[_Sheet], dict[int, tuple[int, Part]]]:
+    """Straight strips in rows along the long side, each row as full as it can be: it takes
+    the longest strip left and the set of others that fills the rest of the row best."""
+    left = sorted(range(len(shapes)), key=lambda i: (-shapes[i][0].w, i))
+    sheets: list[_Sheet] = []
+    placed: dict[int, tuple[int, Part]] = {}
+    y = np.inf
+    while left:
+        L = np.array([shapes[i][0].w + g for i in left])
+        row = [left[k] for k in _fullest(L, Lx - g + SLACK)]
+        if not row:
+            raise InputError(f"lamella {shapes[left[0]][0].part.strip.lamella}: a piece does "
+                             f"not fit an empty {Lx:g} x {Ly:g} mm sheet; use a larger --sheet")
+        h = max(shapes[i][0].h for i in row)
+        if y + h > Ly - g + 1e-9:
+            sheets.append(_Sheet(Lx, Ly, g))
+            y = g
+        x = g
+        for i in row:
+            s = shapes[i][0]
+            placed[i] = (len(sheets) - 1, sheets[-1].add(s, x, y))
+            x += s.w + g
+        y += h + g
+        left = [i for i in left if i not in row]
+    return sheets, placed
+
+
+def _key(key: str, x: np.ndarray, y: np.ndarray, h: float) -> np.ndarray:
+    """Indices of the places ``(x, y)`` from best to worst under ``key``."""
+    if key == "bottom-left":
+        return np.lexsort((x, np.round(y, 6)))
+    if key == "left-bottom":
+        return np.lexsort((y, np.round(x, 6)))
+    return np.lexsort((x, np.round(y + h, 6)))
+
+
+def _order(shapes: list[list[_Shape]], order: str, first: list[int]) -> list[int]:
+    """The parts' order: ``first``, then the others by decreasing length (or area)."""
+    if order == "length":
+        key = lambda i: (-round(shapes[i][0].w, 6), -shapes[i][0].poly.area, i)  # noqa: E731
+    else:
+        key = lambda i: (-shapes[i][0].poly.area, i)  # noqa: E731
+    rest = sorted((i for i in range(len(shapes)) if i not in set(first)), key=key)
+    return sorted(first, key=key) + rest
+
+
+def _nest_once(shapes: list[list[_Shape]], Lx: float, Ly: float, g: float, key: str,
+               turn: bool, seq: list[int]) -> tuple[list[_Sheet], dict[int, tuple[int, Part]]]:
+    """One first-fit pass under one strategy, parts in the order ``seq``."""
+    sheets: list[_Sheet] = []
+    placed: dict[int, tuple[int, Part]] = {}
+    for i in seq:
+        options = shapes[i] if turn else shapes[i][:1]
+        for k in range(len(sheets) + 1):
+            if k == len(sheets):
+                sheets.append(_Sheet(Lx, Ly, g))
+            best = None
+            for s in options:
+                x, y = sheets[k].places(s)
+                tried = 0
+                for j in _key(key, x, y, s.h):
+                    cand = (y[j], x[j]) if key != "left-bottom" else (x[j], y[j])
+                    if key == "low-top":
+                        cand = (y[j] + s.h, x[j])
+                    if (best is not None and cand >= best[0]) or tried > 20:
+                        break
+                    if sheets[k].clear(s.poly, x[j], y[j]):
+                        best = (cand, s, x[j], y[j])
+                        break
+                    tried += 1
+            if best is not None:
+                _, s, x, y = best
+                placed[i] = (k, sheets[k].add(s, float(x), float(y)))
+                break
+            if not sheets[k].placed:
+                raise InputError(f"lamella {s.part.strip.lamella}: a piece does not fit an "
+                                 f"empty {Lx:g} x {Ly:g} mm sheet; use a larger --sheet or "
+                                 "a smaller --gap")
+    return sheets, placed
+
+
 def nest(parts: list[Part], params: FabParams) -> Layout:
-    """Place ``parts`` on as many sheets as needed; see the module docstring."""
+    """Place ``parts`` on as many sheets as needed; see the module docstring.
+
+    Each strategy of :data:`STRATEGIES` nests all parts, first fit decreasing: each part
+    goes onto the first sheet with room for it, at the best of its drop places there; then
+    again (:data:`RETRIES` times) with the parts the last sheet got placed first. The layout
+    with the fewest sheets wins, then the one whose last sheet is emptiest. Raises
+    :class:`InputError` for a part that no empty sheet holds
+    (:func:`fabrication.splice.split_strip` cuts such lamellae into pieces first)."""
     W, H = params.sheet
     Lx, Ly, g = max(W, H), min(W, H), params.gap
     to_sheet = _frame_to_sheet(W, H)
-    placed: list[tuple[int, Part]] = []
-    n_sheets = 0
-    straight = [p for p in parts if p.strip.axis.kind == "line"]
-    curved = [p for p in parts if p.strip.axis.kind != "line"]
-
-    # rows, first-fit decreasing
-    if straight:
-        canon = [_canonical(p, False) for p in straight]
-        order = sorted(range(len(canon)), key=lambda i: -canon[i].polygon().bounds[2])
-        rows: list[list[float]] = []      # [sheet, y, x_end, height]
-        for i in order:
-            p = canon[i]
-            _, _, w, h = p.polygon(FLAT_TOL).bounds
-            row = next((r for r in rows if r[2] + g + w <= Lx - g + 1e-9 and h <= r[3] + 1e-9),
-                       None)
-            if row is None:
-                last = [r for r in rows if r[0] == n_sheets - 1]
-                y = (last[-1][1] + last[-1][3] + g) if last else g
-                if not last or y + h > Ly - g + 1e-9:
-                    n_sheets += 1
-                    y = g
-                row = [n_sheets - 1, y, 0.0, h]
-                rows.append(row)
-            placed.append((row[0], p.moved(Motion(0.0, row[2] + g, row[1]))))
-            row[2] += g + w
-
-    # stacks of curved parts
-    if curved:
-        canon = [_canonical(p, True) for p in curved]
-        order = sorted(range(len(canon)), key=lambda i: -canon[i].polygon().bounds[2])
-
-        # a stack: sheet, x, width, parts [(ring, grown ring, top)]
-        def try_stack(st: dict, poly: Polygon, w: float, h: float):
-            x = st["x"] + 0.5 * (st["width"] - w)
-            if not st["parts"]:
-                return x, g
-            coarse = poly.simplify(DROP_TOL)
-            B = _ring(coarse) + [x, 0.0]
-            y0 = max(t for _, _, t in st["parts"]) + g       # B entirely above the stack
-            d = min(_drop(A, B + [0.0, y0]) for _, A, _ in st["parts"])
-            y = max(g, y0 - d) if np.isfinite(d) else g
-            fine = poly.simplify(CHECK_TOL)
-            while True:       # the drop used coarse rings: make sure, nudge up
-                cand = shapely.affinity.translate(fine, x, y)
-                need = g + 2 * CHECK_TOL + 2 * FLAT_TOL
-                short = max(need - cand.distance(A) for A, _, _ in st["parts"])
-                if short <= 0:
-                    break
-                y += short + 0.01
-            return (x, y) if y + h <= Ly - g + 1e-9 else None
-
-        stacks: list[dict] = []
-        right: dict[int, float] = {}    # per sheet of stacks: x where the next stack may start
-
-        for i in order:
-            p = canon[i]
-            poly = p.polygon(FLAT_TOL)
-            _, _, w, h = poly.bounds
-            stack, pos = None, None
-            for st in stacks:           # first fit: the first stack with room for it
-                if w <= st["width"] + 1e-9:
-                    pos = try_stack(st, poly, w, h)
-                    if pos is not None:
-                        stack = st
-                        break
-            if stack is None:           # a new stack right of the others, on any sheet
-                k = next((k for k, x in right.items() if x + w <= Lx - g + 1e-9), None)
-                if k is None:
-                    n_sheets += 1
-                    k = n_sheets - 1
-                    right[k] = g
-                stack = {"sheet": k, "x": right[k], "width": w, "parts": []}
-                stacks.append(stack)
-                right[k] += w + g
-                pos = try_stack(stack, poly, w, h)
-            q = p.moved(Motion(0.0, *pos))
-            qp = q.polygon(FLAT_TOL)
-            stack["parts"].append((qp.simplify(CHECK_TOL),
-                                   _ring(qp.simplify(DROP_TOL).buffer(g + 2 * FLAT_TOL,
-                                                                      quad_segs=8)),
-                                   pos[1] + h))
-            placed.append((stack["sheet"], q))
-
-    out_parts = [p.moved(to_sheet) for _, p in placed]
-    return Layout(out_parts, [s for s, _ in placed], n_sheets, (W, H))
+    shapes = [_shapes(p, p.strip.axis.kind != "line") for p in parts]
+    curved = any(len(s) > 1 for s in shapes)
+    best = None
+    if not curved and all(len(s) == 1 for s in shapes):
+        sheets, placed = _rows(shapes, Lx, Ly, g)
+        best = ((len(sheets), sum(q.poly.area for q in sheets[-1].placed)), sheets, placed)
+    for key, turn, order in STRATEGIES:
+        if turn and not curved:
+            continue
+        first: list[int] = []
+        for _ in range(RETRIES + 1):      # the parts left on the last sheet go first next time
+            sheets, placed = _nest_once(shapes, Lx, Ly, g, key, turn,
+                                        _order(shapes, order, first))
+            last = sum(q.poly.area for q in sheets[-1].placed) if sheets else 0.0
+            score = (len(sheets), last)
+            if best is None or score < best[0]:
+                best = (score, sheets, placed)
+            if len(sheets) < 2:
+                break
+            first = first + [i for i, (k, _) in placed.items()
+                             if k == len(sheets) - 1 and i not in first]
+    _, sheets, placed = best
+    idx = sorted(placed)
+    return Layout([placed[i][1].moved(to_sheet) for i in idx], [placed[i][0] for i in idx],
+                  len(sheets), (W, H))
 
 
-def check_layout(layout: Layout, gap: float, tol: float = 1e-6) -> None:
-    """Assert that parts keep ``gap`` from each other and lie inside their sheets."""
+def check_layout(layout: Layout, gap: float, tol: float = 1e-3) -> None:
+    """Assert that parts keep ``gap`` mm from each other and from the sheet edges (to SLACK:
+    a piece cut to fit the sheet fits it to 0.01 mm)."""
     W, H = layout.sheet
-    sheet = shapely.box(0, 0, W, H)
+    m = gap - tol - SLACK
+    inner = shapely.box(m, m, W - m, H - m)
     for k in range(layout.n_sheets):
         polys = [p.polygon(FLAT_TOL) for p in layout.on_sheet(k)]
         for P in polys:
-            if not sheet.contains(P):
-                raise AssertionError(f"a part leaves sheet {k + 1}")
+            if not inner.contains(P):
+                raise AssertionError(f"a part leaves sheet {k + 1} or its {gap} mm margin")
         tree = shapely.STRtree(polys)
         for i, P in enumerate(polys):
             for j in tree.query(P.buffer(gap - tol)):
-                if j > i and polys[j].distance(P) < gap - 1e-3:
+                if j > i and polys[j].distance(P) < gap - tol:
                     raise AssertionError(f"parts {i} and {j} on sheet {k + 1} are closer than "
                                          f"{gap} mm")

@@ -70,6 +70,8 @@ def plan_parts(bundle: DesignBundle, params: FabParams,
                           "overlaps_mm": [round(n["overlap"], 3) for n in notes],
                           "splice_joints": [n["splice_joint"] for n in notes
                                             if n["kind"] == "joint"],
+                          "splice_joint_names": [n["splice_name"] for n in notes
+                                                 if n["kind"] == "joint"],
                           "span_splices_mm": [round(n["at"], 3) for n in notes
                                               if n["kind"] == "span"]})
     if split:
@@ -98,7 +100,7 @@ def plan_parts(bundle: DesignBundle, params: FabParams,
 def fabricate(bundle: str | Path | DesignBundle, out_dir: str | Path,
               params: FabParams | dict[str, Any] | None = None,
               progress: Callable[[str], None] | None = None,
-              plan: bool = True) -> dict[str, Any]:
+              plan: bool = True, keep_layout: bool = False) -> dict[str, Any]:
     """Write cut files, cut list and plan of a design bundle to ``out_dir``.
 
     Parameters
@@ -113,6 +115,8 @@ def fabricate(bundle: str | Path | DesignBundle, out_dir: str | Path,
     progress : callable, optional
     plan : bool
         Draw plan.png / plan.svg (the slowest step; off for quick checks).
+    keep_layout : bool
+        Also return the :class:`~fabrication.nesting.Layout` under ``"layout"`` (not written).
 
     Returns
     -------
@@ -157,6 +161,8 @@ def fabricate(bundle: str | Path | DesignBundle, out_dir: str | Path,
         "n_design_joints": int(sum(len(lam.joints) for lam in bundle.net.lamellae)),
         "utilisation": util,
         "utilisation_per_sheet": per_sheet,
+        "material_used": layout.used(),
+        "material_used_per_sheet": [layout.used(k) for k in range(layout.n_sheets)],
         "pieces_split": info["split"],
         "labels_dropped": int(sum(p.labels_dropped for p in parts)),
         "joints_fallback": info["joints_fallback"],
@@ -183,11 +189,15 @@ def fabricate(bundle: str | Path | DesignBundle, out_dir: str | Path,
         if plan:
             say("drawing the assembly plan")
             write_plan(tmp / "plan.png", tmp / "plan.svg", bundle.net,
-                       title=f"{bundle.kind} gridshell: lamella ids (blue family 1, red family 3)")
+                       title=f"{bundle.kind} gridshell: lamella ids (blue family 1, red family 3)"
+                       f"; {layout.n_sheets} sheet{'s' if layout.n_sheets != 1 else ''} "
+                       f"{W:g} x {H:g} mm, {100 * layout.used():.0f} % of their area used")
         (tmp / REPORT).write_text(json.dumps(finite_json(report), indent=1, allow_nan=False,
                                              default=_json_default),
                                   encoding="utf-8")
     report["out"] = str(out)
+    if keep_layout:
+        report["layout"] = layout
     return report
 
 

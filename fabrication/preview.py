@@ -3,7 +3,7 @@
 Drawn with matplotlib's Agg backend (no display, no global pyplot state) from the same
 :class:`~fabrication.part.Part` geometry the DXF and SVG writers take: the outline path the
 writers choose (bulges, or short segments with ``--segments``), hole circles, score lines and
-label strokes, each layer in its cut-file colour (CUT red, SCORE blue, ENGRAVE black) on the
+label strokes, each layer in its cut-file colour (CUT red, SCORE blue, ENGRAVE green) on the
 sheet drawn to scale (pale fill, grey edge). A title band above the sheet gives the sheet's
 name, size in mm and part count; the same title is stored in the PNG's ``Title`` text chunk.
 
@@ -20,7 +20,7 @@ from gridshell.atomic import atomic_path
 
 from .params import FabParams
 from .part import Part
-from .svg import COLOURS
+from .layers import COLOURS
 
 PX_PER_LONG_SIDE = 1200   # pixels along the sheet's long side
 DPI = 100

@@ -83,8 +83,18 @@ def _joint_splices(strip: Strip, params: FabParams, start: float, first: int,
         nxt = js[k] - m
         shared = [int(i) for i in np.flatnonzero((js >= nxt - 1e-9) & (js <= end + 1e-9))]
         found.append({"kind": "joint", "overlap": float(ov), "from": float(nxt),
-                      "to": float(end), "splice_joint": int(k), "shared_joints": shared})
+                      "to": float(end), "splice_joint": int(k), "splice_name": joint_name(strip, k),
+                      "shared_joints": shared,
+                      "shared_names": [joint_name(strip, i) for i in shared]})
     return found[::-1]
+
+
+def joint_name(strip: Strip, k: int) -> str:
+    """The name engraved beside joint ``k`` of ``strip``: the ids of the lamellae crossing it
+    (``11``, ``11,12``); for a joint no other lamella crosses, its position along the strip
+    from the strip's start (``at 123.4 mm``)."""
+    nb = strip.neighbours[k] if k < len(strip.neighbours) else []
+    return ",".join(str(i) for i in nb) if nb else f"at {strip.joint_s[k] - strip.s0:.1f} mm"
 
 
 def span_overlap(params: FabParams) -> float:
@@ -135,8 +145,9 @@ def _span_note(strip: Strip, params: FabParams, c: float, i: int) -> dict:
     stations ``i`` and ``i + 1`` of ``s0, joints, s1``)."""
     ov = span_overlap(params)
     n = len(strip.joint_s)      # stations i, i+1 are joints i-1, i (0, n+1: the strip ends)
-    where = ("before the first joint" if i == 0 else "after the last joint" if i == n
-             else f"between joints {i - 1} and {i}")
+    where = (f"before the first joint ({joint_name(strip, 0)})" if i == 0 else
+             f"after the last joint ({joint_name(strip, n - 1)})" if i == n
+             else f"between joints {joint_name(strip, i - 1)} and {joint_name(strip, i)}")
     return {"kind": "span", "overlap": float(ov), "from": float(c), "to": float(c + ov),
             "at": float(c + ov / 2), "where": where,
             "fasteners": span_fasteners(float(c), float(ov), params),

@@ -4,7 +4,7 @@ One file per sheet. ``width``/``height`` in mm with a matching ``viewBox`` (1 us
 1 mm), y flipped so that the drawing reads as the DXF does (sheet origin at the bottom left),
 coordinates written flipped (no transforms, which some laser importers ignore),
 ``fill="none"``, hairline strokes (0.025 mm) in pure colours: CUT ``#FF0000``, SCORE
-``#0000FF``, ENGRAVE ``#000000``. Arcs are SVG elliptical arcs (``A``) with equal radii.
+``#0000FF``, ENGRAVE ``#00FF00`` (:mod:`fabrication.layers`). Arcs are SVG elliptical arcs (``A``) with equal radii.
 Element order as in the DXF: engrave, score, holes, outlines.
 """
 from __future__ import annotations
@@ -15,11 +15,11 @@ import numpy as np
 
 from gridshell.atomic import atomic_path
 
+from .layers import COLOURS
 from .params import FabParams
 from .part import Part
 from .path import Path, arc_geometry
 
-COLOURS = {"CUT": "#FF0000", "SCORE": "#0000FF", "ENGRAVE": "#000000"}
 STROKE = 0.025  # mm, a hairline
 
 

@@ -6,6 +6,7 @@ import pytest
 import shapely
 from fab_cases import make_bundle, read_dxf_sheet
 
+from fabrication.layers import LAYERS
 from fabrication import FabParams, fabricate
 
 
@@ -26,7 +27,13 @@ def test_dxf_round_trip(cnc_bundle, tmp_path, version, segments, joints):
     assert doc.dxfversion == ("AC1009" if version == "R12" else "AC1024")
     assert doc.header["$INSUNITS"] == 4
     layers = {l.dxf.name: l.dxf.color for l in doc.layers}
-    assert (layers["CUT"], layers["SCORE"], layers["ENGRAVE"]) == (1, 5, 7)
+    assert (layers["CUT"], layers["SCORE"], layers["ENGRAVE"]) == (1, 5, 3)   # never ACI 7
+    check_extents(doc)
+    if version == "R2010":     # true colours as well as ACI, on the layers and the entities
+        rgb = {l.dxf.name: l.rgb for l in doc.layers if l.dxf.name in LAYERS}
+        assert rgb == {k: v[1] for k, v in LAYERS.items()}
+        assert all(e.rgb == LAYERS[e.dxf.layer][1] and e.dxf.color == LAYERS[e.dxf.layer][0]
+                   for e in doc.modelspace())
     assert len(parts) == rep["n_pieces"]
     outline_type = "POLYLINE" if version == "R12" else "LWPOLYLINE"
     outlines = [e for e in doc.modelspace() if e.dxf.layer == "CUT" and e.dxftype() == outline_type]
@@ -55,7 +62,7 @@ def test_svg_parses_and_measures_in_mm(cnc_bundle, tmp_path):
     paths = [e for e in els if isinstance(e, Path) and not isinstance(e, Polyline)]
     strokes = [e for e in els if isinstance(e, Polyline)]
     assert {e.stroke.hexrgb.upper() for e in circles + paths} == {"#FF0000"}
-    assert {e.stroke.hexrgb.upper() for e in strokes} == {"#000000"}
+    assert {e.stroke.hexrgb.upper() for e in strokes} == {"#00FF00"}
     assert all(e.fill is None or e.fill.value is None for e in circles + paths + strokes)
     # the same holes as the DXF, y flipped
     doc, parts = read_dxf_sheet(tmp_path / "f" / "sheet_01.dxf")
@@ -82,7 +89,7 @@ def gg_bundle():
 @pytest.mark.parametrize("joints", ["marks", "hole"])
 def test_gg_svg_round_trip_layers_colours_and_units(gg_bundle, tmp_path, joints):
     """A GG (straight strips) sheet read back with svgelements: width/height in mm equal the
-    viewBox (1 unit = 1 mm), SCORE lines pure #0000FF, CUT #FF0000, ENGRAVE #000000, hairline
+    viewBox (1 unit = 1 mm), SCORE lines pure #0000FF, CUT #FF0000, ENGRAVE #00FF00, hairline
     strokes, no fill; and the same outlines, holes, score lines and strokes as the DXF."""
     import xml.etree.ElementTree as ET
 
@@ -92,7 +99,7 @@ def test_gg_svg_round_trip_layers_colours_and_units(gg_bundle, tmp_path, joints)
     rep = fabricate(gg_bundle, tmp_path / "f", FabParams(joints=joints, sheet=f"{W}x{H}"),
                     plan=False)
     ns = "{http://www.w3.org/2000/svg}"
-    expect = {"CUT": "#FF0000", "SCORE": "#0000FF", "ENGRAVE": "#000000"}
+    expect = {"CUT": "#FF0000", "SCORE": "#0000FF", "ENGRAVE": "#00FF00"}
     tags = {"CUT": {"path", "circle"}, "SCORE": {"line"}, "ENGRAVE": {"polyline"}}
     for k in range(rep["n_sheets"]):
         f = tmp_path / "f" / f"sheet_{k + 1:02d}.svg"
@@ -120,7 +127,7 @@ def test_gg_svg_round_trip_layers_colours_and_units(gg_bundle, tmp_path, joints)
         assert {e.stroke.hexrgb.upper() for e in lines} == ({"#0000FF"} if joints == "marks"
                                                             else set())
         assert {e.stroke.hexrgb.upper() for e in circles + outlines} == {"#FF0000"}
-        assert {e.stroke.hexrgb.upper() for e in strokes} == {"#000000"}
+        assert {e.stroke.hexrgb.upper() for e in strokes} == {"#00FF00"}
         # the same geometry as the DXF, y flipped
         doc, parts = read_dxf_sheet(tmp_path / "f" / f"sheet_{k + 1:02d}.dxf")
         assert len(outlines) == len(parts)
@@ -146,3 +153,15 @@ def test_gg_svg_round_trip_layers_colours_and_units(gg_bundle, tmp_path, joints)
             assert len(S) == 0 and len(C) == len(Hd) > 0
             assert np.sort(C, axis=0) == pytest.approx(np.sort(Hd, axis=0), abs=1e-3)
             assert all(c.rx == pytest.approx(1.5) for c in circles)
+
+
+def check_extents(doc):
+    """$EXTMIN / $EXTMAX are the drawing's real extents (mm): the bounding box of every
+    entity, recomputed with ezdxf.bbox, within 0.01 mm; never the 1e20 defaults."""
+    from ezdxf import bbox
+
+    box = bbox.extents(doc.modelspace(), fast=False)
+    lo, hi = doc.header["$EXTMIN"], doc.header["$EXTMAX"]
+    assert np.allclose(np.asarray(lo)[:2], [box.extmin.x, box.extmin.y], atol=0.01)
+    assert np.allclose(np.asarray(hi)[:2], [box.extmax.x, box.extmax.y], atol=0.01)
+    assert 0 <= lo[0] < hi[0] < 1e6 and 0 <= lo[1] < hi[1] < 1e6

@@ -144,6 +144,9 @@ def run(args: Any) -> int:
         "sheets": f"{rep['n_sheets']} x {params.sheet[0]:g} x {params.sheet[1]:g} mm "
                   f"({rep['sheet_files']})",
         "utilisation [%]": 100.0 * rep["utilisation"],
+        "material used [% of sheet area]": ", ".join(
+            f"{100.0 * u:.1f}" for u in rep["material_used_per_sheet"])
+            + f" (all sheets {100.0 * rep['material_used']:.1f})",
         "pieces split": ", ".join(f"L{d['lamella']} in {d['pieces']}"
                                   for d in rep["pieces_split"]) or "none",
         "files": ", ".join(rep["files"]),

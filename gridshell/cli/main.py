@@ -21,6 +21,7 @@ SUBCOMMANDS: dict[str, str] = {
     "export": "export",
     "demo": "demo",
     "check": "check",
+    "serve": "serve",
 }
 
 

@@ -1,0 +1,7 @@
+"""Grasshopper components through Hops (``gridshell serve``): a thin layer over the Python API.
+
+:mod:`.rhino` converts between rhino3dm geometry (what Hops sends and receives) and our arrays;
+:mod:`.components` registers the components (GG design, NCP design, verify, fabricate) on a
+``ghhops-server`` Flask app; errors reach the component as its message, never a dead
+component.
+"""
