@@ -169,7 +169,7 @@ class LinearSolver:
         f, new = self._analysis(A, key)
         try:
             if new:
-                f = cholmod.analyze(A, mode="supernodal")
+                f = cholmod.analyze(A, mode="supernodal", ordering_method="amd")
                 self._store(key, f)
             f.cholesky_inplace(A)
         except cholmod.CholmodNotPositiveDefiniteError as exc:
