@@ -18,8 +18,8 @@ CMAKE_BIN := $(PY) -c 'import cmake; print(cmake.CMAKE_BIN_DIR)' 2>/dev/null
 # wheel; 0.4.16 builds against Debian's libsuitesparse-dev 5.12 (Cython < 3, numpy/scipy from the
 # venv, hence --no-build-isolation: ~20 s instead of ~4 min isolated). As root on Debian/Ubuntu the
 # headers and OpenBLAS (CHOLMOD's BLAS; reference BLAS otherwise) are installed with apt-get:
-# ~90 MB installed. Without them the set-up goes on and gridshell uses SuperLU (scipy); see
-# `gridshell --version`.
+# ~85 MB installed (Cython, needed for the build only, is removed again). Without them the
+# set-up goes on and gridshell uses SuperLU (scipy); see `gridshell --version`.
 SKSPARSE  := scikit-sparse==0.4.16
 CHOLMOD_H := /usr/include/suitesparse/cholmod.h
 # a C++ compiler on PATH: $CXX if set, else the usual names
@@ -68,6 +68,7 @@ $(STAMP): pyproject.toml
 	  $(PY) -m pip install --quiet "cython>=0.29,<3" && \
 	  $(PY) -m pip install --quiet --no-build-isolation "$(SKSPARSE)" \
 	    || echo "building $(SKSPARSE) failed: the linear solver will be SuperLU (scipy)"; \
+	  $(PY) -m pip uninstall --quiet --yes cython >/dev/null 2>&1; \
 	else echo "no libsuitesparse-dev ($(CHOLMOD_H)): the linear solver will be SuperLU (scipy)"; fi
 	@$(VENV)/bin/gridshell --version | tail -1
 	@touch $(STAMP)
