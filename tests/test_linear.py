@@ -149,6 +149,16 @@ def test_normal_equations_keep_their_pattern():
     ne.update(J4)
     assert ne.patterns == 2 and ne.key != key
     assert np.allclose(ne.JTJ.toarray(), (J4.T @ J4).toarray())
+    J5 = J4.tolil()
+    J5[:, 3] = 0.0  # a variable no residual uses: its diagonal entry joins the pattern anyway
+    J5 = J5.tocsr()
+    J5.eliminate_zeros()
+    assert ne.update(J5).nnz == ne.JTJ.nnz and ne.patterns == 2  # a sub-pattern: kept
+    ne = NormalEquations()
+    M5 = ne.update(J5)
+    assert ne.patterns == 1 and M5.nnz == (J5.T @ J5).nnz + 1
+    assert np.allclose(M5.toarray(), (J5.T @ J5).toarray())
+    assert np.allclose(ne.damped(1.0).diagonal(), M5.diagonal() + 1.0)
 
 
 @pytest.mark.parametrize("backend", BACKENDS)

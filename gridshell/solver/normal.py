@@ -64,6 +64,14 @@ class NormalEquations:
 
     def _new_pattern(self, M: sp.csr_matrix) -> None:
         n = M.shape[0]
+        rows = np.repeat(np.arange(n), np.diff(M.indptr))
+        diag = np.flatnonzero(rows == M.indices)
+        if len(diag) == n:  # the usual case: M holds its whole diagonal, its pattern is the one
+            self.JTJ = sp.csc_matrix((M.data.copy(), M.indices, M.indptr), shape=M.shape)
+            self._diag = diag
+            self.key = pattern_key(self.JTJ)
+            self.patterns += 1
+            return
         ones = sp.csr_matrix((np.ones(M.nnz), M.indices, M.indptr), shape=M.shape)
         S = (ones + sp.identity(n, format="csr")).tocsr()  # M's pattern plus the diagonal
         S.sort_indices()
