@@ -139,7 +139,7 @@ def solve(problem: Problem, x0: np.ndarray, *, fixed: np.ndarray | None = None,
         if E <= tol_energy:
             message, converged, it = "energy below tolerance", True, it - 1
             break
-        J = (a.J if len(free) == len(x) else a.J[:, free]).tocsc()  # no copy if none fixed
+        J = a.J if len(free) == len(x) else a.J[:, free]  # CSR; no copy if none fixed
         g = J.T @ a.r
         if np.max(np.abs(g), initial=0.0) <= tol_grad:
             message, converged, it = "gradient below tolerance", True, it - 1
