@@ -14,6 +14,14 @@ STAMP  := $(VENV)/.installed
 # CMake 4 refuses openmesh's cmake_minimum_required(3.3) unless given a policy minimum (the
 # variable is ignored by CMake 3).
 CMAKE_BIN := $(PY) -c 'import cmake; print(cmake.CMAKE_BIN_DIR)' 2>/dev/null
+# The linear solver (gridshell/solver/linear.py): CHOLMOD through scikit-sparse, which has no
+# wheel; 0.4.16 builds against Debian's libsuitesparse-dev 5.12 (Cython < 3, numpy/scipy from the
+# venv, hence --no-build-isolation: ~20 s instead of ~4 min isolated). As root on Debian/Ubuntu the
+# headers and OpenBLAS (CHOLMOD's BLAS; reference BLAS otherwise) are installed with apt-get:
+# ~85 MB installed (Cython, needed for the build only, is removed again). Without them the
+# set-up goes on and gridshell uses SuperLU (scipy); see `gridshell --version`.
+SKSPARSE  := scikit-sparse==0.4.16
+CHOLMOD_H := /usr/include/suitesparse/cholmod.h
 # a C++ compiler on PATH: $CXX if set, else the usual names
 HAVE_CXX  := { command -v "$${CXX:-c++}" || command -v g++ || command -v clang++; } >/dev/null 2>&1
 
@@ -50,6 +58,19 @@ $(STAMP): pyproject.toml
 	  echo >&2 "error: installing gridshell and its dependencies failed (see above); openmesh"; \
 	  echo >&2 "  builds from source with cmake and a C++ compiler, and pip needs the network"; \
 	  exit 1; }
+	@if [ ! -f $(CHOLMOD_H) ] && [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then \
+	  echo "installing libsuitesparse-dev and OpenBLAS with apt-get (CHOLMOD for the linear solver)"; \
+	  { apt-get update && DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends \
+	      libsuitesparse-dev libopenblas0-pthread; } >/dev/null 2>&1 \
+	    || echo "apt-get could not install libsuitesparse-dev: the linear solver will be SuperLU"; \
+	fi
+	@if [ -f $(CHOLMOD_H) ]; then \
+	  $(PY) -m pip install --quiet "cython>=0.29,<3" && \
+	  $(PY) -m pip install --quiet --no-build-isolation "$(SKSPARSE)" \
+	    || echo "building $(SKSPARSE) failed: the linear solver will be SuperLU (scipy)"; \
+	  $(PY) -m pip uninstall --quiet --yes cython >/dev/null 2>&1; \
+	else echo "no libsuitesparse-dev ($(CHOLMOD_H)): the linear solver will be SuperLU (scipy)"; fi
+	@$(VENV)/bin/gridshell --version | tail -1
 	@touch $(STAMP)
 
 demo: $(STAMP)

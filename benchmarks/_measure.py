@@ -21,12 +21,14 @@ MB = float(2 ** 20)
 
 
 class Measured(NamedTuple):
-    """Outcome of :func:`measure`: seconds, peak MB above the start, absolute peak MB."""
+    """Outcome of :func:`measure`: seconds, peak MB above the start, absolute peak MB, the
+    value, and the process's CPU seconds (all threads; under load, wall >> CPU)."""
 
     seconds: float
     peak_mb: float
     rss_peak_mb: float
     value: Any
+    cpu_seconds: float = float("nan")
 
 
 def _status_kb(key: str) -> float | None:
@@ -57,12 +59,12 @@ def measure(fn: Callable[[], Any]) -> Measured:
     """Run ``fn()`` once; its wall time and peak resident memory above the start (MB)."""
     reset = _reset_peak()
     base = rss_mb()
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     value = fn()
-    seconds = time.perf_counter() - t0
+    seconds, cpu = time.perf_counter() - t0, time.process_time() - c0
     hwm = _status_kb("VmHWM") if reset else None
     peak = hwm / 1024 if hwm is not None else resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
-    return Measured(seconds, max(peak - base, 0.0), peak, value)
+    return Measured(seconds, max(peak - base, 0.0), peak, value, cpu)
 
 
 def measure_traced(fn: Callable[[], Any]) -> Measured:

@@ -78,7 +78,7 @@ from gridshell.solver.solve import factorized  # noqa: E402
 
 #: grid side per size label: 3 n^2 + 2 n - 1 unknowns
 SIZES = {"1e3": 18, "1e4": 57, "1e5": 182}
-SECTIONS = ("iterations", "least_squares", "linear", "pipelines")
+SECTIONS = ("iterations", "least_squares", "linear", "backends", "pipelines")
 DAMPING = 1e-3  # relative to mean diag(J^T J), as solve()'s default
 TARGET_REL = 1e-6
 SCRIPT = Path(__file__).resolve()
@@ -123,20 +123,33 @@ def _timed(fn: Callable[[], Any]) -> tuple[float, Any]:
 
 
 def iteration_split(prob: Problem, x: np.ndarray) -> dict[str, float]:
-    """Seconds of one iteration's parts at ``x`` (the steps of solve())."""
-    free = np.arange(len(x))
-    t_asm, a = _timed(lambda: prob.assemble(x))
-    t_ne, (J, JTJ) = _timed(lambda: _ne(a.J, free))
-    A = JTJ + sp.identity(len(free), format="csc") * (DAMPING * JTJ.diagonal().mean())
-    g = J.T @ a.r
-    t_fac, solver = _timed(lambda: factorized(A))
-    t_sol, _ = _timed(lambda: solver(g))
-    return {"assemble": t_asm, "normal_eq": t_ne, "factor": t_fac, "backsolve": t_sol}
+    """Seconds of one iteration's parts at ``x`` (the steps of solve()): assembly, normal
+    equations on their kept pattern (a second update, as in every iteration after the first),
+    the first factorization (analysis included), a refactorization (the analysis reused, as in
+    every later iteration and rejected step) and the back-substitution; wall and CPU."""
+    from gridshell.solver.linear import LinearSolver
+    from gridshell.solver.normal import NormalEquations
 
+    lin, ne = LinearSolver(), NormalEquations()
+    out: dict[str, float] = {}
 
-def _ne(J: sp.csr_matrix, free: np.ndarray) -> tuple[sp.csc_matrix, sp.csc_matrix]:
-    Jf = J[:, free].tocsc()
-    return Jf, (Jf.T @ Jf).tocsc()
+    def timed(name: str, fn: Callable[[], Any]) -> Any:
+        t0, c0 = time.perf_counter(), time.process_time()
+        v = fn()
+        out[name], out[name + "_cpu"] = time.perf_counter() - t0, time.process_time() - c0
+        return v
+
+    a = timed("assemble", lambda: prob.assemble(x))
+    ne.update(a.J)
+    JTJ = timed("normal_eq", lambda: ne.update(a.J))
+    g = a.J.T @ a.r
+    mu = DAMPING * float(np.mean(ne.diagonal()))
+    timed("first_factor", lambda: lin.factor(ne.damped(mu), ne.key))
+    solver = timed("factor", lambda: lin.factor(ne.damped(2 * mu), ne.key))
+    timed("backsolve", lambda: solver(g))
+    out["backend"] = lin.backend  # type: ignore[assignment]
+    del JTJ
+    return out
 
 
 def work_iterations(size: str, max_iter: int) -> dict:
@@ -145,10 +158,12 @@ def work_iterations(size: str, max_iter: int) -> dict:
     m = measure(lambda: solve(prob, x0, method="lm", max_iter=max_iter, tol_rel=1e-10))
     res = m.value
     its = max(res.iterations, 1)
+    split["backend"] = split.get("backend", "")
     A, _ = normal_equations(prob, x0)
     return {"size": size, "unknowns": int(len(x0)), "rows": int(len(prob.residuals(x0))),
             "nnz_J": int(prob.assemble(x0).J.nnz), "nnz_A": int(A.nnz),
-            "seconds": m.seconds, "iterations": res.iterations, "s_per_it": m.seconds / its,
+            "seconds": m.seconds, "cpu_seconds": m.cpu_seconds, "iterations": res.iterations,
+            "s_per_it": m.seconds / its, "cpu_per_it": m.cpu_seconds / its,
             "peak_mb": m.peak_mb, "rss_peak_mb": m.rss_peak_mb, "energy0": res.energy0,
             "energy": res.energy, "message": res.message, "split": split}
 
@@ -469,12 +484,110 @@ def work_linear(size: str, method: str) -> dict:
             "seconds": m.seconds, "fill": fill, "residual": rel, "peak_mb": m.peak_mb}
 
 
+# ============================================================================ 3b. backends
+
+def _pardiso_available() -> bool:
+    try:
+        import pymklpardiso  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+def _backend_runs(name: str) -> tuple[Callable, Callable] | None:
+    """``(first(A, b), again(A, b))`` of a candidate backend: ``first`` analyses and factors,
+    ``again`` refactors the same pattern with new values (the analysis reused)."""
+    from gridshell.solver.linear import LinearSolver, available
+
+    if name in ("cholmod", "superlu"):
+        if not available(name):
+            return None
+        lin = LinearSolver(name)
+        return (lambda A, b: lin.factor(A)(b)), (lambda A, b: lin.factor(A)(b))
+    if name == "pardiso" and _pardiso_available():
+        import pymklpardiso as pm
+
+        state: dict[str, Any] = {}
+
+        def first(A: sp.csc_matrix, b: np.ndarray) -> np.ndarray:
+            U = sp.triu(A, format="csr")
+            U.sort_indices()
+            state["s"] = pm.PardisoSolver(U, pm.MTYPE_REAL_SYM_POSDEF)
+            return state["s"].solve(b)
+
+        def again(A: sp.csc_matrix, b: np.ndarray) -> np.ndarray:
+            U = sp.triu(A, format="csr")
+            U.sort_indices()
+            state["s"].refactor(U.data)
+            return state["s"].solve(b)
+
+        return first, again
+    return None
+
+
+#: candidates of the "analyse once, factor many" interface (gridshell.solver.linear)
+BACKEND_LABELS = {
+    "superlu": "SuperLU (scipy; MMD ordering cached, then NATURAL on the permuted matrix)",
+    "cholmod": "CHOLMOD supernodal (scikit-sparse 0.4.16, Debian libsuitesparse 5.12, OpenBLAS)",
+    "pardiso": "MKL PARDISO SPD (py-mkl-pardiso, optional: not a dependency)",
+}
+
+
+def work_backend(size: str, name: str) -> dict:
+    prob, x0 = grid_problem(SIZES[size])
+    A, b = normal_equations(prob, x0)
+    runs = _backend_runs(name)
+    if runs is None:
+        return {"size": size, "backend": name, "missing": True}
+    first, again = runs
+    m1 = measure(lambda: first(A, b))
+    A2 = A.copy()
+    A2.setdiag(A2.diagonal() * (1 + 1e-2))  # new values, same pattern (a rejected LM step)
+    b2 = A2 @ np.ones(len(b))
+    m2 = measure(lambda: again(A2, b2))
+    return {"size": size, "backend": name, "n": int(A.shape[0]), "nnz_A": int(A.nnz),
+            "first_s": m1.seconds, "first_cpu": m1.cpu_seconds,
+            "again_s": m2.seconds, "again_cpu": m2.cpu_seconds,
+            "residual": float(np.linalg.norm(A @ m1.value - b) / np.linalg.norm(b)),
+            "residual_again": float(np.linalg.norm(A2 @ m2.value - b2) / np.linalg.norm(b2)),
+            "peak_mb": max(m1.peak_mb, m2.peak_mb)}
+
+
+def section_backends(sizes: list[str], timeout: float) -> list[dict]:
+    print("3b. backends of gridshell.solver.linear on the same systems (each size and backend in "
+          "its own process): first = analysis + factorization + solve, again = numeric "
+          "refactorization of the same pattern + solve; wall s (CPU s, all threads)")
+    print(f"  {'size':>4} {'n':>7}  {'backend':<82} {'first':>16} {'again':>16} "
+          f"{'residual':>9} {'peak MB':>8}")
+    rows = []
+    for s in sizes:
+        for name, label in BACKEND_LABELS.items():
+            d = run_worker(SCRIPT, ["backend", s, name], timeout)
+            if d is None or "error" in d:
+                why = f"> {timeout:.0f} s (stopped)" if d is None else d["error"]
+                print(f"  {s:>4} {'':>7}  {label:<82} {why}")
+                continue
+            if d.get("missing"):
+                print(f"  {s:>4} {'':>7}  {label:<82} not installed")
+                continue
+            print(f"  {s:>4} {d['n']:>7}  {label:<82} "
+                  f"{d['first_s']:>7.3f} ({d['first_cpu']:>6.3f}) "
+                  f"{d['again_s']:>7.3f} ({d['again_cpu']:>6.3f}) "
+                  f"{max(d['residual'], d['residual_again']):>9.1e} {d['peak_mb']:>8.0f}")
+            rows.append(d)
+    return rows
+
+
 # ============================================================================ printing
 
 def section_iterations(sizes: list[str], iter_big: int, timeout: float) -> list[dict]:
-    print("1. Levenberg-Marquardt iterations (solve(method='lm')), GG-dome grid problem")
-    print(f"  {'size':>4} {'unknowns':>9} {'nnz(J)':>9} {'nnz(JTJ)':>9} {'its':>4} {'s/it':>7} "
-          f"{'total s':>8} {'peak MB':>8}   one iteration: assemble / J^T J / factor / solve [s]")
+    from gridshell.solver.linear import default_backend
+
+    print("1. Levenberg-Marquardt iterations (solve(method='lm')), GG-dome grid problem, linear "
+          f"solver {default_backend()}; wall s (CPU s, all threads)")
+    print(f"  {'size':>4} {'unknowns':>9} {'nnz(J)':>9} {'nnz(JTJ)':>9} {'its':>4} "
+          f"{'s/it':>16} {'total s':>8} {'peak MB':>8}   one iteration: assemble / J^T J / "
+          "first factor / refactor / solve [s wall (CPU)]")
     rows = []
     for s in sizes:
         max_iter = 100 if SIZES[s] < 100 else iter_big
@@ -483,10 +596,11 @@ def section_iterations(sizes: list[str], iter_big: int, timeout: float) -> list[
             print(f"  {s:>4}  {'timed out' if d is None else d['error']} (limit {timeout:.0f} s)")
             continue
         sp_ = d["split"]
+        parts = " / ".join(f"{sp_[k]:.3f} ({sp_[k + '_cpu']:.3f})" for k in
+                           ("assemble", "normal_eq", "first_factor", "factor", "backsolve"))
         print(f"  {s:>4} {d['unknowns']:>9} {d['nnz_J']:>9} {d['nnz_A']:>9} {d['iterations']:>4} "
-              f"{d['s_per_it']:>7.3f} {d['seconds']:>8.2f} {d['peak_mb']:>8.0f}   "
-              f"{sp_['assemble']:.3f} / {sp_['normal_eq']:.3f} / {sp_['factor']:.3f} / "
-              f"{sp_['backsolve']:.3f}"
+              f"{d['s_per_it']:>7.3f} ({d['cpu_per_it']:>6.3f}) {d['seconds']:>8.2f} "
+              f"{d['peak_mb']:>8.0f}   {parts}"
               + (f"  (capped at {max_iter} iterations)" if max_iter < 100 else ""))
         rows.append(d)
     return rows
@@ -572,6 +686,8 @@ def main(argv: list[str] | None = None) -> dict[str, list[dict]]:
     ap.add_argument("--lsq-1e5-problems", nargs="+", default=["dome", "gg_round"],
                     choices=list(PROBLEMS), help="problems also compared at 1e5 (~2 min each)")
     ap.add_argument("--linear-sizes", nargs="+", default=["1e3", "1e4"], choices=list(SIZES))
+    ap.add_argument("--backend-sizes", nargs="+", default=["1e3", "1e4", "1e5"],
+                    choices=list(SIZES))
     ap.add_argument("--iter-1e5", type=int, default=3,
                     help="iteration cap of the 1e5 run of section 1 (about 12 s each)")
     ap.add_argument("--lsq-cap", type=float, default=300.0,
@@ -592,6 +708,8 @@ def main(argv: list[str] | None = None) -> dict[str, list[dict]]:
                                                      big_problems=a.lsq_1e5_problems)
     if "linear" in a.section:
         out["linear"] = section_linear(a.linear_sizes, a.linear_timeout)
+    if "backends" in a.section:
+        out["backends"] = section_backends(a.backend_sizes, timeout=300)
     if "pipelines" in a.section:
         out["pipelines"] = section_pipelines(a.pipelines, timeout=1800, budget=a.budget)
     if a.json:
@@ -607,6 +725,8 @@ def worker(args: list[str]) -> None:
         d = work_least_squares(args[1], args[2], args[3].split(","), float(args[4]))
     elif kind == "linear":
         d = work_linear(size, args[2])
+    elif kind == "backend":
+        d = work_backend(size, args[2])
     elif kind == "pipeline":
         d = work_pipeline(args[1], float(args[2]))
     else:

@@ -36,6 +36,25 @@ def _available() -> dict[str, object]:
     return mods
 
 
+class _Version(argparse.Action):
+    """``--version``: the package's version and the linear solver in use (looked up when asked)."""
+
+    def __init__(self, option_strings: Sequence[str], dest: str = argparse.SUPPRESS,
+                 default: str = argparse.SUPPRESS,
+                 help: str = "show the version and the linear solver in use, and exit") -> None:
+        super().__init__(option_strings, dest=dest, default=default, nargs=0, help=help)
+
+    def __call__(self, parser, namespace, values, option_string=None):  # noqa: ANN001
+        from ..solver.linear import describe
+
+        try:
+            lin = describe()
+        except GridshellError as exc:
+            lin = f"unavailable: {exc}"
+        sys.stdout.write(f"gridshell {__version__}\nlinear solver: {lin}\n")
+        parser.exit()
+
+
 def build_parser(commands: Iterable[str] | None = None) -> argparse.ArgumentParser:
     """The argument parser of the ``gridshell`` command.
 
@@ -46,7 +65,7 @@ def build_parser(commands: Iterable[str] | None = None) -> argparse.ArgumentPars
     parser = argparse.ArgumentParser(
         prog="gridshell",
         description="Design alignable lamella gridshells: from a target surface to cut files.")
-    parser.add_argument("--version", action="version", version=f"gridshell {__version__}")
+    parser.add_argument("--version", action=_Version)
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     wanted = None if commands is None else set(commands)
     for name, mod in _available().items():

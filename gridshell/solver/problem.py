@@ -43,6 +43,7 @@ class Problem:
 
     layout: Layout
     entries: list[Entry] = field(default_factory=list)
+    _csr: Any = field(default=None, init=False, repr=False, compare=False)
 
     def add(self, name: str, weight: float, fn: TermFn, data: Any = None) -> "Problem":
         """Add term ``fn`` with ``data`` and ``weight`` under ``name``; returns ``self``.
@@ -101,11 +102,28 @@ class Problem:
             off += m
         r = np.concatenate(rs) if rs else np.zeros(0)
         if jacobian and rows:
-            J = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                              shape=(off, self.layout.size))
+            J = self._to_csr(np.concatenate(rows), np.concatenate(cols), np.concatenate(vals),
+                             (off, self.layout.size))
         else:
             J = sp.csr_matrix((off, self.layout.size))
         return Assembled(r, J, slices)
+
+    def _to_csr(self, rows: np.ndarray, cols: np.ndarray, vals: np.ndarray,
+                shape: tuple[int, int]) -> sp.csr_matrix:
+        """CSR from COO triplets (duplicates summed, explicit zeros kept). The structure and
+        each triplet's slot are kept while the triplets' rows and columns stay the same (every
+        iteration of a solve), so later calls only sum the values into place."""
+        c = self._csr
+        if c is None or c[0] != shape or not (np.array_equal(c[1], rows)
+                                              and np.array_equal(c[2], cols)):
+            key = rows.astype(np.int64) * shape[1] + cols
+            uniq, slot = np.unique(key, return_inverse=True)
+            indptr = np.zeros(shape[0] + 1, dtype=np.int64)
+            np.cumsum(np.bincount(uniq // shape[1], minlength=shape[0]), out=indptr[1:])
+            c = self._csr = (shape, rows.copy(), cols.copy(), indptr, uniq % shape[1], slot)
+        _, _, _, indptr, indices, slot = c
+        data = np.bincount(slot, weights=vals, minlength=len(indices))
+        return sp.csr_matrix((data, indices.copy(), indptr.copy()), shape=shape)
 
     def energy(self, x: np.ndarray) -> float:
         """Total energy ``sum_k w_k |r_k|^2``."""

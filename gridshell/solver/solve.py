@@ -2,7 +2,9 @@
 
 ``(J^T J + lambda D) dx = -J^T r`` with fixed damping ("guided projection", Tang et al. 2014)
 or adaptive damping with accept/reject (Levenberg-Marquardt); fixed variables are removed as
-columns. The factorization is done once per iteration.
+columns. ``J^T J`` keeps one pattern for the whole solve (:mod:`.normal`) and the linear solver
+(:mod:`.linear`) analyses that pattern once and refactors it numerically per iteration and per
+rejected step.
 """
 from __future__ import annotations
 
@@ -15,6 +17,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..errors import ConvergenceError, InputError
+from .linear import LinearSolver, NotPositiveDefinite, shared_solver
+from .normal import NormalEquations
 from .problem import Problem
 
 Method = Literal["lm", "gn", "guided"]
@@ -71,12 +75,13 @@ def _free_columns(n: int, fixed: np.ndarray | None) -> np.ndarray:
 
 
 def factorized(A: sp.csc_matrix) -> Callable[[np.ndarray], np.ndarray]:
-    """A solver for the symmetric positive definite ``A``; factors once.
+    """A one-shot SuperLU solver for the symmetric positive definite ``A`` (no cache).
 
     SuperLU in symmetric mode: MMD ordering of ``A^T + A`` and diagonal pivots only
     (``diag_pivot_thresh=0``, safe for the damped normal equations, which are SPD). With
     SuperLU's default partial pivoting, off-diagonal pivots destroy the ordering and the fill
     grows 10-20x on stiff problems; see benchmarks/solver.py for the measured choice.
+    :func:`solve` uses :class:`~.linear.LinearSolver` instead (the analysis cached).
     """
     lu = spla.splu(sp.csc_matrix(A), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
                    options={"SymmetricMode": True})
@@ -87,7 +92,8 @@ def solve(problem: Problem, x0: np.ndarray, *, fixed: np.ndarray | None = None,
           method: Method = "lm", max_iter: int = 100, damping: float = 1e-3,
           tol_energy: float = 1e-20, tol_rel: float = 1e-10, tol_step: float = 1e-12,
           tol_grad: float = 1e-14, callback: Callable[[dict], None] | None = None,
-          time_limit: float | None = None) -> SolveResult:
+          time_limit: float | None = None,
+          linear: LinearSolver | str | None = None) -> SolveResult:
     """Minimize ``problem``'s energy from ``x0``.
 
     Parameters
@@ -105,6 +111,9 @@ def solve(problem: Problem, x0: np.ndarray, *, fixed: np.ndarray | None = None,
     tol_grad : stop when max |J^T r| falls below this
     callback : called with each history record (progress reporting)
     time_limit : seconds; stop (not converged) when exceeded
+    linear : the linear solver: a :class:`~.linear.LinearSolver`, a backend name
+        ("cholmod", "superlu") or None for the process-wide one of the default backend
+        (``$GRIDSHELL_LINEAR`` or the first available, see :mod:`.linear`)
     """
     if method not in ("lm", "gn", "guided"):
         raise InputError(f"unknown method {method!r}; use 'lm', 'gn' or 'guided'")
@@ -114,6 +123,8 @@ def solve(problem: Problem, x0: np.ndarray, *, fixed: np.ndarray | None = None,
     if not np.all(np.isfinite(x)):
         raise InputError("x0 has NaN or infinite entries; check the initial geometry")
     free = _free_columns(len(x), fixed)
+    lin = linear if isinstance(linear, LinearSolver) else shared_solver(linear)
+    ne = NormalEquations()
     t0 = time.perf_counter()
     a = problem.assemble(x)
     E = a.energy()
@@ -128,20 +139,19 @@ def solve(problem: Problem, x0: np.ndarray, *, fixed: np.ndarray | None = None,
         if E <= tol_energy:
             message, converged, it = "energy below tolerance", True, it - 1
             break
-        J = (a.J if len(free) == len(x) else a.J[:, free]).tocsc()  # no copy if none fixed
+        J = a.J if len(free) == len(x) else a.J[:, free]  # CSR; no copy if none fixed
         g = J.T @ a.r
         if np.max(np.abs(g), initial=0.0) <= tol_grad:
             message, converged, it = "gradient below tolerance", True, it - 1
             break
-        JTJ = (J.T @ J).tocsc()
-        diag = JTJ.diagonal()
+        JTJ = ne.update(J)
+        diag = ne.diagonal()
         scale = float(np.mean(diag)) if diag.size and np.mean(diag) > 0 else 1.0
         accepted = False
         while True:
-            A = JTJ + sp.identity(len(free), format="csc") * (lam * scale)
             try:
-                dx = -factorized(A)(g)
-            except RuntimeError:  # singular: raise damping
+                dx = -lin.factor(ne.damped(lam * scale), ne.key)(g)
+            except NotPositiveDefinite:  # singular: raise damping
                 lam *= 10.0
                 if lam > 1e16:
                     message = ("linear system singular at every damping (non-finite Jacobian "
