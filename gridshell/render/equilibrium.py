@@ -37,8 +37,8 @@ def render_equilibrium(path: str | os.PathLike, design_axes: Sequence[np.ndarray
     """Write a PNG of the equilibrium (``eq_axes``, ``eq_joints``, metres) over the design
     (``design_axes``, ``joints``); ``deviation (n,)`` % colours the joints; ``supports`` are
     drawn as triangles; ``factor`` exaggerates the displacements (default
-    :func:`exaggeration`). The design axes are matched to the equilibrium ones by order; an
-    equilibrium axis is displaced from its own design polyline by interpolation in arc length.
+    :func:`exaggeration`). ``design_axes[i]`` and ``eq_axes[i]`` are the same nodes of
+    lamella ``i`` in the design and at equilibrium.
     """
     from matplotlib import colormaps
     from matplotlib.colors import Normalize
@@ -69,7 +69,7 @@ def render_equilibrium(path: str | os.PathLike, design_axes: Sequence[np.ndarray
                    depthshade=False)
     ax.view_init(elev=elev, azim=azim)
     ax.set_axis_off()
-    _fit_view(fig, ax, pts)
+    _fit_view(fig, ax, pts, fill=0.85)
     from matplotlib.cm import ScalarMappable
 
     cax = fig.add_axes((0.9, 0.15, 0.02, 0.6))
@@ -87,13 +87,7 @@ def render_equilibrium(path: str | os.PathLike, design_axes: Sequence[np.ndarray
 
 
 def _exaggerate(a0: np.ndarray, a1: np.ndarray, f: float) -> np.ndarray:
-    """The equilibrium polyline ``a1`` with its displacement from ``a0`` scaled by ``f``."""
+    """The equilibrium polyline ``a1`` with its displacement from ``a0`` (the same nodes in the
+    design) scaled by ``f``."""
     a0, a1 = np.asarray(a0, float), np.asarray(a1, float)
-    if f == 1.0:
-        return a1
-
-    def s(P):
-        d = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(P, axis=0), axis=1))])
-        return d / max(d[-1], 1e-300)
-    base = np.stack([np.interp(s(a1), s(a0), a0[:, c]) for c in range(3)], axis=1)
-    return base + f * (a1 - base)
+    return a0 + f * (a1 - a0)

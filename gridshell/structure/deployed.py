@@ -221,7 +221,7 @@ def build_model(bundle, material: Material, section: Section, *,
         th = rod.frame_angle(a, T, d1)
         # rest state
         k = len(P)
-        wbar, mbar = np.zeros((k - 2, 2, 2)), np.zeros(k - 2)
+        wbar, mbar = np.zeros((k - 2, 2)), np.zeros(k - 2)
         if tangent:
             rests.add("straight strips")
         else:

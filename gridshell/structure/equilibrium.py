@@ -49,6 +49,7 @@ class Equilibrium:
 
     joints : (n,3) joint positions at equilibrium, design metres (the bundle's units)
     axes : per lamella its rod nodes at equilibrium, design metres
+    axes0 : the same nodes in the design
     deviation : (n,) distance of each joint from the design, % of the design's bbox diagonal
     reactions : (k,3) support forces on the model, N, for the joints ``supports``
     energy : stored energy by part (stretch, bend, twist, joints), J, and "elastic" the sum
@@ -60,6 +61,7 @@ class Equilibrium:
     result: NewtonResult
     joints: np.ndarray
     axes: list[np.ndarray]
+    axes0: list[np.ndarray]
     deviation: np.ndarray
     reactions: np.ndarray
     supports: np.ndarray
@@ -74,8 +76,7 @@ def node_stresses(net: RodNetwork, q: np.ndarray, material, section) -> dict[str
     (:func:`gridshell.structure.stresses.strip_stresses`)."""
     V = Jet.variables(q[net.bend_idx], 0)
     d = net.bend_data()
-    w1, w2 = rod.curvature_deviation(V, d)
-    m = rod.twist_angles(V, d)
+    w1, w2, m = rod.strains(V, d)
     half = 0.5 * d.lbar
     weak, strong, twist = w2.v / half, w1.v / half, m.v / half
     sigma = material.E * (np.abs(weak) * section.thickness + np.abs(strong) * section.width) / 2
@@ -180,7 +181,8 @@ def simulate(bundle, material, section, *, supports: str | np.ndarray = "boundar
         "cpu_s": time.process_time() - c0,
     }
     axes = [P[n] / sc for n in model.lamella_nodes]
-    return Equilibrium(model, res, Jeq, axes, dev, R, model.supports, energy, stresses, figures)
+    axes0 = [net.X[n] / sc for n in model.lamella_nodes]
+    return Equilibrium(model, res, Jeq, axes, axes0, dev, R, model.supports, energy, stresses, figures)
 
 
 def joint_mismatch(net: RodNetwork, q: np.ndarray) -> float:

@@ -49,14 +49,17 @@ def _factor_pd(A: sp.csc_matrix):
 
 
 def minimize(fun: EnergyFn, q0: np.ndarray, free: np.ndarray, *, gtol: float,
-             max_iter: int = 200, accept: Callable[[np.ndarray], None] | None = None,
+             etol: float = 1e-13, max_iter: int = 200, accept: Callable[[np.ndarray], None] | None = None,
              time_limit: float | None = None) -> NewtonResult:
     """Minimize ``fun`` from ``q0`` over the variables ``free`` (boolean mask).
 
     ``fun(q, order)`` returns ``(E, g, H)``: the energy, its gradient ``(n,)`` (order >= 1) and
     its sparse Hessian ``(n, n)`` (order 2). ``accept(q)`` is called after every accepted step
-    (the rods re-base their reference frames there). ``gtol``: largest free gradient component
-    at convergence, in the units of the gradient.
+    (the rods re-base their reference frames there). Converged when the largest free gradient
+    component is at most ``gtol`` (in the gradient's units), or when the Newton decrement
+    ``g^T H^-1 g / 2`` (the energy still to gain) is at most ``etol |E|`` with an unshifted,
+    positive definite Hessian (the gradient's round-off floor is reached first on stiff,
+    lightly loaded rods).
     """
     q = np.array(q0, float)
     idx = np.flatnonzero(free)
@@ -87,6 +90,10 @@ def minimize(fun: EnergyFn, q0: np.ndarray, free: np.ndarray, *, gtol: float,
             break
         dq = -solve(gf)
         slope = float(gf @ dq)
+        if shift == 0.0 and -0.5 * slope <= etol * max(abs(E), 1e-300):
+            # Newton decrement: the energy is within etol of its minimum (relative)
+            message, converged = "Newton decrement below tolerance", True
+            break
         alpha, taken = 1.0, False
         for _ in range(40):
             qn = q.copy()
@@ -118,14 +125,14 @@ def minimize(fun: EnergyFn, q0: np.ndarray, free: np.ndarray, *, gtol: float,
         if mu < 1e-10:
             mu = 0.0
         hist.append({"it": it, "energy": E, "grad": gmax, "shift": shift, "alpha": alpha,
-                     "time": time.perf_counter() - t0})
+                     "decrement": -0.5 * slope, "time": time.perf_counter() - t0})
         if time_limit is not None and time.perf_counter() - t0 > time_limit:
             message = f"time limit of {time_limit:g} s reached"
             break
     else:
         it = max_iter
     gmax = float(np.max(np.abs(g[idx]), initial=0.0))
-    if gmax <= gtol:
+    if gmax <= gtol and not converged:
         converged, message = True, "gradient below tolerance"
     return NewtonResult(q=q, converged=converged, message=message, iterations=it, energy=E,
                         grad=gmax, history=hist)

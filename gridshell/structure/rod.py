@@ -11,10 +11,15 @@ Energies (each a stencil function of :class:`~gridshell.structure.jet.Jet` varia
 gradient and Hessian are exact):
 
 - stretching, per edge: ``1/2 EA (|e|/|e_bar| - 1)^2 |e_bar|``;
-- bending, per interior vertex ``i`` (Bergou eq. 3-4): ``1/l_bar_i sum_{j=i-1,i} 1/2
-  (w_i^j - w_bar_i^j)^T diag(B1_j, B2_j) (w_i^j - w_bar_i^j)`` with the curvature binormal
-  ``kb_i = 2 e_{i-1} x e_i / (|e_{i-1}||e_i| + e_{i-1}.e_i)`` and the material curvatures
-  ``w_i^j = (kb_i . m2_j, -kb_i . m1_j)``, ``l_bar_i = |e_bar_{i-1}| + |e_bar_i|``.
+- bending, per interior vertex ``i`` (Bergou eq. 3-4): ``1/l_bar_i (w_i - w_bar_i)^T
+  diag(B1_i, B2_i) (w_i - w_bar_i)`` with the curvature binormal ``kb_i = 2 e_{i-1} x e_i /
+  (|e_{i-1}||e_i| + e_{i-1}.e_i)``, ``l_bar_i = |e_bar_{i-1}| + |e_bar_i|``, the stiffnesses the
+  mean of the two edges' and the material curvatures ``w_i = (kb_i . m2_i, -kb_i . m1_i)``
+  taken against the mean ``m_i = (m_{i-1} + m_i) / 2`` of the two edges' directors. (Bergou's
+  sum over the two edges' own directors reads a strip twisting at the rate ``tau`` as bent
+  about its strong axis by ``h tau / 2`` per unit curvature; with a strip's ``(w/t)^2`` stiffness
+  ratio that is first-order error in the energy that matters (+7 % on a 60-element helix,
+  tests/test_structure_rod.py); the mean directors make it second order.)
   ``w1`` bends the axis towards the width direction ``m1`` (strong axis, ``B1 = E t w^3/12``),
   ``w2`` towards the thickness direction ``m2`` (weak axis, ``B2 = E w t^3/12``);
 - twisting, per interior vertex (Bergou eq. 5): ``GJ (m_i - m_bar_i)^2 / l_bar_i`` with
@@ -65,20 +70,21 @@ def bishop_frame(X: np.ndarray, a0: np.ndarray | None = None) -> np.ndarray:
 
 
 def frame_angle(a1: np.ndarray, t: np.ndarray, d1: np.ndarray) -> np.ndarray:
-    """Angles ``theta (k,)`` turning reference directors ``a1`` about tangents ``t`` onto the
-    projections of ``d1 (k,3)`` (the wanted width directions)."""
+    """Angles ``theta (k,)`` turning the reference directors ``a1`` of consecutive edges about
+    their tangents ``t`` onto the projections of ``d1 (k,3)`` (the wanted width directions),
+    unwrapped along the edges (no jumps of 2 pi: the twist between edges is their difference)."""
     d = unit(d1 - np.sum(d1 * t, axis=-1, keepdims=True) * t)
     a2 = np.cross(t, a1)
-    return np.arctan2(np.sum(d * a2, axis=-1), np.sum(d * a1, axis=-1))
+    return np.unwrap(np.arctan2(np.sum(d * a2, axis=-1), np.sum(d * a1, axis=-1)))
 
 
 def material_curvatures(X: np.ndarray, d1: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Material curvatures of a polyline ``X (n,3)`` whose edges carry width directions
-    ``d1 (n-1,3)``: ``w (n-2, 2, 2)`` (vertex, edge j = i-1 / i, (w1, w2)) and the twist
-    ``m (n-2,)`` of the material frame, radians (the rest state of a rod)."""
+    ``d1 (n-1,3)``: ``w (n-2, 2)`` (vertex, (w1, w2)) and the twist ``m (n-2,)`` of the material
+    frame, radians (the rest state of a rod; formulas of :func:`bend_twist`)."""
     X = np.asarray(X, float)
     if len(X) < 3:
-        return np.zeros((0, 2, 2)), np.zeros(0)
+        return np.zeros((0, 2)), np.zeros(0)
     T = unit(np.diff(X, axis=0))
     a1 = bishop_frame(X)
     th = frame_angle(a1, T, d1)
@@ -86,15 +92,12 @@ def material_curvatures(X: np.ndarray, d1: np.ndarray) -> tuple[np.ndarray, np.n
     e0, e1 = e[:-1], e[1:]
     le0, le1 = np.linalg.norm(e0, axis=1), np.linalg.norm(e1, axis=1)
     kb = 2 * np.cross(e0, e1) / (le0 * le1 + np.sum(e0 * e1, axis=1))[:, None]
-    w = np.empty((len(kb), 2, 2))
-    for j, sl in enumerate((slice(0, -1), slice(1, None))):
-        t, a, c, s = T[sl], a1[sl], np.cos(th[sl])[:, None], np.sin(th[sl])[:, None]
-        a2 = np.cross(t, a)
-        m1, m2 = c * a + s * a2, -s * a + c * a2
-        w[:, j, 0] = np.sum(kb * m2, axis=1)
-        w[:, j, 1] = -np.sum(kb * m1, axis=1)
-    dth = np.diff(th)  # Bishop frame: no reference twist
-    return w, np.arctan2(np.sin(dth), np.cos(dth))
+    c, s = np.cos(th)[:, None], np.sin(th)[:, None]
+    a2 = np.cross(T, a1)
+    m1, m2 = c * a1 + s * a2, -s * a1 + c * a2
+    m1, m2 = 0.5 * (m1[:-1] + m1[1:]), 0.5 * (m2[:-1] + m2[1:])
+    w = np.stack([np.sum(kb * m2, axis=1), -np.sum(kb * m1, axis=1)], axis=1)
+    return w, np.diff(th)  # Bishop frame: no reference twist
 
 
 # ---------------------------------------------------------------------------------------------
@@ -146,8 +149,8 @@ class BendTwistData(NamedTuple):
     """Per interior vertex (edges j = 0: before it, 1: after it):
 
     a_old, t_old : (B, 2, 3) stored reference directors and tangents of the two edges
-    wbar : (B, 2, 2) rest material curvatures (edge j, (w1, w2))
-    B1, B2 : (B, 2) bending stiffness of each edge towards m1 (strong) and m2 (weak), N m^2
+    wbar : (B, 2) rest material curvatures (w1, w2)
+    B1, B2 : (B,) bending stiffness towards m1 (strong) and m2 (weak), N m^2
     GJ : (B,) torsional stiffness, N m^2
     mbar : (B,) rest twist, radians
     lbar : (B,) rest length |e_bar_{i-1}| + |e_bar_i|, m
@@ -168,29 +171,37 @@ def _curvature_binormal(e0: Jet, e1: Jet) -> Jet:
     return cross(e0, e1) * (den.reciprocal() * 2.0).expand()
 
 
+def _frames(V: list[Jet], d: BendTwistData):
+    e0, e1 = _vec(V, 1) - _vec(V, 0), _vec(V, 2) - _vec(V, 1)
+    t0, t1 = e0 * norm(e0).reciprocal().expand(), e1 * norm(e1).reciprocal().expand()
+    f0 = _material(d.a_old[:, 0], d.t_old[:, 0], t0, V[9])
+    f1 = _material(d.a_old[:, 1], d.t_old[:, 1], t1, V[10])
+    return e0, e1, t0, t1, f0, f1
+
+
+def _curvatures(e0: Jet, e1: Jet, f0, f1, d: BendTwistData) -> tuple[Jet, Jet]:
+    kb = _curvature_binormal(e0, e1)
+    m1, m2 = (f0[1] + f1[1]) * 0.5, (f0[2] + f1[2]) * 0.5
+    return dot(kb, m2) - d.wbar[:, 0], -dot(kb, m1) - d.wbar[:, 1]
+
+
+def _twist(t0: Jet, t1: Jet, f0, f1, V: list[Jet], d: BendTwistData) -> Jet:
+    u = _jet_transport_var(f0[0], t0, t1)
+    mref = atan2(dot(cross(u, f1[0]), t1), dot(u, f1[0]))
+    return V[10] - V[9] + mref - d.mbar
+
+
 def bend_twist(V: list[Jet], d: BendTwistData, bend: bool = True,
                twist: bool = True) -> tuple[Jet | None, Jet | None]:
     """Bending and twisting energies at interior vertices (variables x0, x1, x2, theta0,
-    theta1), J (Bergou 2008, eqs. 3-5)."""
-    e0, e1 = _vec(V, 1) - _vec(V, 0), _vec(V, 2) - _vec(V, 1)
-    t0, t1 = e0 * norm(e0).reciprocal().expand(), e1 * norm(e1).reciprocal().expand()
-    a10, m10, m20 = _material(d.a_old[:, 0], d.t_old[:, 0], t0, V[9])
-    a11, m11, m21 = _material(d.a_old[:, 1], d.t_old[:, 1], t1, V[10])
+    theta1), J (Bergou 2008, eqs. 3-5; module docstring)."""
+    e0, e1, t0, t1, f0, f1 = _frames(V, d)
     Eb = Et = None
     if bend:
-        kb = _curvature_binormal(e0, e1)
-        Eb = None
-        for j, (m1, m2) in enumerate(((m10, m20), (m11, m21))):
-            w1 = dot(kb, m2) - d.wbar[:, j, 0]
-            w2 = -dot(kb, m1) - d.wbar[:, j, 1]
-            term = w1.square() * d.B1[:, j] + w2.square() * d.B2[:, j]
-            Eb = term if Eb is None else Eb + term
-        Eb = Eb * (0.5 / d.lbar)
+        w1, w2 = _curvatures(e0, e1, f0, f1, d)
+        Eb = (w1.square() * d.B1 + w2.square() * d.B2) * (1.0 / d.lbar)
     if twist:
-        u = _jet_transport_var(a10, t0, t1)
-        mref = atan2(dot(cross(u, a11), t1), dot(u, a11))
-        m = V[10] - V[9] + mref - d.mbar
-        Et = m.square() * (d.GJ / d.lbar)
+        Et = _twist(t0, t1, f0, f1, V, d).square() * (d.GJ / d.lbar)
     return Eb, Et
 
 
@@ -204,28 +215,13 @@ def twist_energy(V: list[Jet], d: BendTwistData) -> Jet:
     return bend_twist(V, d, bend=False)[1]
 
 
-def twist_angles(V: list[Jet], d: BendTwistData) -> Jet:
-    """The discrete twist ``m_i - m_bar_i`` at interior vertices, radians (values only)."""
-    e0, e1 = _vec(V, 1) - _vec(V, 0), _vec(V, 2) - _vec(V, 1)
-    t0, t1 = e0 * norm(e0).reciprocal().expand(), e1 * norm(e1).reciprocal().expand()
-    a10, _, _ = _material(d.a_old[:, 0], d.t_old[:, 0], t0, V[9])
-    a11, _, _ = _material(d.a_old[:, 1], d.t_old[:, 1], t1, V[10])
-    u = _jet_transport_var(a10, t0, t1)
-    mref = atan2(dot(cross(u, a11), t1), dot(u, a11))
-    return V[10] - V[9] + mref - d.mbar
-
-
-def curvature_deviation(V: list[Jet], d: BendTwistData) -> tuple[Jet, Jet]:
-    """Mean over the two edges of ``w1 - w1_bar`` and ``w2 - w2_bar`` at interior vertices
-    (integrated curvatures, radians; values only): strong- and weak-axis bending."""
-    e0, e1 = _vec(V, 1) - _vec(V, 0), _vec(V, 2) - _vec(V, 1)
-    t0, t1 = e0 * norm(e0).reciprocal().expand(), e1 * norm(e1).reciprocal().expand()
-    _, m10, m20 = _material(d.a_old[:, 0], d.t_old[:, 0], t0, V[9])
-    _, m11, m21 = _material(d.a_old[:, 1], d.t_old[:, 1], t1, V[10])
-    kb = _curvature_binormal(e0, e1)
-    w1 = (dot(kb, m20) - d.wbar[:, 0, 0] + dot(kb, m21) - d.wbar[:, 1, 0]) * 0.5
-    w2 = (-dot(kb, m10) - d.wbar[:, 0, 1] - dot(kb, m11) - d.wbar[:, 1, 1]) * 0.5
-    return w1, w2
+def strains(V: list[Jet], d: BendTwistData) -> tuple[Jet, Jet, Jet]:
+    """Integrated curvature changes ``w1 - w1_bar`` (strong axis), ``w2 - w2_bar`` (weak
+    axis) and twist ``m - m_bar`` at interior vertices, radians (divide by ``l_bar / 2`` for
+    curvatures in 1/m)."""
+    e0, e1, t0, t1, f0, f1 = _frames(V, d)
+    w1, w2 = _curvatures(e0, e1, f0, f1, d)
+    return w1, w2, _twist(t0, t1, f0, f1, V, d)
 
 
 class JointData(NamedTuple):

@@ -22,7 +22,7 @@ from .jet import Jet
 class RodSpec:
     """One rod: ``nodes (k,)`` global node indices; per edge ``(k-1,)`` rest length ``lbar`` (m),
     ``EA`` (N), ``B1`` strong / ``B2`` weak bending stiffness (N m^2), ``GJ`` (N m^2) and
-    ``mass`` per length (kg/m); per interior vertex ``wbar (k-2, 2, 2)`` rest material
+    ``mass`` per length (kg/m); per interior vertex ``wbar (k-2, 2)`` rest material
     curvatures and ``mbar (k-2,)`` rest twist (radians); ``width``/``thickness`` of the section
     (m, for stresses; 0 when not a strip)."""
 
@@ -106,7 +106,7 @@ class RodNetwork:
                 ve.append(np.stack([np.arange(a, b - 1), np.arange(a + 1, b)], 1))
         self.vert_nodes = np.concatenate(vi) if vi else np.zeros((0, 3), np.int64)
         self.vert_edges = np.concatenate(ve) if ve else np.zeros((0, 2), np.int64)
-        self.wbar = np.concatenate([np.asarray(r.wbar, float).reshape(-1, 2, 2)
+        self.wbar = np.concatenate([np.asarray(r.wbar, float).reshape(-1, 2)
                                     for r in self.rods])
         self.mbar = np.concatenate([np.asarray(r.mbar, float).reshape(-1) for r in self.rods])
         if len(self.wbar) != len(self.vert_nodes) or len(self.mbar) != len(self.vert_nodes):
@@ -154,7 +154,8 @@ class RodNetwork:
     # -- stencil data -------------------------------------------------------------------------
     def bend_data(self) -> rod.BendTwistData:
         ve = self.vert_edges
-        return rod.BendTwistData(self.a1[ve], self.tref[ve], self.wbar, self.B1[ve], self.B2[ve],
+        return rod.BendTwistData(self.a1[ve], self.tref[ve], self.wbar, self.B1[ve].mean(1),
+                                 self.B2[ve].mean(1),
                                  0.5 * self.GJ[ve].sum(1), self.mbar, self.lbar[ve].sum(1))
 
     def joint_data(self) -> rod.JointData:
