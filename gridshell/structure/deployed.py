@@ -234,6 +234,14 @@ def build_model(bundle, material: Material, section: Section, *,
                 sign = 1.0 if np.sum(wr[..., 0] * wd[..., 0]) >= 0 else -1.0
                 wbar[..., 0] = sign * wr[..., 0]
                 rests.add(f"collapse curve ({bundle.collapse.shape})")
+            elif k >= 3 and bundle.collapse is not None and bundle.collapse.shape == "circle" \
+                    and bundle.collapse.radius:
+                # a CNC bundle without collapse_s: every strip is an arc of the circle
+                wd, _ = rod.material_curvatures(P, d1)
+                sign = 1.0 if np.sum(wd[..., 0]) >= 0 else -1.0
+                lb = seg[:-1] + seg[1:]
+                wbar[..., 0] = sign * 2.0 * np.tan(lb / (4.0 * bundle.collapse.radius * scale))
+                rests.add("collapse curve (circle)")
             elif k >= 3:
                 wd, _ = rod.material_curvatures(P, d1)
                 wbar[..., 0] = wd[..., 0]
