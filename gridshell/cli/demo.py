@@ -90,9 +90,34 @@ def _finish(d: Path, label: str, name: str, fab_params: dict, progress) -> dict[
     progress(f"{label}: cut files ({fab_params['scale']}, {fab_params['thickness']:g} mm "
              "polypropylene)")
     fab = fabricate(d, d / "fabrication", fab_params, progress=progress.detail)
+    fab = dict(fab, structure=_structure(d, label, fab_params, progress))
     progress(f"{label}: writing report.html")
     write_report(d)
     return fab
+
+
+def _structure(d: Path, label: str, fab_params: dict, progress) -> dict[str, Any]:
+    """``gridshell check`` of the cut strips in polypropylene: structure.json and .png."""
+    from fabrication.params import parse_scale
+
+    from ..render.structure import PICTURE, render_utilisation
+    from ..structure import Section, get_material
+    from ..structure.check import check_bundle, write_structure_json
+
+    progress(f"{label}: stresses in the strips (structure.json, {PICTURE})")
+    sec = Section(fab_params["width"], fab_params["thickness"], parse_scale(fab_params["scale"]))
+    res = check_bundle(d, get_material("pp"), sec)
+    write_structure_json(d, res)
+    render_utilisation(d, res, d / PICTURE)
+    return {k: res[k] for k in ("verdict", "max_utilisation", "max_utilisation_deployed",
+                                "governing_state", "max_elastic_thickness_mm")}
+
+
+def _strength(fab: dict) -> str:
+    s = fab["structure"]
+    return (f"{s['verdict']}: max utilisation {s['max_utilisation_deployed']:.2f} deployed, "
+            f"{s['max_utilisation']:.2f} governing ({s['governing_state']}); elastic up to "
+            f"{s['max_elastic_thickness_mm']:.2f} mm thick (gridshell check)")
 
 
 def _gg(root: Path, sizes: dict, progress) -> dict[str, Any]:
@@ -208,6 +233,7 @@ def _summary(out: Path, gg: dict | None, ncp: dict | None, total: float) -> dict
                              f"{gg['sequence_length_error']:.2g} % of the deployed net")
         s["GG paper thresholds"] = gg["checks"]
         s["GG cut files"] = _sheets(gg["fabrication"])
+        s["GG strips 1 mm pp"] = _strength(gg["fabrication"])
     if ncp is not None:
         s["CNC pavilion"] = (f"{out / 'ncp'}/ (report.html, render.png, alignment.gif, "
                              "ncp.3dm, fabrication/)")
@@ -226,6 +252,7 @@ def _summary(out: Path, gg: dict | None, ncp: dict | None, total: float) -> dict
                               f"{ncp['sequence_length_error']:.2g} % of the deployed net")
         s["CNC paper thresholds"] = ncp["checks"]
         s["CNC cut files"] = _sheets(ncp["fabrication"])
+        s["CNC strips 1 mm pp"] = _strength(ncp["fabrication"])
     s["verified from the files"] = "yes" if all(
         r["verified"] for r in (gg, ncp) if r is not None) else "NO: stored and recomputed differ"
     s["time [s]"] = {**({"gg": gg["time"]} if gg else {}), **({"ncp": ncp["time"]} if ncp else {}),
@@ -241,7 +268,7 @@ def _nested(summary: dict, gg: dict | None, ncp: dict | None) -> dict[str, Any]:
         keep = {k: v for k, v in r.items() if k not in ("dir", "fabrication")}
         f = r["fabrication"]
         keep["fabrication"] = {k: f[k] for k in ("n_strips", "n_pieces", "n_sheets", "shape",
-                                                  "utilisation")}
+                                                  "utilisation", "structure")}
         return keep
 
     return {"summary": summary, "gg": part(gg), "ncp": part(ncp)}

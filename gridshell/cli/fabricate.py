@@ -64,6 +64,9 @@ def add_args(p: argparse.ArgumentParser) -> None:
     g.add_argument("--segments", action="store_true",
                    help="write arcs as short segments instead of bulges")
     g.add_argument("--no-labels", action="store_true", help="do not engrave ids")
+    p.add_argument("--material", default="pp", metavar="NAME",
+                   help="strip material for the stress warning (gridshell check's presets; "
+                        "default pp)")
     p.add_argument("--no-plan", action="store_true", help="do not draw plan.png / plan.svg")
     p.add_argument("--force", action="store_true",
                    help="cut a design whose recomputed figures miss the paper's thresholds, or "
@@ -87,6 +90,20 @@ def check_design(bundle: str, force: bool) -> dict[str, Any]:
                      f"{bundle}' shows them - pass --force to cut it anyway")
 
 
+def _structure_warning(bundle: str, params, material: str, progress) -> str | None:
+    """The warning of :func:`gridshell.structure.check.overstress_warning` for these strips
+    (deployed and collapsed states, the sequence too when the bundle has one)."""
+    from ..structure import Section, get_material
+    from ..structure.check import check_bundle, overstress_warning
+
+    progress("checking the strips' stresses")
+    res = check_bundle(bundle, get_material(material), Section.from_params(params))
+    warning = overstress_warning(res)
+    if warning:
+        progress(f"warning: {warning}")
+    return warning
+
+
 def run(args: Any) -> int:
     from fabrication import FabParams, fabricate
 
@@ -95,6 +112,9 @@ def run(args: Any) -> int:
     from .common import Progress, print_summary
 
     progress = Progress(args)
+    from ..structure import get_material
+
+    get_material(args.material)  # an unknown name is refused before any work
     params = FabParams(width=args.width, thickness=args.thickness, hole=args.hole,
                        joints=args.joints or FabParams.joints,
                        fallback_marks=args.joints is None, clearance=args.clearance,
@@ -128,6 +148,9 @@ def run(args: Any) -> int:
                                   for d in rep["pieces_split"]) or "none",
         "files": ", ".join(rep["files"]),
     }
+    structure = _structure_warning(args.bundle, params, args.material, progress)
+    if structure:
+        summary["warning (structure)"] = structure
     if rep["joints_fallback"]:
         summary["warning"] = rep["joints_fallback"]
     if rep["labels_dropped"]:

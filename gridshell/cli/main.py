@@ -19,6 +19,7 @@ SUBCOMMANDS: dict[str, str] = {
     "fabricate": "fabricate",
     "render": "render",
     "demo": "demo",
+    "check": "check",
     "simulate": "simulate",
 }
 

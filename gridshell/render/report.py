@@ -67,6 +67,8 @@ _CAPTIONS = {
                   "(every lamella on one straight line).",
     "alignment.gif": "The alignment sequence (Fig. 16).",
     "plan.png": "Assembly plan: every lamella's id at its place.",
+    "structure.png": "Utilisation of the strips (gridshell check): equivalent stress / allowable "
+                     "stress along every lamella, worst point marked.",
 }
 _MIME = {".png": "image/png", ".gif": "image/gif", ".jpg": "image/jpeg", ".jpeg": "image/jpeg"}
 MAX_SHEETS = 12
@@ -236,6 +238,13 @@ def _fabrication_section(d: Path) -> str:
     return "".join(parts)
 
 
+def _structure_section(d: Path) -> str:
+    """The structural check's section when ``structure.json`` exists (``gridshell check``)."""
+    from .structure import structure_section
+
+    return structure_section(d)
+
+
 def report_html(bundle_dir: str | os.PathLike) -> str:
     """The HTML text of the report of ``bundle_dir`` (see :func:`write_report`)."""
     from .. import __version__
@@ -299,6 +308,7 @@ def report_html(bundle_dir: str | os.PathLike) -> str:
         "</section>",
         f'<section id="pictures"><h2>Pictures</h2>{figs}</section>',
         _fabrication_section(d),
+        _structure_section(d),
         f'<section id="lamellae"><h2>Lamellae</h2>{_lamella_table(lams)}</section>',
         f'<section id="parameters"><h2>Parameters</h2>{_kv_table(_flatten(params))}',
         ("<h2>Timings [s]</h2>" + _kv_table(timings)) if timings else "",

@@ -1,0 +1,183 @@
+"""``gridshell check``: will the strips bend into the design without breaking?
+
+Stresses along every lamella of a design bundle for a strip section and material
+(:func:`gridshell.structure.check.check_bundle`), written to ``DIR/structure.json`` (listed in
+the bundle's manifest) and ``DIR/structure.png`` (the strips coloured by utilisation). Prints a
+table (the ``--top`` most utilised lamellae) and a verdict.
+Exit code: 0 every state stays elastic (utilisation <= 1); 4 overstressed (like a figure
+that fails in ``verify``; ``structure.json`` is written all the same); 2 bad input.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+HELP = ("stresses the design imposes on its strips (bending about both axes, twist) for a "
+        "material and section; writes DIR/structure.json (exit 0 elastic, 4 overstressed)")
+
+#: exit code of an overstressed design (gridshell.errors.EXIT_CODES: a figure fails)
+OVERSTRESSED = 4
+
+
+def add_args(p: argparse.ArgumentParser) -> None:
+    from ..structure import MATERIALS
+
+    p.add_argument("bundle", metavar="DIR",
+                   help="design bundle (output of 'gridshell gg' or 'ncp'); structure.json "
+                        "goes into it")
+    g = p.add_argument_group("material")
+    g.add_argument("--material", default=None, metavar="NAME",
+                   help="preset: " + "; ".join(f"{k}: {m.label}" for k, m in MATERIALS.items())
+                        + " (default pp unless --E and --allowable give your own)")
+    g.add_argument("--E", dest="E", type=float, metavar="GPA", help="Young's modulus, GPa")
+    g.add_argument("--G", dest="G", type=float, metavar="GPA",
+                   help="shear modulus, GPa (default: from E and the Poisson ratio for an "
+                        "isotropic material, the preset's for timber and GFRP)")
+    g.add_argument("--nu", type=float, help="Poisson ratio")
+    g.add_argument("--allowable", type=float, metavar="MPA",
+                   help="allowable (elastic limit) stress, MPa")
+    g.add_argument("--allowable-strain", type=float, metavar="PERCENT",
+                   help="allowable strain, %% (the smaller of stress and E x strain governs)")
+    g.add_argument("--density", type=float, metavar="KG_M3", help="density, kg/m^3")
+    g = p.add_argument_group("strip (mm of the model; default: DIR/fabrication's, else 20 x 1 "
+                             "at 1:10)")
+    g.add_argument("--width", type=float, help="strip width, mm")
+    g.add_argument("--thickness", type=float, help="strip thickness, mm")
+    g.add_argument("--scale", help="model scale, e.g. 1:10, 1:1 or 0.1")
+    p.add_argument("--no-states", action="store_true",
+                   help="deployed state only (not the collapsed state nor the alignment "
+                        "sequence)")
+    p.add_argument("--no-picture", action="store_true",
+                   help="do not draw DIR/structure.png (the strips coloured by utilisation)")
+    p.add_argument("--top", type=int, default=12, metavar="N",
+                   help="lamellae listed in the table, most utilised first (default 12; 0: all)")
+
+
+def _fabrication_params(bundle: Path) -> dict[str, Any]:
+    """width, thickness and scale of the bundle's cut files, if it has them."""
+    f = bundle / "fabrication" / "fabrication.json"
+    try:
+        rep = json.loads(f.read_text(encoding="utf-8"))
+        p = rep.get("params", rep)
+        return {k: p[k] for k in ("width", "thickness", "scale") if k in p}
+    except (OSError, ValueError, AttributeError, TypeError):
+        return {}
+
+
+def section_and_material(args: Any):
+    """The :class:`Section` and :class:`Material` the options describe (SI inside)."""
+    from fabrication.params import parse_scale
+
+    from ..errors import InputError
+    from ..structure import Section, get_material, user_material
+
+    fab = _fabrication_params(Path(args.bundle))
+    width = args.width if args.width is not None else fab.get("width", 20.0)
+    thickness = args.thickness if args.thickness is not None else fab.get("thickness", 1.0)
+    scale = parse_scale(args.scale if args.scale is not None else fab.get("scale", "1:10"))
+    for name, v in (("width", width), ("thickness", thickness)):
+        if not (isinstance(v, (int, float)) and v > 0 and v < float("inf")):
+            raise InputError(f"--{name} must be a positive length in mm, got {v}")
+    section = Section(float(width), float(thickness), scale)
+    own = args.material is None and args.E is not None
+    base = None if own else get_material(args.material or "pp")
+    for name, v in (("E", args.E), ("G", args.G), ("allowable", args.allowable),
+                    ("allowable-strain", args.allowable_strain), ("density", args.density)):
+        if v is not None and not v > 0:
+            raise InputError(f"--{name} must be positive, got {v}")
+    mat = user_material(
+        base, E=None if args.E is None else args.E * 1e9,
+        G=None if args.G is None else args.G * 1e9, nu=args.nu, density=args.density,
+        allowable_stress=None if args.allowable is None else args.allowable * 1e6,
+        allowable_strain=None if args.allowable_strain is None else args.allowable_strain / 100)
+    return section, mat
+
+
+def table(result: dict[str, Any], top: int = 12) -> list[str]:
+    """The lamella table's lines, most utilised first (``top`` rows; 0: all)."""
+    rows = sorted(result["lamellae"], key=lambda r: -r["max_utilisation"])
+    if top > 0:
+        rows = rows[:top]
+    lines = [f"  {'lamella':>7} {'fam':>3} {'util':>6} {'at s [m]':>9} {'joint':>6} "
+             f"{'sig_w':>6} {'sig_s':>6} {'tau':>6} {'R_min [mm]':>10} {'t_max [mm]':>10}",
+             f"  {'':>7} {'':>3} {'':>6} {'':>9} {'':>6} {'[MPa]':>6} {'[MPa]':>6} "
+             f"{'[MPa]':>6}"]
+    for r in rows:
+        R = r["min_radius_m"]
+        Rt = f"{R * 1e3:10.1f}" if R is not None and R < float("inf") else f"{'straight':>10}"
+        lines.append(f"  {r['id']:>7} {'C' + str(r['family']):>3} {r['max_utilisation']:6.2f} "
+                     f"{r['worst_s_m']:9.3f} {r['worst_joint']:>6} "
+                     f"{r['max_sigma_weak_MPa']:6.2f} {r['max_sigma_strong_MPa']:6.2f} "
+                     f"{r['max_tau_MPa']:6.2f} {Rt} {r['max_elastic_thickness_mm']:10.2f}")
+    return lines
+
+
+def verdict_line(result: dict[str, Any]) -> str:
+    """One line: the verdict, the governing utilisation and where."""
+    w = result["worst"]
+    sec = result["section"]
+    what = (f"{sec['width_mm']:g} x {sec['thickness_mm']:g} mm {result['material']['name']} "
+            f"at {sec['scale_text']}")
+    state = result["governing_state"]
+    where = (f"lamella {w['lamella']} at s = {w['s_m']:.3f} m (joint {w['joint']})"
+             if state == "deployed" else f"state {state}")
+    word = "ok" if result["verdict"] == "ok" else "OVERSTRESSED"
+    return (f"{word}: {what}, max utilisation {result['max_utilisation']:.2f} ({where}); "
+            f"thickest elastic strip {result['max_elastic_thickness_mm']:.2f} mm")
+
+
+def run(args: Any) -> int:
+    from ..bundle import finite_json, read_bundle, read_design_json
+    from ..errors import InputError
+    from ..structure.check import check_bundle, write_structure_json
+    from .common import Progress
+
+    progress = Progress(args)
+    if args.top < 0:
+        raise InputError(f"--top must be >= 0, got {args.top}")
+    read_design_json(args.bundle)
+    section, material = section_and_material(args)
+    bundle = read_bundle(args.bundle)
+    res = check_bundle(bundle, material, section, states=not args.no_states,
+                       bundle_dir=Path(args.bundle), progress=progress.callback)
+    out = write_structure_json(args.bundle, res)
+    picture = None
+    if not args.no_picture:
+        from ..render.structure import PICTURE, render_utilisation
+
+        progress(f"drawing {PICTURE}")
+        picture = render_utilisation(bundle, res, Path(args.bundle) / PICTURE)
+    code = 0 if res["verdict"] == "ok" else OVERSTRESSED
+    if getattr(args, "json", False):
+        summary = {k: v for k, v in res.items() if k not in ("lamellae", "states")}
+        summary["states"] = {k: v for k, v in res["states"].items() if k != "frames"}
+        summary["file"] = str(out)
+        summary["picture"] = str(picture) if picture else None
+        print(json.dumps(finite_json({"ok": code == 0, **summary}), indent=1, allow_nan=False))
+        return code
+    print(f"Structure of {args.bundle} ({res['kind']}, {res['orientation']} strips cut "
+          f"{res['cut_shape']})")
+    print(f"  material  {material.label}: E {material.E / 1e9:.3g} GPa, G {material.G / 1e9:.3g} "
+          f"GPa, allowable {material.allowable / 1e6:.3g} MPa")
+    print(f"  section   {section.width_mm:g} x {section.thickness_mm:g} mm at "
+          f"{res['section']['scale_text']} (edge ratio {section.edge_ratio:.3g}:1)")
+    print("\n".join(table(res, args.top)))
+    st = res["states"]
+    if st:
+        col = st["collapsed"]
+        print(f"  states    alignment sequence max utilisation "
+              f"{st['sequence_max_utilisation']:.2f}; collapsed {col['max_utilisation']:.2f}")
+        if st["unresolved"]:
+            print(f"  warning   {len(st['unresolved'])} states of the alignment sequence fold "
+                  f"(a lamella turns by more than {st['fold_deg']:g} deg between joints): "
+                  f"{', '.join(st['unresolved'])}: not judged (the sequence is kinematic; "
+                  "where it folds its stresses mean nothing)")
+    print(f"  files     {out}" + (f", {picture}" if picture else ""))
+    print(verdict_line(res))
+    if code and not getattr(args, "quiet", False):
+        print("gridshell check: overstressed (exit 4); a thinner strip, a larger scale or a "
+              "stronger material help", file=sys.stderr)
+    return code

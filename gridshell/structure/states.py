@@ -1,0 +1,175 @@
+"""Stresses in the states of the alignment sequence and in the collapsed state (transport).
+
+A state is known by its joints only (``sequence/frame_*.obj``, ``aligned.obj``): each lamella
+is the cubic spline (not-a-knot) through its joints at the design's arc lengths (the alignment
+keeps them), and the strip's section normal at a joint is the normal of the joint mesh there
+(:func:`gridshell.structure.frames.joint_normals`; GG: the strips lie tangent to the net) or,
+for NCP kinds, the joint axis, which is the strip's width direction: stored deployed
+(``axes_r.npy``) and collapsed (``aligned_r.npy``), turned the fraction ``t`` of the way from
+one to the other in the intermediate states (:func:`slerp_axes`; the sequence's own axes are
+not stored).
+In a collapsed GG net every lamella lies on one line: no curvature, and the strips lie stacked
+untwisted. The resolution is the joint spacing, coarser than the dense axes of the deployed
+check; the deployed state is evaluated the same way (``frame_000``) so that the states compare
+with each other.
+"""
+from __future__ import annotations
+
+import re
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..bundle import DesignBundle
+from .cutshape import collapse_curvature, cut_curvature, cut_shape
+from .frames import joint_curvatures, joint_normals
+from .materials import Material
+from .section import Section
+from .stresses import KIND_ORIENTATION, strip_curvatures, strip_stresses
+
+METHOD = ("joints only: a cubic spline (not-a-knot) through each lamella's joints at the design's "
+          "arc lengths; section normals from the joint mesh (NCP: the joint axes, deployed and "
+          "collapsed as stored, interpolated between); resolution the joint spacing")
+
+_FRAME = re.compile(r"^frame_(\d+)\.obj$")
+
+#: a state whose lamellae turn by more than this between consecutive joint-to-joint chords
+#: (degrees) is folded: a spline through the joints no longer describes a strip there, and the
+#: state is reported as unresolved instead of judged (a folded kinematic sequence)
+FOLD_DEG = 30.0
+
+
+def _frames(path: Path | None, n: int) -> list[np.ndarray]:
+    """The joints of every frame of ``path/sequence`` in order (empty if none or unreadable
+    as a configuration of ``n`` joints)."""
+    from ..meshfile import read_configuration
+
+    if path is None or not (path / "sequence").is_dir():
+        return []
+    found = sorted((int(m.group(1)), p) for p in (path / "sequence").iterdir()
+                   if (m := _FRAME.match(p.name)))
+    out = []
+    for _, p in found:
+        V = read_configuration(p)[0]
+        if V.shape != (n, 3):
+            return []
+        out.append(V)
+    return out
+
+
+def _axes(path: Path | None, name: str, n: int) -> np.ndarray | None:
+    if path is None or not (path / name).is_file():
+        return None
+    try:
+        r = np.load(path / name)
+    except (OSError, ValueError):
+        return None
+    return r if r.shape == (n, 3) and np.all(np.isfinite(r)) else None
+
+
+def slerp_axes(r0: np.ndarray, r1: np.ndarray, t: float) -> np.ndarray:
+    """Unit axes ``(n,3)`` turned the fraction ``t`` of the way from ``r0`` to ``r1`` (rows,
+    unit; a row of ``r1`` is taken with the sign nearer to ``r0``: axes are lines), about
+    their common normal (spherical linear interpolation)."""
+    a = np.asarray(r0, float)
+    b = np.asarray(r1, float)
+    a = a / np.maximum(np.linalg.norm(a, axis=1), 1e-300)[:, None]
+    b = b / np.maximum(np.linalg.norm(b, axis=1), 1e-300)[:, None]
+    c = np.einsum("ij,ij->i", a, b)
+    b = np.where((c < 0)[:, None], -b, b)
+    th = np.arccos(np.clip(np.abs(c), -1.0, 1.0))
+    sn = np.sin(th)
+    small = sn < 1e-9
+    wa = np.where(small, 1.0 - t, np.sin((1.0 - t) * th) / np.where(small, 1.0, sn))
+    wb = np.where(small, t, np.sin(t * th) / np.where(small, 1.0, sn))
+    r = wa[:, None] * a + wb[:, None] * b
+    return r / np.maximum(np.linalg.norm(r, axis=1), 1e-300)[:, None]
+
+
+def _max_turn(X: np.ndarray) -> float:
+    """Largest angle (degrees) between consecutive chords of the joint polyline ``X (j,3)``."""
+    d = np.diff(np.asarray(X, float), axis=0)
+    n = np.linalg.norm(d, axis=1)
+    d = d[n > 0] / n[n > 0, None]
+    if len(d) < 2:
+        return 0.0
+    c = np.clip(np.einsum("ij,ij->i", d[1:], d[:-1]), -1.0, 1.0)
+    return float(np.degrees(np.arccos(c)).max())
+
+
+def state_record(bundle: DesignBundle, V: np.ndarray, normals: np.ndarray, section: Section,
+                 material: Material, curve=None) -> dict[str, Any]:
+    """Utilisation of every lamella in the state with joints ``V (n,3)`` and section normals
+    ``normals (n,3)`` (zero rows: unknown); the cut shape is matched with the orientation of
+    the normals that fits it best (their sign is arbitrary). Lamellae of fewer than 3 joints
+    are not measured (``None`` in ``lamellae_max_utilisation``). ``resolved`` is False when a
+    lamella turns by more than :data:`FOLD_DEG` between joints (``max_turn_deg``)."""
+    orientation = KIND_ORIENTATION[bundle.kind]
+    lams = bundle.net.lamellae
+    dcs = [joint_curvatures(V[lam.joints], lam.joint_s, normals[lam.joints]) for lam in lams]
+    k_cut = [np.zeros(len(lam.joints)) for lam in lams]
+    sign = 1.0
+    if orientation == "orthogonal":
+        k_cut = [cut_curvature(bundle, lam, lam.joint_s, curve) for lam in lams]
+        a, b = np.concatenate([dc.kn for dc in dcs]), np.concatenate(k_cut)
+        a, b = np.nan_to_num(a), np.where(np.isfinite(a), b, 0.0)
+        sign = 1.0 if np.sum((a - b) ** 2) <= np.sum((a + b) ** 2) else -1.0
+    turn = max((_max_turn(V[lam.joints]) for lam in lams), default=0.0)
+    per, best = [], (0.0, -1, -1)
+    kw = ks = kt = 0.0
+    for lam, dc, kc in zip(lams, dcs, k_cut):
+        k = strip_curvatures(dc, orientation, section, sign * kc)
+        u = strip_stresses(k, section, material).utilisation
+        if not np.all(np.isfinite(u)):    # fewer than 3 joints: not measured
+            per.append(None)
+            continue
+        m = float(u.max()) if len(u) else 0.0
+        per.append(m)
+        if len(u) and m > best[0]:
+            best = (m, int(lam.id), int(lam.joints[int(np.argmax(u))]))
+        if len(u):
+            kw = max(kw, float(np.abs(k.weak).max()))
+            ks = max(ks, float(np.abs(k.strong).max()))
+            kt = max(kt, float(np.abs(k.twist).max()))
+    return {"max_utilisation": best[0], "worst_lamella": best[1], "worst_joint": best[2],
+            "max_turn_deg": turn, "resolved": bool(turn <= FOLD_DEG),
+            "max_weak_curvature_per_m": kw, "max_strong_curvature_per_m": ks,
+            "max_twist_rad_per_m": kt, "lamellae_max_utilisation": per}
+
+
+def bundle_states(bundle: DesignBundle, path: Path | None, section: Section,
+                  material: Material) -> dict[str, Any]:
+    """``structure.json["states"]``: the record of :func:`state_record` for every frame of the
+    alignment sequence (``frame_000`` deployed ... last = collapsed) or, without a sequence,
+    for the deployed and the collapsed joints; ``frames`` in order, each with ``name`` and
+    ``t`` (0 deployed, 1 collapsed); ``collapsed``; ``unresolved``: the names of the folded
+    states (not judged); ``sequence_max_utilisation`` over the resolved ones."""
+    n = len(bundle.net.joints)
+    loops = bundle.net.loops
+    frames = _frames(path, n)
+    named = [(f"frame_{k:03d}", V) for k, V in enumerate(frames)] if frames else \
+        [("deployed", bundle.net.joints), ("collapsed", bundle.aligned)]
+    K = max(len(named) - 1, 1)
+    curve = collapse_curvature(bundle) if cut_shape(bundle) == "curve" else None
+    r_dep, r_col = _axes(path, "axes_r.npy", n), _axes(path, "aligned_r.npy", n)
+    out = []
+    for k, (name, V) in enumerate(named):
+        N = joint_normals(V, loops)
+        if r_dep is not None and r_col is not None:
+            N = slerp_axes(r_dep, r_col, k / K)
+        elif k == 0 and r_dep is not None:
+            N = r_dep
+        elif k == len(named) - 1 and r_col is not None:
+            N = r_col
+        rec = state_record(bundle, np.asarray(V, float), N, section, material, curve)
+        out.append({"name": name, "t": k / K, **rec})
+    collapsed = out[-1]
+    judged = [f["max_utilisation"] for f in out if f["resolved"]]
+    return {"method": METHOD, "fold_deg": FOLD_DEG, "frames": out,
+            "unresolved": [f["name"] for f in out if not f["resolved"]],
+            "collapsed": {"name": collapsed["name"],
+                          "max_utilisation": collapsed["max_utilisation"],
+                          "worst_lamella": collapsed["worst_lamella"],
+                          "worst_joint": collapsed["worst_joint"]},
+            "sequence_max_utilisation": max(judged, default=0.0)}
