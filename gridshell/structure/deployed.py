@@ -7,11 +7,10 @@ in the surface (``n x t``) for GG's tangent strips, along the surface normal ``n
 orthogonal strips of NCP / CNC / AA; ``n`` is the joints' net normal (sum of the loops' vector
 areas), interpolated along the lamella by arc length.
 
-Rest state, the strip as cut (so the design is a stressed state):
-
-- GG: straight and untwisted;
-- NCP / CNC / AA: the planar collapse curve of the bundle (circle for CNC, line for AA),
-  strong-axis curvature only; the lamella's joints sit at their ``collapse_s`` along it.
+Rest state, the strip as cut (:mod:`gridshell.structure.cutshape`, the rule fabrication cuts
+by; so the design is a stressed state): GG and AA straight; CNC arcs of the collapse circle;
+NCP pieces of the planar collapse curve from the lamella's first ``collapse_s`` on; strong-axis
+curvature only, untwisted, signed like the design's in-surface curvature.
 
 Crossing lamellae share the joint's node and keep a common joint axis (the net normal at the
 joint) while turning freely about it (:func:`~gridshell.structure.rod.joint_energy`). Supports
@@ -27,6 +26,7 @@ import numpy as np
 from ..errors import InputError
 from ..net import polyline_arclength
 from . import rod
+from .cutshape import collapse_curvature, collapse_radius, cut_curvature, cut_shape
 from .materials import Material
 from .rodnet import JointSpec, RodNetwork, RodSpec
 from .section import Section
@@ -130,42 +130,6 @@ def _interp_rows(s: np.ndarray, xs: np.ndarray, Y: np.ndarray) -> np.ndarray:
     return np.stack([np.interp(s, xs, Y[:, c]) for c in range(Y.shape[1])], axis=1)
 
 
-def _rest_from_collapse(bundle, lam, s_nodes: np.ndarray
-                        ) -> tuple[np.ndarray, np.ndarray] | None:
-    """The lamella's rest polyline ``(k,3)`` on the collapse curve and the width direction of
-    each edge ``(k-1,3)`` (the flattened surface normal), or None if the bundle has none."""
-    cc, cs = bundle.collapse, (bundle.collapse_s or {}).get(lam.id)
-    if cc is None or cs is None or len(cc.points) < 2 or len(cs) != len(lam.joint_s):
-        return None
-    cs = np.asarray(cs, float)
-    keep = np.concatenate([[True], np.diff(lam.joint_s) > 1e-12])
-    jsd, csd = lam.joint_s[keep], cs[keep]
-    if len(jsd) >= 2:
-        slope = np.sign(csd[-1] - csd[0]) or 1.0
-    else:
-        slope = 1.0
-    c = np.interp(s_nodes, jsd, csd) if len(jsd) >= 2 else csd[0] + (s_nodes - jsd[0])
-    c = np.where(s_nodes < jsd[0], csd[0] + slope * (s_nodes - jsd[0]), c)
-    c = np.where(s_nodes > jsd[-1], csd[-1] + slope * (s_nodes - jsd[-1]), c)
-    P2 = np.asarray(cc.points, float)
-    sc = polyline_arclength(np.column_stack([P2, np.zeros(len(P2))]))
-    # extend the curve linearly past its ends (tails of the strip beyond the collapse curve)
-    def at(x, Y):
-        out = _interp_rows(np.clip(x, sc[0], sc[-1]), sc, Y)
-        lo, hi = x < sc[0], x > sc[-1]
-        d0 = rod.unit(Y[1] - Y[0]) if Y is P2 else 0 * Y[0]
-        d1 = rod.unit(Y[-1] - Y[-2]) if Y is P2 else 0 * Y[0]
-        out[lo] += (x[lo] - sc[0])[:, None] * d0
-        out[hi] += (x[hi] - sc[-1])[:, None] * d1
-        return out
-    R = at(c, P2)
-    Nn = at(c, np.asarray(cc.normals, float))
-    R3 = np.column_stack([R, np.zeros(len(R))])
-    N3 = np.column_stack([Nn, np.zeros(len(Nn))])
-    D = rod.unit(0.5 * (N3[1:] + N3[:-1]))
-    return R3, D
-
-
 def build_model(bundle, material: Material, section: Section, *,
                 supports: str | np.ndarray = "boundary", gravity: bool = False,
                 per_bay: int = 3, stiffness: Stiffness | None = None,
@@ -185,11 +149,15 @@ def build_model(bundle, material: Material, section: Section, *,
     EA, B1 = E * section.area, st.strong * E * section.I_strong
     B2, GJ = st.weak * E * section.I_weak, st.torsion * G * section.J
     mass = material.density * section.area
+    shape = cut_shape(bundle)
+    curve = collapse_curvature(bundle) if shape == "curve" else None
+    rest = {"line": "straight strips", "arc": f"arcs of the collapse circle (radius "
+            f"{collapse_radius(bundle) if shape == 'arc' else 0:.4g} m of the design)",
+            "curve": "pieces of the collapse curve"}[shape]
     X = [J]
     n_nodes = len(J)
     rods, theta, a1, lam_nodes, lam_ids = [], [], [], [], []
     joint_at: dict[int, list[tuple[int, int, int]]] = {}  # joint -> (rod, node pos, edges)
-    rests = set()
     edge0 = 0
     for li, lam in enumerate(net.lamellae):
         if len(lam.joints) == 0 or len(lam.axis) < 2:
@@ -219,33 +187,17 @@ def build_model(bundle, material: Material, section: Section, *,
         d1 = rod.unit(np.cross(Ne, T)) if tangent else Ne
         a = rod.bishop_frame(P)
         th = rod.frame_angle(a, T, d1)
-        # rest state
+        # rest state: the strip as cut (gridshell.structure.cutshape, as fabrication cuts it)
         k = len(P)
         wbar, mbar = np.zeros((k - 2, 2)), np.zeros(k - 2)
-        if tangent:
-            rests.add("straight strips")
-        else:
-            got = _rest_from_collapse(bundle, lam, s_nodes / scale) \
-                if k >= 3 else None
-            if got is not None:
-                R, D = got
-                wr, mr = rod.material_curvatures(R * scale, D)
-                wd, _ = rod.material_curvatures(P, d1)
-                sign = 1.0 if np.sum(wr[..., 0] * wd[..., 0]) >= 0 else -1.0
-                wbar[..., 0] = sign * wr[..., 0]
-                rests.add(f"collapse curve ({bundle.collapse.shape})")
-            elif k >= 3 and bundle.collapse is not None and bundle.collapse.shape == "circle" \
-                    and bundle.collapse.radius:
-                # a CNC bundle without collapse_s: every strip is an arc of the circle
-                wd, _ = rod.material_curvatures(P, d1)
-                sign = 1.0 if np.sum(wd[..., 0]) >= 0 else -1.0
-                lb = seg[:-1] + seg[1:]
-                wbar[..., 0] = sign * 2.0 * np.tan(lb / (4.0 * bundle.collapse.radius * scale))
-                rests.add("collapse curve (circle)")
-            elif k >= 3:
-                wd, _ = rod.material_curvatures(P, d1)
-                wbar[..., 0] = wd[..., 0]
-                rests.add("cut to the design's in-surface curvature (no collapse curve)")
+        if k >= 3 and shape != "line":
+            # a vertex's curvature belongs between its edges' midpoints
+            s_mid = 0.25 * (s_nodes[:-2] + 2 * s_nodes[1:-1] + s_nodes[2:])
+            kc = cut_curvature(bundle, lam, s_mid / scale, curve) / scale
+            wd, _ = rod.material_curvatures(P, d1)
+            lb = seg[:-1] + seg[1:]
+            w = 2.0 * np.tan(0.25 * kc * lb)
+            wbar[:, 0] = w if np.sum(w * wd[:, 0]) >= 0 else -w
         ne = k - 1
         rods.append(RodSpec(nodes, seg, np.full(ne, EA), np.full(ne, B1), np.full(ne, B2),
                             np.full(ne, GJ), wbar, mbar, np.full(ne, mass),
@@ -304,7 +256,7 @@ def build_model(bundle, material: Material, section: Section, *,
         network.forces[:, 2] -= GRAVITY * lump
     _check_supported(Xall, sup, len(J))
     return DeployedModel(network, joint_node, sup, lam_nodes, lam_ids, scale, bundle.kind,
-                         "; ".join(sorted(rests)), section, material, gravity,
+                         rest, section, material, gravity,
                          loops=net.loops.copy())
 
 

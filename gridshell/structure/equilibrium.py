@@ -74,17 +74,16 @@ def node_stresses(net: RodNetwork, q: np.ndarray, material, section) -> dict[str
     """Per interior vertex of the network at ``q``: curvature changes from the rest state
     (weak / strong axis, 1/m), twist rate (rad/m) and the stresses and utilisation of the strip
     (:func:`gridshell.structure.stresses.strip_stresses`)."""
+    from .stresses import StripCurvatures, strip_stresses
+
     V = Jet.variables(q[net.bend_idx], 0)
     d = net.bend_data()
     w1, w2, m = rod.strains(V, d)
     half = 0.5 * d.lbar
-    weak, strong, twist = w2.v / half, w1.v / half, m.v / half
-    sigma = material.E * (np.abs(weak) * section.thickness + np.abs(strong) * section.width) / 2
-    tau = section.torsion_factor * material.G * min(section.thickness, section.width) \
-        * np.abs(twist)
-    u = np.sqrt(sigma ** 2 + 3.0 * tau ** 2) / material.allowable
-    return {"weak": weak, "strong": strong, "twist": twist, "sigma": sigma, "tau": tau,
-            "utilisation": u}
+    k = StripCurvatures(weak=w2.v / half, strong=w1.v / half, twist=m.v / half)
+    st = strip_stresses(k, section, material)
+    return {"weak": k.weak, "strong": k.strong, "twist": k.twist, "sigma": st.sigma,
+            "tau": st.tau, "utilisation": st.utilisation}
 
 
 def _stress_summary(model: DeployedModel, q: np.ndarray) -> dict[str, Any]:
