@@ -27,6 +27,7 @@ from ..errors import InputError
 from ..net import polyline_arclength
 from . import rod
 from .cutshape import collapse_curvature, collapse_radius, cut_curvature, cut_shape
+from .frames import joint_normals
 from .materials import Material
 from .rodnet import JointSpec, RodNetwork, RodSpec
 from .section import Section
@@ -72,20 +73,6 @@ class DeployedModel:
     material: Material
     gravity: bool
     loops: np.ndarray = field(default_factory=lambda: np.zeros((0, 4), np.int64))
-
-
-def joint_normals(V: np.ndarray, loops: np.ndarray) -> np.ndarray:
-    """Unit normals ``(n,3)`` at net joints ``V (n,3)``: sum of the vector areas of the quad
-    ``loops (m,4)`` around each joint (zero where none)."""
-    from ..quadmesh import polygon_vector_areas
-
-    N = np.zeros_like(np.asarray(V, float))
-    L = np.asarray(loops, np.int64).reshape(-1, 4)
-    if len(L):
-        A = polygon_vector_areas(V, L)
-        for c in range(4):
-            np.add.at(N, L[:, c], A)
-    return rod.unit(N)
 
 
 def boundary_joints(net) -> np.ndarray:

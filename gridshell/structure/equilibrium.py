@@ -181,7 +181,8 @@ def simulate(bundle, material, section, *, supports: str | np.ndarray = "boundar
     }
     axes = [P[n] / sc for n in model.lamella_nodes]
     axes0 = [net.X[n] / sc for n in model.lamella_nodes]
-    return Equilibrium(model, res, Jeq, axes, axes0, dev, R, model.supports, energy, stresses, figures)
+    return Equilibrium(model, res, Jeq, axes, axes0, dev, R, model.supports, energy, stresses,
+                       figures)
 
 
 def joint_mismatch(net: RodNetwork, q: np.ndarray) -> float:

@@ -49,7 +49,8 @@ def _factor_pd(A: sp.csc_matrix):
 
 
 def minimize(fun: EnergyFn, q0: np.ndarray, free: np.ndarray, *, gtol: float,
-             etol: float = 1e-13, max_iter: int = 200, accept: Callable[[np.ndarray], None] | None = None,
+             etol: float = 1e-13, max_iter: int = 200,
+             accept: Callable[[np.ndarray], None] | None = None,
              time_limit: float | None = None) -> NewtonResult:
     """Minimize ``fun`` from ``q0`` over the variables ``free`` (boolean mask).
 

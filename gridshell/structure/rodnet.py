@@ -42,7 +42,8 @@ class RodSpec:
 @dataclass
 class JointSpec:
     """A joint: ``edges (4,)`` global edge indices (two per lamella, an end joint repeating its
-    edge), ``c (4, 3)`` joint-axis coordinates in the edge frames (see :class:`~gridshell.structure.rod.JointData`),
+    edge), ``c (4, 3)`` joint-axis coordinates in the edge frames (see
+    :class:`~gridshell.structure.rod.JointData`),
     ``k`` rotational stiffness N m/rad."""
 
     edges: np.ndarray
@@ -127,7 +128,6 @@ class RodNetwork:
                                self.theta_dofs(edges)[:, None]], 1)
 
     def _index(self) -> None:
-        E = np.arange(self.n_edges)
         self.stretch_idx = self.pos_dofs(self.edge_nodes).reshape(-1, 6)
         self.bend_idx = np.concatenate([self.pos_dofs(self.vert_nodes).reshape(-1, 9),
                                         self.theta_dofs(self.vert_edges)], 1)
@@ -142,7 +142,6 @@ class RodNetwork:
         if self.moments:
             me = np.array([m[0] for m in self.moments], np.int64)
             self.moment_idx = self.pos_dofs(self.edge_nodes[me]).reshape(-1, 6)
-        del E
 
     def q0(self) -> np.ndarray:
         """The unknowns of the initial state."""
