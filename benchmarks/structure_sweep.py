@@ -26,19 +26,24 @@ THICKNESSES = (0.5, 0.75, 1.0, 1.5, 2.0, 2.5, 3.0)
 
 
 def sweep(bundle_dir: Path, thicknesses=THICKNESSES, width: float = 20.0, scale: float = 0.1,
-          material: str = "pp") -> list[dict]:
+          material: str = "pp", every: int = 1, loads=(True, False)) -> list[dict]:
+    """Rows of figures per thickness and load case; supports: every ``every``-th boundary
+    joint (1: all of them)."""
     from gridshell.bundle import read_bundle
     from gridshell.structure import Section, get_material
+    from gridshell.structure.deployed import boundary_joints
     from gridshell.structure.equilibrium import simulate
 
     b = read_bundle(bundle_dir)
+    supports = boundary_joints(b.net)[::every] if every > 1 else "boundary"
     mat = get_material(material)
     rows = []
     for t in thicknesses:
-        for gravity in (True, False):
-            eq = simulate(b, mat, Section(width, t, scale), gravity=gravity, require=False)
+        for gravity in loads:
+            eq = simulate(b, mat, Section(width, t, scale), gravity=gravity, require=False,
+                          supports=supports)
             f = eq.figures
-            r = {"kind": b.kind, "gravity": gravity, "thickness_mm": t, "edge_ratio": width / t,
+            r = {"kind": b.kind, "gravity": gravity, "supports_every": every, "thickness_mm": t, "edge_ratio": width / t,
                  "deviation_max_pct": f["deviation_max_pct"],
                  "deviation_mean_pct": f["deviation_mean_pct"],
                  "utilisation_design": f["utilisation_design"],
@@ -47,7 +52,7 @@ def sweep(bundle_dir: Path, thicknesses=THICKNESSES, width: float = 20.0, scale:
                  "weight_N": f["weight_N"], "converged": f["converged"],
                  "newton": f["newton"], "wall_s": f["wall_s"], "cpu_s": f["cpu_s"]}
             rows.append(r)
-            print(f"{b.kind:4s} t={t:4.2f} mm ratio {r['edge_ratio']:5.1f}:1 "
+            print(f"{b.kind:4s} supports 1/{every} t={t:4.2f} mm ratio {r['edge_ratio']:5.1f}:1 "
                   f"{'self-weight' if gravity else 'no load   '}  deviation max "
                   f"{r['deviation_max_pct']:8.4f} % mean {r['deviation_mean_pct']:8.4f} %  "
                   f"utilisation design {r['utilisation_design']:6.3f} equilibrium "
@@ -64,15 +69,18 @@ def plot(rows: list[dict], path: Path) -> None:
     ax1, ax2 = fig.add_subplot(1, 2, 1), fig.add_subplot(1, 2, 2)
     for kind, colour in (("GG", (0.13, 0.42, 0.70)), ("CNC", (0.86, 0.35, 0.12)),
                          ("NCP", (0.86, 0.35, 0.12)), ("AA", (0.4, 0.6, 0.2))):
-        for gravity, style in ((True, "o-"), (False, "s--")):
-            rs = [r for r in rows if r["kind"] == kind and r.get("gravity", True) == gravity]
-            if not rs:
-                continue
+        cases = sorted({(r.get("supports_every", 1), r.get("gravity", True)) for r in rows
+                        if r["kind"] == kind})
+        for every, gravity in cases:
+            rs = [r for r in rows if r["kind"] == kind and r.get("gravity", True) == gravity
+                  and r.get("supports_every", 1) == every]
+            style = ("o-" if gravity else "s--") if every == 1 else ("^-." if gravity else "v:")
             x = [r["edge_ratio"] for r in rs]
-            what = "self-weight" if gravity else "no load"
+            what = ("self-weight" if gravity else "no load") + \
+                ("" if every == 1 else f", 1/{every} of the boundary held")
             ax1.plot(x, [r["deviation_max_pct"] for r in rs], style, color=colour, ms=4,
                      label=f"{kind}, {what}")
-            if gravity:
+            if gravity and every == 1:
                 ax2.plot(x, [r["utilisation_peak"] for r in rs], "o-", color=colour, ms=4,
                          label=f"{kind} at equilibrium (self-weight)")
                 ax2.plot(x, [r["utilisation_design"] for r in rs], "s:", color=colour, ms=3,
@@ -103,6 +111,10 @@ def main(argv=None) -> int:
                    default=[ROOT / "out/demo/gg", ROOT / "out/demo/ncp"])
     p.add_argument("--png", type=Path, default=ROOT / "docs/images/structure_sweep.png")
     p.add_argument("--json", type=Path, default=None, help="write every figure here")
+    p.add_argument("--every", type=int, default=1,
+                   help="hold every N-th boundary joint only (default 1: all)")
+    p.add_argument("--thickness", type=float, nargs="+", default=list(THICKNESSES), metavar="MM")
+    p.add_argument("--loaded-only", action="store_true", help="self-weight case only")
     p.add_argument("--from-json", type=Path, nargs="+", default=None,
                    help="plot the rows of earlier --json runs instead of simulating")
     args = p.parse_args(argv)
@@ -115,7 +127,8 @@ def main(argv=None) -> int:
             if not (d / "design.json").is_file():
                 print(f"{d}: not a design bundle; run 'make demo' first", file=sys.stderr)
                 return 2
-            rows += sweep(d)
+            rows += sweep(d, args.thickness, every=args.every,
+                          loads=(True,) if args.loaded_only else (True, False))
     if args.json:
         args.json.write_text(json.dumps(rows, indent=1))
     plot(rows, args.png)
