@@ -179,3 +179,23 @@ def test_folded_sequence_states_are_listed_not_judged(tmp_path, capsys):
     f1 = st["frames"][1]
     assert not f1["resolved"] and f1["max_turn_deg"] > 30
     assert _read(d)["governing_state"] != "frame_001"
+
+
+@pytest.mark.parametrize("kind, shape", [("GG", None), ("AA", None), ("NCP", "curve"),
+                                         ("NCP", "line"), ("CNC", "circle")])
+def test_cut_shape_is_the_one_fabricate_cuts(kind, shape):
+    """The check and fabricate write the cut-shape rule twice (fabrication imports only
+    data-level modules): they must agree."""
+    from fabrication.strips import axis_shape, collapse_radius
+
+    from gridshell.structure import cutshape
+
+    b = make_bundle(kind, metrics={"n": 0.3} if kind == "CNC" else None)
+    if shape is not None:
+        t = np.linspace(-0.5, 0.5, 50)
+        b.collapse = CollapseCurve(points=np.stack([t, t ** 2], 1),
+                                   normals=np.stack([0 * t, 1 + 0 * t], 1), shape=shape,
+                                   radius=2.0 if shape == "circle" else None)
+    assert cutshape.cut_shape(b) == axis_shape(b)
+    if axis_shape(b) == "arc":
+        assert cutshape.collapse_radius(b) == collapse_radius(b) == 2.0

@@ -108,6 +108,11 @@ def test_quick_demo_figures_meet_the_paper_bounds(quick_demo):
     assert saved["summary"]["GG Delta_a [%]"] == s["GG Delta_a [%]"]
     assert saved["ncp"]["fabrication"]["shape"] == "arc"
     assert saved["gg"]["fabrication"]["shape"] == "line"
+    # the 1 mm polypropylene strips are checked: structure.json, a line per design
+    for part, key in (("gg", "GG strips 1 mm pp"), ("ncp", "CNC strips 1 mm pp")):
+        r = json.loads((out / part / "structure.json").read_text())
+        assert s[key].startswith(r["verdict"]) and r["section"]["thickness_mm"] == 1
+        assert saved[part]["fabrication"]["structure"]["verdict"] == r["verdict"]
 
 
 def test_demo_prints_a_one_screen_summary(tmp_path, capsys):

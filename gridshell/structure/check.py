@@ -163,7 +163,8 @@ def check_bundle(bundle: DesignBundle | str | Path, material: Material, section:
         "units": {"utilisation": "equivalent stress / allowable stress",
                   "worst_s_m": "arc length along the design axis, metres of the design",
                   "worst_s_mm": "arc length along the cut strip, mm of the model",
-                  "min_radius_m": "smallest bending radius of the real strip, metres",
+                  "min_radius_m": "smallest bending radius of the real strip, metres "
+                                  "(null: the strip stays straight)",
                   "curvatures": "of the real strip (model), 1/m; stresses MPa"},
         "states": out_states,
         "lamellae": lams,

@@ -1,7 +1,8 @@
 """The in-plane curvature of each strip as cut (orthogonal lamellae), along its axis.
 
-The shapes :mod:`fabrication.strips` cuts (it takes :func:`cut_shape` and
-:func:`collapse_radius` from here): AA and GG strips are straight;
+The shapes :mod:`fabrication.strips` cuts (the same rule as its ``axis_shape`` and
+``collapse_radius``; fabrication may import only data-level modules of gridshell, so the rule
+is written twice: keep them together): AA and GG strips are straight;
 CNC strips are arcs of radius ``collapse.radius`` (or ``1 / metrics.n``); NCP strips are pieces
 of the planar collapse curve, joint 0 at ``collapse_s[0]`` and the axis following at its own arc
 length. Curvatures are signed against the flattened surface normals stored with the collapse
