@@ -22,6 +22,7 @@ SUBCOMMANDS: dict[str, str] = {
     "demo": "demo",
     "check": "check",
     "serve": "serve",
+    "simulate": "simulate",
 }
 
 
