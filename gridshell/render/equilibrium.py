@@ -14,7 +14,37 @@ from typing import Sequence
 import numpy as np
 
 from ..atomic import atomic_path
-from .ribbons import FAMILY_COLOURS, _fit_view, view_angles
+from .ribbons import FAMILY_COLOURS, view_angles
+
+
+def _fit_view(fig, ax, P: np.ndarray, fill: float = 0.92) -> None:
+    """Equal axis scales around ``P (k,3)`` and the zoom that makes the projected points fill
+    ``fill`` of the axes rectangle (3D axes otherwise draw into a centred square)."""
+    from mpl_toolkits.mplot3d import proj3d
+
+    _set_equal_limits(ax, P, zoom=1.0)
+    ax.apply_aspect()  # the centred square that draw() would use, so transData is final
+    x, y, _ = proj3d.proj_transform(P[:, 0], P[:, 1], P[:, 2], ax.get_proj())
+    xy = ax.transData.transform(np.column_stack([x, y]))
+    box = ax.get_position(original=True).transformed(fig.transFigure)
+    cx, cy = 0.5 * (box.x0 + box.x1), 0.5 * (box.y0 + box.y1)
+    dx = float(np.max(np.abs(xy[:, 0] - cx))) or 1.0
+    dy = float(np.max(np.abs(xy[:, 1] - cy))) or 1.0
+    zoom = fill * min(0.5 * box.width / dx, 0.5 * box.height / dy)
+    _set_equal_limits(ax, P, zoom=float(np.clip(zoom, 0.2, 5.0)))
+
+
+def _set_equal_limits(ax, P: np.ndarray, pad: float = 0.0, zoom: float = 1.0) -> None:
+    lo, hi = P.min(axis=0), P.max(axis=0)
+    span = hi - lo
+    m = float(span.max()) or 1.0
+    span = np.maximum(span, 0.05 * m)
+    c = 0.5 * (lo + hi)
+    half = 0.5 * span * (1 + 2 * pad)
+    ax.set_xlim(c[0] - half[0], c[0] + half[0])
+    ax.set_ylim(c[1] - half[1], c[1] + half[1])
+    ax.set_zlim(c[2] - half[2], c[2] + half[2])
+    ax.set_box_aspect(tuple(2 * half), zoom=zoom)
 
 
 def exaggeration(deviation_max_pct: float, visible_pct: float = 3.0) -> float:

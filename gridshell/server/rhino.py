@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
-from ..export.rhino import _mesh
+from ..export.rhino_geometry import mesh as _mesh
 
 #: grid of points a surface is sampled on
 SURFACE_SAMPLES = 24
