@@ -87,7 +87,8 @@ def solve(problem: Problem, x0: np.ndarray, *, fixed: np.ndarray | None = None,
           method: Method = "lm", max_iter: int = 100, damping: float = 1e-3,
           tol_energy: float = 1e-20, tol_rel: float = 1e-10, tol_step: float = 1e-12,
           tol_grad: float = 1e-14, callback: Callable[[dict], None] | None = None,
-          time_limit: float | None = None) -> SolveResult:
+          time_limit: float | None = None,
+          stop: Callable[[np.ndarray], bool] | None = None) -> SolveResult:
     """Minimize ``problem``'s energy from ``x0``.
 
     Parameters
@@ -105,6 +106,8 @@ def solve(problem: Problem, x0: np.ndarray, *, fixed: np.ndarray | None = None,
     tol_grad : stop when max |J^T r| falls below this
     callback : called with each history record (progress reporting)
     time_limit : seconds; stop (not converged) when exceeded
+    stop : called with ``x`` after each accepted step; stop (converged) when it returns True
+        (a caller's own convergence test, e.g. the design's figures hold)
     """
     if method not in ("lm", "gn", "guided"):
         raise InputError(f"unknown method {method!r}; use 'lm', 'gn' or 'guided'")
@@ -184,6 +187,9 @@ def solve(problem: Problem, x0: np.ndarray, *, fixed: np.ndarray | None = None,
                 converged = bool(np.max(np.abs(g)) <= max(tol_grad, 1e-8 * max(E, 1e-300) ** 0.5))
             elif "singular" not in message:
                 message = "energy became non-finite"
+            break
+        if stop is not None and stop(x):
+            message, converged = "the caller's stop condition holds", True
             break
         if method == "lm" and 0 <= rel < tol_rel:
             message, converged = "relative energy decrease below tolerance", True
