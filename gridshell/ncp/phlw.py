@@ -36,7 +36,9 @@ the principal curvatures stays above a margin), and a one-sided boundary term.
 Rounds: the solver works with relaxed auxiliary variables; each round is judged by the
 surface's *true* energy (auxiliaries re-projected from the control points, same problem) and
 halved or rejected if that rose (:func:`_round`). ``converged`` means the figures hold
-(:func:`acceptance_figures`), not that a solver tolerance was met.
+(:func:`acceptance_figures`), not that a solver tolerance was met; the iterations and the rounds
+end as soon as they hold (issue 17: a round's iterations with a margin, :data:`STOP_MARGIN`),
+and a dense sampling is reached from a coarser one (:func:`sample_levels`).
 
 Module layout: the terms live in :mod:`.phlw_terms`, row fits and checks in
 :mod:`.phlw_checks`; their public names are re-exported here.
