@@ -36,7 +36,9 @@ the principal curvatures stays above a margin), and a one-sided boundary term.
 Rounds: the solver works with relaxed auxiliary variables; each round is judged by the
 surface's *true* energy (auxiliaries re-projected from the control points, same problem) and
 halved or rejected if that rose (:func:`_round`). ``converged`` means the figures hold
-(:func:`acceptance_figures`), not that a solver tolerance was met.
+(:func:`acceptance_figures`), not that a solver tolerance was met; the iterations and the rounds
+end as soon as they hold (issue 17: a round's iterations with a margin, :data:`STOP_MARGIN`),
+and a dense sampling is reached from a coarser one (:func:`sample_levels`).
 
 Module layout: the terms live in :mod:`.phlw_terms`, row fits and checks in
 :mod:`.phlw_checks`; their public names are re-exported here.
@@ -65,6 +67,7 @@ from .phlw_terms import (MODES, Mode, Regularity, SampleGliding, Samples, Umbili
                          make_samples, normal_eq, parametrization_guard, phlw_target,
                          principal_eq, sample_gliding, second_form_eq, sqrt_delta_eq,
                          umbilic_guard)
+from .phlw_output import result_summary, write_phlw  # noqa: F401  (re-exported)
 from .reference import boundary_segments, closest_on_segments
 
 #: Default weights, on geometry scaled to a unit bounding-box diagonal. ``target`` and ``beta``
@@ -374,9 +377,159 @@ def boundary_gliding(ctrl: np.ndarray, op: Any, reference: tuple[np.ndarray, np.
     return SampleGliding(op, foot, m)
 
 
+#: Continuation in the sampling: rounds run first on at most this many samples per direction
+#: (the paper's 18) when more are asked for, then on the asked sampling, started from the
+#: coarse level's control points (:func:`sample_levels`). The figures are always measured at
+#: the asked sampling, so the fine level runs only when the coarse one cannot make them hold.
+COARSE_SAMPLES = 18
+#: Rounds on the coarse level: the first round makes the large move (on the saddle of
+#: benchmarks/phlw.py the energy falls 4e4-fold in it, later rounds by < 10 % each), the
+#: later ones refine what only the asked sampling can judge.
+COARSE_ROUNDS = 1
+#: The in-round stop (:meth:`_Judge.holds`): a round's Levenberg-Marquardt iterations end as
+#: soon as every acceptance figure holds, with the relation and the principal angle this many
+#: times within their tolerances (the figures the iterations drive; a margin for what the
+#: NCP stages after the PHLW step build on).
+STOP_MARGIN = 10.0
+
+
+def sample_levels(samples: tuple[int, int]) -> list[tuple[int, int]]:
+    """The sampling levels of the rounds, coarse to fine, the last one ``samples``: a coarse
+    level of ``max(COARSE_SAMPLES, ceil(s / 2))`` per direction when that is fewer."""
+    fine = tuple(int(s) for s in samples)
+    coarse = tuple(min(s, max(COARSE_SAMPLES, -(-s // 2))) for s in fine)
+    return [fine] if coarse == fine else [coarse, fine]
+
+
+class _Level:
+    """One sampling level of the rounds: its samples, terms and start (unit-diagonal units)."""
+
+    def __init__(self, s0: BSplineSurface, samples: tuple[int, int], w: dict[str, float],
+                 reference: tuple[np.ndarray, np.ndarray], mode: Mode, diag: float) -> None:
+        self.samples, self.mode, self.reference = tuple(samples), mode, reference
+        self.u, self.v = uniform_params(s0, self.samples)
+        R = len(self.u)
+        self.data = make_samples(s0, self.u, self.v, mode)
+        self.lay = make_layout(s0.n_ctrl, R * len(self.v), R, mode)
+        self.prob, self.x0, self.fit = phlw_problem(s0, self.data, self.lay, w, reference, mode,
+                                                    scale=diag)
+        self.op_b = boundary_operator(s0, self.data)
+        self.bd = reference_boundary(*reference)
+
+    def start(self, ctrl: np.ndarray) -> np.ndarray:
+        """The state of this level on the control points ``ctrl (nc, 3)``: auxiliaries exact,
+        row coefficients fitted to the rows' curvatures (:func:`start_rows`)."""
+        with np.errstate(divide="ignore", invalid="ignore"):
+            aux = init_auxiliary(ctrl, self.data)
+        R = len(self.u)
+        fit = start_rows(aux["K"].reshape(R, -1), aux["H"].reshape(R, -1), self.mode)
+        vals = {"C": ctrl, **aux, "t": fit.t}
+        if self.mode != "aa":
+            vals["n"] = fit.n if self.mode == "phlw" else fit.n[:1]
+        return self.lay.pack(vals)
+
+    def refresh(self, x: np.ndarray) -> None:
+        """Closest points on the reference (closeness, gliding, boundary) at the state ``x``."""
+        from ..igl_adapter import closest_points_with_normals
+
+        C = self.lay.view(x, "C")
+        S = np.asarray(self.data.ops["S"] @ C)
+        foot, nrm = closest_points_with_normals(S, *self.reference)
+        self.prob.set_data("closeness", T.Linear("C", self.data.ops["S"], foot))
+        self.prob.set_data("gliding", SampleGliding(self.data.ops["S"], foot, nrm))
+        if any(e.name == "boundary" for e in self.prob.entries):
+            self.prob.set_data("boundary", boundary_gliding(C, self.op_b, self.reference,
+                                                            self.bd))
+
+
+class _State(NamedTuple):
+    """A state of the fine level with its figures (:class:`_Judge`); metres in ``surface``."""
+
+    x: np.ndarray
+    energy: float
+    surface: BSplineSurface
+    n_rows: np.ndarray
+    t_rows: np.ndarray
+    after: dict
+    check: NetCheck
+    deviation: float
+    figures: dict
+
+
+class _Judge:
+    """The acceptance figures of a state of the fine level (what ``converged`` means)."""
+
+    def __init__(self, fine: _Level, surf: BSplineSurface, center: np.ndarray, diag: float,
+                 before: dict, energy_initial: float, reference: tuple[np.ndarray, np.ndarray],
+                 mode: Mode, omega_t: float, check_samples: tuple[int, int]) -> None:
+        self.fine, self.surf, self.center, self.diag = fine, surf, center, diag
+        self.before, self.energy_initial, self.reference = before, energy_initial, reference
+        self.mode, self.omega_t, self.check_samples = mode, omega_t, check_samples
+
+    def _surface_rows(self, x: np.ndarray) -> tuple[BSplineSurface, np.ndarray, np.ndarray]:
+        lv, diag, s = self.fine, self.diag, self.surf
+        ctrl = lv.lay.view(x, "C").reshape(s.ctrl.shape) * diag + self.center
+        out = BSplineSurface(s.degree_u, s.degree_v, s.knots_u.copy(), s.knots_v.copy(), ctrl)
+        R = len(lv.u)
+        t_rows = np.abs(lv.lay.view(x, "t")) / diag
+        if self.mode == "phlw":
+            n_rows = lv.lay.view(x, "n") / diag
+        elif self.mode == "cnc":
+            n_rows = np.full(R, lv.lay.view(x, "n")[0] / diag)
+        else:
+            n_rows = np.zeros(R)
+        return out, n_rows, t_rows
+
+    def _check(self, out: BSplineSurface, n_rows: np.ndarray) -> NetCheck:
+        lv, mode = self.fine, self.mode
+        return net_direction_check(out, n_rows if mode == "phlw" else
+                                   (n_rows[:1] if mode == "cnc" else None),
+                                   u_rows=lv.u, u_samples=lv.u, v_samples=lv.v)
+
+    def __call__(self, x: np.ndarray, unchanged: bool, refresh: bool = True) -> _State:
+        """Every figure of the fine level's state ``x`` (auxiliaries exact); ``refresh``: the
+        energy with closest points at ``x`` (else those of the problem as it is)."""
+        lv = self.fine
+        if refresh and not unchanged:
+            lv.refresh(x)
+        energy = float(lv.prob.energy(x))
+        out, n_rows, t_rows = self._surface_rows(x)
+        after = _acceptance(out, n_rows, t_rows, lv.u, lv.v, self.mode, self.omega_t, self.diag)
+        check = self._check(out, n_rows)
+        dev = deviation_percent(out, *self.reference, self.check_samples)
+        cov = coverage_percent(out, *self.reference, self.check_samples)
+        figures = acceptance_figures(self.before, after, dev, check, self.energy_initial, energy,
+                                     cov, unchanged=unchanged)
+        return _State(x, energy, out, n_rows, t_rows, after, check, dev, figures)
+
+    def holds(self, x: np.ndarray) -> bool:
+        """Whether every figure holds at ``x``, relation and angle :data:`STOP_MARGIN` times
+        within their tolerances: the in-round stop (:func:`_round`). Cheapest figures first;
+        the energy with the closest points the problem has now (a running round's own)."""
+        lv = self.fine
+        out, n_rows, t_rows = self._surface_rows(x)
+        after = _acceptance(out, n_rows, t_rows, lv.u, lv.v, self.mode, self.omega_t, self.diag)
+        if not (after["relation_max_rel"] < RELATION_TOL / STOP_MARGIN
+                and after["angle_max_deg"] < ANGLE_TOL_DEG / STOP_MARGIN):
+            return False
+        check = self._check(out, n_rows)
+        if np.any(check.umbilic | check.out_of_range):
+            return False
+        dev = deviation_percent(out, *self.reference, self.check_samples)
+        if not dev < DEVIATION_TOL:
+            return False
+        cov = coverage_percent(out, *self.reference, self.check_samples)
+        if not cov < COVERAGE_TOL:
+            return False
+        figures = acceptance_figures(self.before, after, dev, check, self.energy_initial,
+                                     float(lv.prob.energy(x)), cov)
+        return all(f["ok"] for f in figures.values())
+
+
 def optimize_phlw(surf: BSplineSurface, reference: Any, *, mode: Mode = "phlw",
                   samples: tuple[int, int] = (18, 18), weights: dict[str, float] | None = None,
                   outer: int = 4, max_iter: int = 40, check_samples: tuple[int, int] = (60, 60),
+                  early_stop: bool = True,
                   progress: Callable[[str], None] | None = None) -> PHLWResult:
     """Optimize a B-spline towards a PHLW (``phlw``), CNC (``cnc``) or PK (``aa``) surface
     close to a reference mesh (paper 4.2.1).
@@ -393,10 +546,14 @@ def optimize_phlw(surf: BSplineSurface, reference: Any, *, mode: Mode = "phlw",
         ``closeness``, ``gliding``, ``boundary``, ``umbilic``); in mode ``aa`` ``beta``
         defaults to 0 (see the code)
     outer : at most this many rounds of (refresh closest points, Levenberg-Marquardt solve,
-        accept / halve / reject by the true energy); the loop ends early when a round is
-        rejected or lowers the energy by less than :data:`ROUND_TOL_REL`
+        accept / halve / reject by the true energy) per sampling level
+        (:func:`sample_levels`); a level ends early when a round is rejected or lowers the
+        energy by less than :data:`ROUND_TOL_REL`
     max_iter : solver iterations per round
     check_samples : sampling for the deviation figure
+    early_stop : end the rounds as soon as every figure of :func:`acceptance_figures` holds
+        at ``samples`` (measured after every accepted round); False runs the rounds until
+        they stagnate, as before
     progress : called with one line per round
 
     Returns
@@ -411,8 +568,6 @@ def optimize_phlw(surf: BSplineSurface, reference: Any, *, mode: Mode = "phlw",
     ConvergenceError : no round could improve the surface and its figures fail, or the
         energy became non-finite
     """
-    from ..igl_adapter import closest_points_with_normals
-
     _check_mode(mode)
     w = dict(DEFAULT_WEIGHTS)
     if mode == "aa":
@@ -433,88 +588,88 @@ def optimize_phlw(surf: BSplineSurface, reference: Any, *, mode: Mode = "phlw",
         raise InputError("the reference mesh has zero extent; pass a real surface")
     Vs = (V - center) / diag
     s0 = _scaled_surface(surf, center, diag)
-    u, v = uniform_params(s0, samples)
-    R = len(u)
-    data = make_samples(s0, u, v, mode)
-    lay = make_layout(s0.n_ctrl, R * len(v), R, mode)
-
-    prob, x, fit = phlw_problem(s0, data, lay, w, (Vs, Fr), mode, scale=diag)
-    op_b = boundary_operator(s0, data)
-    bd = reference_boundary(Vs, Fr)
+    plan = sample_levels(samples)
+    fine = _Level(s0, plan[-1], w, (Vs, Fr), mode, diag)
+    u, v, R = fine.u, fine.v, len(fine.u)
+    x, fit = fine.x0, fine.fit
     diagnostics: list[str] = []
     if len(fit.clamped):
         diagnostics.append(f"initial fit: rows {fit.clamped.tolist()} had t_u^2 < 0 (b^2 - 4ac > 0) "
                            "or n_u outside [kappa_1, kappa_2]; started there from n_u inside "
                            "the principal range")
-    diagnostics += principal_range_notes(lay.view(x, "K").reshape(R, -1),
-                                         lay.view(x, "H").reshape(R, -1), u, mode, diag)
+    diagnostics += principal_range_notes(fine.lay.view(x, "K").reshape(R, -1),
+                                         fine.lay.view(x, "H").reshape(R, -1), u, mode, diag)
 
-    before = {"terms": prob.report(x), **_acceptance(surf, fit.n / diag, fit.t / diag, u, v,
-                                                     mode, w["target"], diag)}
-    energy_initial = prob.energy(x)
+    before = {"terms": fine.prob.report(x), **_acceptance(surf, fit.n / diag, fit.t / diag, u,
+                                                          v, mode, w["target"], diag)}
+    energy_initial = fine.prob.energy(x)
+    judge = _Judge(fine, surf, center, diag, before, float(energy_initial), (V, Fr), mode,
+                   w["target"], check_samples)
     history: list[dict] = []
     t0 = time.perf_counter()
-    for rnd in range(int(outer)):
-        if rnd > 0:
-            # a new problem: closest points refreshed at the accepted state (auxiliaries exact)
-            S = np.asarray(data.ops["S"] @ lay.view(x, "C"))
-            foot, nrm = closest_points_with_normals(S, Vs, Fr)
-            prob.set_data("closeness", T.Linear("C", data.ops["S"], foot))
-            prob.set_data("gliding", SampleGliding(data.ops["S"], foot, nrm))
-            if any(e.name == "boundary" for e in prob.entries):
-                prob.set_data("boundary", boundary_gliding(lay.view(x, "C"), op_b, (Vs, Fr),
-                                                           bd))
-        step = _round(prob, lay, data, x, int(max_iter))
-        history.append({"round": rnd + 1, **{k: v_ for k, v_ in step.items() if k != "x"},
-                        "time": time.perf_counter() - t0})
+    level = fine if len(plan) == 1 else _Level(s0, plan[0], w, (Vs, Fr), mode, diag)
+    xl = x if level is fine else level.x0     # the state at the current level
+    state = judge(x, unchanged=True)          # the figures of the fine level's state
+    at_level, total = 0, 0
+    while True:
+        if total > 0:
+            level.refresh(xl)                 # closest points at the accepted state
+        to_fine = (lambda xr: xr) if level is fine else \
+            (lambda xr, lv=level: fine.start(lv.lay.view(xr, "C")))
+        step = _round(level.prob, level.lay, level.data, xl, int(max_iter),
+                      stop=(lambda xr: judge.holds(to_fine(xr))) if early_stop else None)
+        at_level += 1
+        total += 1
+        rec = {"round": total, "samples": list(level.samples),
+               **{k: v_ for k, v_ in step.items() if k != "x"}}
+        gain_small = step["energy0"] - step["energy"] <= ROUND_TOL_REL * step["energy0"]
+        if step["accepted"]:
+            xl = step["x"]
+            state = judge(to_fine(xl), unchanged=False)
+            rec["figures_failing"] = [k for k, f in state.figures.items() if not f["ok"]]
+        rec["time"] = time.perf_counter() - t0
+        history.append(rec)
+        held = step["accepted"] and not rec["figures_failing"]
         if progress is not None:
-            progress(f"round {rnd + 1}/{outer}: energy {step['energy0']:.3e} -> "
-                     f"{step['energy']:.3e} in {step['iterations']} iterations "
-                     f"({step['message']})")
-        if not step["accepted"]:
+            where = (f"round {at_level}/{outer}" if level is fine else
+                     f"coarse round {at_level}/{COARSE_ROUNDS} ({level.samples[0]} x "
+                     f"{level.samples[1]} samples)")
+            progress(f"{where}: energy {step['energy0']:.3e} -> {step['energy']:.3e} in "
+                     f"{step['iterations']} iterations ({step['message']})"
+                     + ("; the figures hold" if held else ""))
+        if held and early_stop:
             break
-        x = step["x"]
-        if step["energy0"] - step["energy"] <= ROUND_TOL_REL * step["energy0"]:
-            break
-    energy_final = float(prob.energy(x))
+        if not step["accepted"] or gain_small or at_level >= (
+                int(outer) if level is fine else COARSE_ROUNDS):
+            if level is fine:
+                break
+            # continuation: the next sampling level starts from this level's control points
+            level, xl, at_level = fine, fine.start(level.lay.view(xl, "C")), 0
+    x = state.x
+    energy_final = state.energy
     if not np.isfinite(energy_final):
         raise ConvergenceError(f"the {mode.upper()} optimization produced a non-finite energy; "
                                "refit the reference with fewer control points or more smoothing")
-
-    ctrl = lay.view(x, "C").reshape(s0.shape[0], s0.shape[1], 3) * diag + center
-    out_surf = BSplineSurface(surf.degree_u, surf.degree_v, surf.knots_u.copy(),
-                              surf.knots_v.copy(), ctrl)
-    t_rows = np.abs(lay.view(x, "t")) / diag
-    if mode == "phlw":
-        n_rows = lay.view(x, "n") / diag
-    elif mode == "cnc":
-        n_rows = np.full(R, lay.view(x, "n")[0] / diag)
-    else:
-        n_rows = np.zeros(R)
-    abc = np.column_stack([np.ones(R), -2 * n_rows, n_rows ** 2 + t_rows ** 2])
-    after = {"terms": prob.report(x), **_acceptance(out_surf, n_rows, t_rows, u, v, mode,
-                                                    w["target"], diag)}
-    check = net_direction_check(out_surf, n_rows if mode == "phlw" else
-                                (n_rows[:1] if mode == "cnc" else None),
-                                u_rows=u, u_samples=u, v_samples=v)
-    diagnostics += check.messages
-    dev = deviation_percent(out_surf, V, Fr, check_samples)
-    cov = coverage_percent(out_surf, V, Fr, check_samples)
     unchanged = not any(h["accepted"] for h in history)
-    figures = acceptance_figures(before, after, dev, check, energy_initial, energy_final, cov,
-                                 unchanged=unchanged)
+    if unchanged:
+        state = judge(x, unchanged=True)
+    figures, check = state.figures, state.check
+    diagnostics += check.messages
     if unchanged and not all(f["ok"] for f in figures.values()):
         raise ConvergenceError(
             f"the {mode.upper()} optimization could not lower its energy from "
             f"{energy_initial:.4g}: every round made the surface worse (true energy "
             f"{history[0]['energy_true']:.4g} after round 1) and was rejected; try more control "
             "points, a denser reference or another mode")
-    return PHLWResult(surface=out_surf, mode=mode, u_rows=u, v_samples=v, n_rows=n_rows,
+    n_rows, t_rows = state.n_rows, state.t_rows
+    abc = np.column_stack([np.ones(R), -2 * n_rows, n_rows ** 2 + t_rows ** 2])
+    after = {"terms": fine.prob.report(x), **state.after}
+    return PHLWResult(surface=state.surface, mode=mode, u_rows=u, v_samples=v, n_rows=n_rows,
                       t_rows=t_rows, abc=abc, history=history, report_before=before,
                       report_after=after, converged=all(f["ok"] for f in figures.values()),
-                      deviation=dev, diagnostics=diagnostics, net_check=check, weights=w,
-                      reference_diagonal=diag, figures=figures,
-                      energy_initial=float(energy_initial), energy_final=energy_final)
+                      deviation=state.deviation, diagnostics=diagnostics, net_check=check,
+                      weights=w, reference_diagonal=diag, figures=figures,
+                      energy_initial=float(energy_initial), energy_final=float(energy_final))
 
 
 def _reprojected(lay: Layout, data: Samples, x: np.ndarray) -> np.ndarray:
@@ -534,7 +689,8 @@ def _true_energy(prob: Problem, lay: Layout, data: Samples, x: np.ndarray
     return (E if math.isfinite(E) else math.inf), xr
 
 
-def _round(prob: Problem, lay: Layout, data: Samples, x: np.ndarray, max_iter: int) -> dict:
+def _round(prob: Problem, lay: Layout, data: Samples, x: np.ndarray, max_iter: int,
+           stop: Callable[[np.ndarray], bool] | None = None) -> dict:
     """One outer round from the accepted state ``x`` (auxiliaries exact).
 
     The solver's end point is judged by its *true* energy (auxiliaries re-projected from the
@@ -542,10 +698,12 @@ def _round(prob: Problem, lay: Layout, data: Samples, x: np.ndarray, max_iter: i
     auxiliaries, and its energy can fall while the surface's own rises (the 1e12 jumps of
     issue 13). If the true energy did not fall, the step in ``C, n, t`` is halved up to
     :data:`BACKTRACK` times; if none of these lowers it, the round is rejected and ``x`` kept.
+    ``stop(x_exact)`` (auxiliaries re-projected) may end the solver's iterations early.
     """
     E0, x = _true_energy(prob, lay, data, x)
     sol = solve(prob, x, method="lm", max_iter=max_iter, damping=SOLVER_DAMPING,
-                tol_rel=SOLVER_TOL_REL)
+                tol_rel=SOLVER_TOL_REL,
+                stop=None if stop is None else (lambda xs: stop(_reprojected(lay, data, xs))))
     E1, x1 = _true_energy(prob, lay, data, sol.x)
     out = {"iterations": sol.iterations, "energy0": E0, "energy_solver": float(sol.energy),
            "energy_true": E1, "step": 1.0, "message": sol.message}
@@ -597,90 +755,3 @@ def acceptance_figures(before: dict, after: dict, deviation: float, check: NetCh
         "coverage": fig(coverage, COVERAGE_TOL),
         "net": fig(bad, 0.5),
     }
-
-
-# ============================================================================ output
-
-def result_summary(res: PHLWResult) -> dict[str, Any]:
-    """JSON-ready report of a :class:`PHLWResult` (what ``report.json`` holds)."""
-    def clean(o: Any) -> Any:
-        if isinstance(o, dict):
-            return {str(k): clean(v) for k, v in o.items()}
-        if isinstance(o, (list, tuple)):
-            return [clean(v) for v in o]
-        if isinstance(o, np.ndarray):
-            return clean(o.tolist())
-        if isinstance(o, np.generic):
-            return o.item()
-        if isinstance(o, float) and not math.isfinite(o):
-            return None
-        return o
-
-    return clean({
-        "mode": res.mode, "converged": res.converged, "deviation_percent": res.deviation,
-        "figures": res.figures, "energy_initial": res.energy_initial,
-        "energy_final": res.energy_final,
-        "reference_diagonal_m": res.reference_diagonal, "weights": res.weights,
-        "samples": [len(res.u_rows), len(res.v_samples)],
-        "control_points": list(res.surface.shape),
-        "degree": [res.surface.degree_u, res.surface.degree_v],
-        "before": res.report_before, "after": res.report_after,
-        "rows": [{"u": float(u), "n": float(n), "t": float(t), "a": float(a), "b": float(b),
-                  "c": float(c)} for u, n, t, (a, b, c) in zip(res.u_rows, res.n_rows, res.t_rows,
-                                                             res.abc)],
-        "history": res.history, "diagnostics": res.diagnostics,
-        "net_regions": res.net_check.regions if res.net_check is not None else [],
-    })
-
-
-def write_phlw(directory: str | Any, res: PHLWResult, sample_grid: tuple[int, int] = (60, 60),
-               overwrite: bool = True, units: Any = None,
-               source: dict | None = None) -> dict[str, str]:
-    """Write a PHLW design into ``directory`` atomically (all files or none).
-
-    ``units`` (:class:`gridshell.io.Units`, None: metres) is the unit the reference was drawn
-    in, recorded in report.json as ``"units": {"name", "metres_per_unit"}`` (the geometry is
-    metres); ``source`` (``InputGeometry.info()``) as ``"input"``.
-
-    Files: ``surface.json`` (:meth:`BSplineSurface.save`), ``surface.obj`` (quad mesh sampled
-    ``sample_grid`` over the domain: rows = u, columns = v, so principal lines are mesh
-    polylines), ``rows.csv`` (``u, n_u, t_u, a, b, c`` per optimization row, 1/m),
-    ``report.json`` (:func:`result_summary`), ``curvature_diagram.png`` (paper Fig. 11 at the
-    optimization samples).
-
-    Returns
-    -------
-    dict : file role -> final path
-    """
-    import json
-    from pathlib import Path
-
-    from ..atomic import atomic_dir, write_text
-    from ..bundle import finite_json
-    from ..meshfile import write_mesh
-    from ..render.curvature_diagram import curvature_diagram
-
-    directory = Path(directory)
-    rows, cols = (int(s) for s in sample_grid)
-    # owned by `phlw` whether written by the CLI or the API (an `-o` later may replace it)
-    with atomic_dir(directory, overwrite=overwrite, owner="phlw",
-                    kind=f"PHLW {res.mode}") as tmp:
-        res.surface.save(tmp / "surface.json")
-        mesh = res.surface.sample(rows, cols)
-        write_mesh(tmp / "surface.obj", mesh.V, mesh.F)
-        lines = ["u,n_u,t_u,a,b,c"] + [
-            f"{u:.12g},{n:.12g},{t:.12g},{a:.12g},{b:.12g},{c:.12g}"
-            for u, n, t, (a, b, c) in zip(res.u_rows, res.n_rows, res.t_rows, res.abc)]
-        write_text(tmp / "rows.csv", "\n".join(lines) + "\n")
-        from ..io.units import METRES
-
-        summary = {**result_summary(res), "units": (units or METRES).to_json()}
-        if source is not None:
-            summary["input"] = source
-        write_text(tmp / "report.json", json.dumps(finite_json(summary), indent=1,
-                                                     allow_nan=False) + "\n")
-        g = _grid_geometry(res.surface, res.u_rows, res.v_samples)
-        curvature_diagram(tmp / "curvature_diagram.png", g["H"], g["K"], res.n_rows, res.t_rows,
-                          u_rows=res.u_rows, title=f"curvature diagram ({res.mode})")
-    names = ("surface.json", "surface.obj", "rows.csv", "report.json", "curvature_diagram.png")
-    return {n.split(".")[0] if n != "surface.obj" else "mesh": str(directory / n) for n in names}

@@ -93,7 +93,8 @@ def solve(problem: Problem, x0: np.ndarray, *, fixed: np.ndarray | None = None,
           tol_energy: float = 1e-20, tol_rel: float = 1e-10, tol_step: float = 1e-12,
           tol_grad: float = 1e-14, callback: Callable[[dict], None] | None = None,
           time_limit: float | None = None,
-          linear: LinearSolver | str | None = None) -> SolveResult:
+          linear: LinearSolver | str | None = None,
+          stop: Callable[[np.ndarray], bool] | None = None) -> SolveResult:
     """Minimize ``problem``'s energy from ``x0``.
 
     Parameters
@@ -114,6 +115,8 @@ def solve(problem: Problem, x0: np.ndarray, *, fixed: np.ndarray | None = None,
     linear : the linear solver: a :class:`~.linear.LinearSolver`, a backend name
         ("cholmod", "superlu") or None for the process-wide one of the default backend
         (``$GRIDSHELL_LINEAR`` or the first available, see :mod:`.linear`)
+    stop : called with ``x`` after each accepted step; stop (converged) when it returns True
+        (a caller's own convergence test, e.g. the design's figures hold)
     """
     if method not in ("lm", "gn", "guided"):
         raise InputError(f"unknown method {method!r}; use 'lm', 'gn' or 'guided'")
@@ -194,6 +197,9 @@ def solve(problem: Problem, x0: np.ndarray, *, fixed: np.ndarray | None = None,
                 converged = bool(np.max(np.abs(g)) <= max(tol_grad, 1e-8 * max(E, 1e-300) ** 0.5))
             elif "singular" not in message:
                 message = "energy became non-finite"
+            break
+        if stop is not None and stop(x):
+            message, converged = "the caller's stop condition holds", True
             break
         if method == "lm" and 0 <= rel < tol_rel:
             message, converged = "relative energy decrease below tolerance", True
