@@ -129,7 +129,7 @@ def register(hops, workdir: Path) -> None:
                  hs.HopsString("Metrics", "M", "figures of the design (JSON)"),
                  hs.HopsString("Bundle", "B", "design bundle folder (for Verify, Fabricate)")])
     def gg(target, lamellae=6, grid=12, opts="{}"):
-        from ..gg.pipeline import design_gg, write_gg
+        from ..api import design_gg, write
 
         kw = options(opts, GG_OPTIONS, "GG design")
         kw.setdefault("frames", 0)
@@ -137,10 +137,9 @@ def register(hops, workdir: Path) -> None:
         if int(grid) < 4 or int(lamellae) < 2:
             raise InputError(f"Grid {grid} and Lamellae {lamellae}: give Grid >= 4 and "
                              "Lamellae >= 2")
-        bundle, report = design_gg((V, F), grid=(int(grid), int(grid)),
-                                   n_lamellae=int(lamellae), **kw)
-        out = write_gg(new_dir("gg"), bundle, preview=False, sequence=report["sequence"],
-                       frames=0)
+        design = design_gg((V, F), grid=(int(grid), int(grid)), n_lamellae=int(lamellae), **kw)
+        bundle = design.bundle
+        out = write(new_dir("gg"), design, render=False, frames=0)
         return _net_outputs(bundle, out, _quality_warning(bundle))
 
     @hops.component(
@@ -160,13 +159,13 @@ def register(hops, workdir: Path) -> None:
                  hs.HopsString("Metrics", "M", "figures of the design (JSON)"),
                  hs.HopsString("Bundle", "B", "design bundle folder (for Verify, Fabricate)")])
     def ncp(reference, mode="cnc", curves=8, opts="{}"):
-        from ..ncp.pipeline import design_ncp, write_ncp
+        from ..api import design_ncp, write
 
         kw = options(opts, NCP_OPTIONS, "NCP design")
         V, F = rhino.target_arrays(reference)
-        bundle, report = design_ncp((V, F), mode=str(mode).strip().lower(), curves=int(curves),
-                                    **kw)
-        out = write_ncp(new_dir(bundle.kind.lower()), bundle, report, render=False)
+        design = design_ncp((V, F), mode=str(mode).strip().lower(), curves=int(curves), **kw)
+        bundle = design.bundle
+        out = write(new_dir(bundle.kind.lower()), design, render=False)
         return _net_outputs(bundle, out, _quality_warning(bundle))
 
     @hops.component(
