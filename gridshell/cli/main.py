@@ -4,7 +4,14 @@ from __future__ import annotations
 import argparse
 import importlib
 import json
+import os
 import sys
+
+# One BLAS thread unless the user asks for more (before numpy / CHOLMOD load OpenBLAS): the
+# command's problems are small to mid-sized, where OpenBLAS's second thread spins more than it
+# helps (measured: the 12 x 8 m hill gg 10.1 -> 5.4 s, 200k triangles 12.5 -> 9.9 s, the demo
+# 39 -> 35 s on 2 cores; benchmarks/README.md "Big input").
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 from typing import Iterable, Sequence
 
 from .. import __version__
