@@ -17,7 +17,8 @@ from collections import defaultdict
 
 import numpy as np
 
-from gridshell.bundle import DesignBundle
+from gridshell.bundle import DesignBundle, collapse_radius
+from gridshell.bundle import strip_cut_shape as axis_shape
 from gridshell.errors import InputError
 
 from .axis import ArcAxis, CurveAxis, DenseCurve, LineAxis
@@ -26,30 +27,6 @@ from .strip import Strip
 
 #: design kind -> lamella orientation relative to the surface
 ORIENTATION = {"GG": "tangent", "AA": "orthogonal", "CNC": "orthogonal", "NCP": "orthogonal"}
-
-
-def axis_shape(bundle: DesignBundle) -> str:
-    """``"line"``, ``"arc"`` or ``"curve"``: the flat shape of the bundle's lamellae."""
-    if bundle.kind in ("GG", "AA"):
-        return "line"
-    if bundle.kind == "CNC":
-        return "arc"
-    if bundle.collapse is None:
-        raise InputError("NCP design bundle has no collapse curve in design.json; "
-                         "re-run 'gridshell ncp' to write it")
-    return {"circle": "arc", "line": "line"}.get(bundle.collapse.shape, "curve")
-
-
-def collapse_radius(bundle: DesignBundle) -> float:
-    """Radius (m) of the circle a CNC (or circular NCP) design collapses into."""
-    c = bundle.collapse
-    if c is not None and c.shape == "circle" and c.radius:
-        return abs(float(c.radius))
-    n = bundle.metrics.get("n")
-    if n is not None and np.isfinite(float(n)) and float(n) != 0:
-        return 1.0 / abs(float(n))
-    raise InputError("CNC design bundle gives neither collapse.radius nor metrics.n; "
-                     "re-run the design command")
 
 
 def _edge_side(bundle: DesignBundle, shape: str) -> float:

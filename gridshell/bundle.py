@@ -388,3 +388,30 @@ def read_bundle(path: str | Path) -> DesignBundle:
                         params=d.get("params", {}), collapse=collapse, collapse_s=collapse_s,
                         revolution_V=rev_V, revolution_F=rev_F,
                         units=Units.from_json(d.get("units")))
+
+
+def strip_cut_shape(bundle: "DesignBundle") -> str:
+    """``"line"``, ``"arc"`` or ``"curve"``: the flat shape the bundle's strips are cut in (GG
+    and AA straight, CNC arcs of the collapse circle, NCP pieces of its planar collapse curve);
+    one rule for :mod:`fabrication.strips` (what is cut) and :mod:`gridshell.structure` (what
+    is checked)."""
+    if bundle.kind in ("GG", "AA"):
+        return "line"
+    if bundle.kind == "CNC":
+        return "arc"
+    if bundle.collapse is None:
+        raise InputError("NCP design bundle has no collapse curve in design.json; "
+                         "re-run 'gridshell ncp' to write it")
+    return {"circle": "arc", "line": "line"}.get(bundle.collapse.shape, "curve")
+
+
+def collapse_radius(bundle: "DesignBundle") -> float:
+    """Radius (m) of the circle a CNC (or circular NCP) design collapses into."""
+    c = bundle.collapse
+    if c is not None and c.shape == "circle" and c.radius:
+        return abs(float(c.radius))
+    n = bundle.metrics.get("n")
+    if n is not None and np.isfinite(float(n)) and float(n) != 0:
+        return 1.0 / abs(float(n))
+    raise InputError("CNC design bundle gives neither collapse.radius nor metrics.n; "
+                     "re-run the design command")

@@ -181,11 +181,12 @@ def test_folded_sequence_states_are_listed_not_judged(tmp_path, capsys):
     assert _read(d)["governing_state"] != "frame_001"
 
 
-@pytest.mark.parametrize("kind, shape", [("GG", None), ("AA", None), ("NCP", "curve"),
-                                         ("NCP", "line"), ("CNC", "circle")])
-def test_cut_shape_is_the_one_fabricate_cuts(kind, shape):
-    """The check and fabricate write the cut-shape rule twice (fabrication imports only
-    data-level modules): they must agree."""
+@pytest.mark.parametrize("kind, shape, cut", [("GG", None, "line"), ("AA", None, "line"),
+                                              ("NCP", "curve", "curve"), ("NCP", "line", "line"),
+                                              ("CNC", "circle", "arc")])
+def test_cut_shape_is_the_one_fabricate_cuts(kind, shape, cut):
+    """The check judges the strip fabricate cuts: straight GG / AA strips, CNC arcs of the
+    collapse circle, NCP pieces of the collapse curve (one rule, gridshell.bundle)."""
     from fabrication.strips import axis_shape, collapse_radius
 
     from gridshell.structure import cutshape
@@ -196,6 +197,6 @@ def test_cut_shape_is_the_one_fabricate_cuts(kind, shape):
         b.collapse = CollapseCurve(points=np.stack([t, t ** 2], 1),
                                    normals=np.stack([0 * t, 1 + 0 * t], 1), shape=shape,
                                    radius=2.0 if shape == "circle" else None)
-    assert cutshape.cut_shape(b) == axis_shape(b)
+    assert cutshape.cut_shape(b) == axis_shape(b) == cut
     if axis_shape(b) == "arc":
         assert cutshape.collapse_radius(b) == collapse_radius(b) == 2.0

@@ -1,8 +1,8 @@
 """The in-plane curvature of each strip as cut (orthogonal lamellae), along its axis.
 
-The shapes :mod:`fabrication.strips` cuts (the same rule as its ``axis_shape`` and
-``collapse_radius``; fabrication may import only data-level modules of gridshell, so the rule
-is written twice: keep them together): AA and GG strips are straight;
+The shapes :mod:`fabrication.strips` cuts (one rule for both:
+:func:`gridshell.bundle.strip_cut_shape` and :func:`gridshell.bundle.collapse_radius`): AA and
+GG strips are straight;
 CNC strips are arcs of radius ``collapse.radius`` (or ``1 / metrics.n``); NCP strips are pieces
 of the planar collapse curve, joint 0 at ``collapse_s[0]`` and the axis following at its own arc
 length. Curvatures are signed against the flattened surface normals stored with the collapse
@@ -12,34 +12,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..bundle import DesignBundle
+from ..bundle import DesignBundle, collapse_radius
+from ..bundle import strip_cut_shape as cut_shape
 from ..diffgeo import polyline_curvature
 from ..errors import InputError
 from ..net import Lamella, polyline_arclength
-
-
-def cut_shape(bundle: DesignBundle) -> str:
-    """``"line"``, ``"arc"`` or ``"curve"``: the flat shape of the bundle's strips."""
-    if bundle.kind in ("GG", "AA"):
-        return "line"
-    if bundle.kind == "CNC":
-        return "arc"
-    if bundle.collapse is None:
-        raise InputError("NCP design bundle has no collapse curve in design.json; re-run "
-                         "'gridshell ncp' to write it")
-    return {"circle": "arc", "line": "line"}.get(bundle.collapse.shape, "curve")
-
-
-def collapse_radius(bundle: DesignBundle) -> float:
-    """Radius (m) of the circle a CNC (or circular NCP) design collapses into."""
-    c = bundle.collapse
-    if c is not None and c.radius:
-        return abs(float(c.radius))
-    n = bundle.metrics.get("n")
-    if n is not None and np.isfinite(float(n)) and float(n) != 0:
-        return 1.0 / abs(float(n))
-    raise InputError("CNC design bundle gives neither collapse.radius nor metrics.n; re-run "
-                     "the design command")
 
 
 def collapse_curvature(bundle: DesignBundle) -> tuple[np.ndarray, np.ndarray]:
