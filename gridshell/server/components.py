@@ -112,6 +112,16 @@ def register(hops, workdir: Path) -> None:
     def new_dir(kind: str) -> Path:
         return workdir / f"{kind}-{uuid.uuid4().hex[:10]}"
 
+    def net_outputs() -> list:
+        """The outputs of a design component (GG and NCP alike: :func:`_net_outputs`)."""
+        return [hs.HopsMesh("Net", "N", "joints and net loops, metres"),
+                hs.HopsCurve("Lamellae", "L", "lamella axes, metres",
+                             access=hs.HopsParamAccess.LIST),
+                hs.HopsCurve("Aligned", "A", "lamellae through their joints when aligned",
+                             access=hs.HopsParamAccess.LIST),
+                hs.HopsString("Metrics", "M", "figures of the design (JSON)"),
+                hs.HopsString("Bundle", "B", "design bundle folder (for Verify, Fabricate)")]
+
     @hops.component(
         rule="/gg", name="GG design", nickname="GG",
         description="Design a geodesic alignable lamella gridshell (GG) on a target surface",
@@ -121,13 +131,7 @@ def register(hops, workdir: Path) -> None:
                 hs.HopsInteger("Grid", "G", "GG mesh resolution (G x G)", optional=True),
                 hs.HopsString("Options", "O", "JSON object of further design_gg keywords",
                               optional=True)],
-        outputs=[hs.HopsMesh("Net", "N", "joints and net loops, metres"),
-                 hs.HopsCurve("Lamellae", "L", "lamella axes, metres",
-                              access=hs.HopsParamAccess.LIST),
-                 hs.HopsCurve("Aligned", "A", "lamellae through their joints when aligned",
-                              access=hs.HopsParamAccess.LIST),
-                 hs.HopsString("Metrics", "M", "figures of the design (JSON)"),
-                 hs.HopsString("Bundle", "B", "design bundle folder (for Verify, Fabricate)")])
+        outputs=net_outputs())
     def gg(target, lamellae=6, grid=12, opts="{}"):
         from ..api import design_gg, write
 
@@ -151,13 +155,7 @@ def register(hops, workdir: Path) -> None:
                 hs.HopsInteger("Curves", "C", "curves per family", optional=True),
                 hs.HopsString("Options", "O", "JSON object of further design_ncp keywords",
                               optional=True)],
-        outputs=[hs.HopsMesh("Net", "N", "joints and net loops, metres"),
-                 hs.HopsCurve("Lamellae", "L", "lamella axes, metres",
-                              access=hs.HopsParamAccess.LIST),
-                 hs.HopsCurve("Aligned", "A", "lamellae through their joints when aligned",
-                              access=hs.HopsParamAccess.LIST),
-                 hs.HopsString("Metrics", "M", "figures of the design (JSON)"),
-                 hs.HopsString("Bundle", "B", "design bundle folder (for Verify, Fabricate)")])
+        outputs=net_outputs())
     def ncp(reference, mode="cnc", curves=8, opts="{}"):
         from ..api import design_ncp, write
 
