@@ -29,12 +29,12 @@ from gridshell.errors import InputError
 from .params import FabParams
 from .part import Part
 from .path import Motion
+from .rows import SLACK, fullest as _fullest, plan_rows  # noqa: F401 (_fullest: tests)
 from .splice import chord_frame
 
 
 DROP_TOL = 0.1     # mm, growth and simplification of the rings the drop search uses
 FLAT_TOL = 0.01    # mm, chord tolerance of the part polygons (arcs bulge out by up to this)
-SLACK = 0.05       # mm: a piece cut to fit the sheet (to 0.01 mm, arcs sampled) fits it
 COLUMN = 2.0       # mm, width of the columns of the part profiles (the step of the places)
 
 
@@ -109,25 +109,27 @@ def _shapes(part: Part, curved: bool) -> list[_Shape]:
         base = part.moved(Motion(-np.arctan2(u[1], u[0]), 0.0, 0.0))  # +s along +x
     else:
         base = part
-    out = []
-    for turn in ((0.0, np.pi) if curved else (0.0,)):
-        p = base.moved(Motion(turn, 0.0, 0.0)) if turn else base
-        pad = FLAT_TOL if curved else 0.0               # arcs bulge out by up to FLAT_TOL
-        x0, y0, _, _ = p.polygon(FLAT_TOL).bounds
-        p = p.moved(Motion(0.0, pad - x0, pad - y0))
-        poly = p.polygon(FLAT_TOL)
-        _, _, w, h = poly.bounds
-        w, h = w + pad, h + pad
-        ring = _outer_ring(poly, 0.0)
-        ox = (float(ring[:, 0].min()), float(ring[:, 0].max()))
-        n = int(np.ceil((ox[1] - ox[0]) / COLUMN)) + 1
-        low, up = _columns(ring, ox[0], n, False), _columns(ring, ox[0], n, True)
-        # one column wider, each column also covering its left neighbour: the profile of the
-        # shape anywhere between two column offsets (so it may also touch the margins)
-        low = np.minimum(np.append(low, np.inf), np.insert(low, 0, np.inf))
-        up = np.maximum(np.append(up, -np.inf), np.insert(up, 0, -np.inf))
-        out.append(_Shape(p, poly, w, h, ox, low, up))
-    return out
+    return [_shape(base, turn, curved) for turn in ((0.0, np.pi) if curved else (0.0,))]
+
+
+def _shape(base: Part, turn: float, curved: bool) -> _Shape:
+    """``base`` turned by ``turn`` (radians), its box at the origin, with its profiles."""
+    p = base.moved(Motion(turn, 0.0, 0.0)) if turn else base
+    pad = FLAT_TOL if curved else 0.0               # arcs bulge out by up to FLAT_TOL
+    x0, y0, _, _ = p.polygon(FLAT_TOL).bounds
+    p = p.moved(Motion(0.0, pad - x0, pad - y0))
+    poly = p.polygon(FLAT_TOL)
+    _, _, w, h = poly.bounds
+    w, h = w + pad, h + pad
+    ring = _outer_ring(poly, 0.0)
+    ox = (float(ring[:, 0].min()), float(ring[:, 0].max()))
+    n = int(np.ceil((ox[1] - ox[0]) / COLUMN)) + 1
+    low, up = _columns(ring, ox[0], n, False), _columns(ring, ox[0], n, True)
+    # one column wider, each column also covering its left neighbour: the profile of the
+    # shape anywhere between two column offsets (so it may also touch the margins)
+    low = np.minimum(np.append(low, np.inf), np.insert(low, 0, np.inf))
+    up = np.maximum(np.append(up, -np.inf), np.insert(up, 0, -np.inf))
+    return _Shape(p, poly, w, h, ox, low, up)
 
 
 def _columns(ring: np.ndarray, x0: float, n: int, top: bool) -> np.ndarray:
@@ -232,59 +234,8 @@ def _frame_to_sheet(W: float, H: float) -> Motion:
 #: whether curved parts may turn by 180 degrees, and the order of the parts
 STRATEGIES = [("bottom-left", True, "length"), ("bottom-left", False, "length"),
               ("left-bottom", False, "length")]
-ROW_UNIT = 0.1     # mm, the length unit of the row filling
 RETRIES = 2        # passes more per strategy, with the last sheet's parts placed first
-
-
-def _fullest(lengths: np.ndarray, cap: float) -> list[int]:
-    """Indices of a subset of ``lengths`` that contains the first and whose sum is largest
-    but at most ``cap`` (subset sum over ROW_UNIT steps, lengths rounded up)."""
-    units = np.ceil(lengths / ROW_UNIT - 1e-9).astype(int)
-    c = int(np.floor(cap / ROW_UNIT + 1e-9)) - units[0]
-    if c < 0:
-        return []
-    reach = np.zeros(c + 1, bool)
-    reach[0] = True
-    history = []
-    for u in units[1:]:
-        history.append(reach.copy())
-        if u <= c:
-            reach[u:] |= history[-1][:c + 1 - u]
-    total = int(np.flatnonzero(reach).max())
-    chosen = [0]
-    for k in range(len(units) - 1, 0, -1):      # walk back through the items
-        if not history[k - 1][total]:
-            chosen.append(k)
-            total -= units[k]
-    return sorted(chosen)
-
-
-def _rows(shapes: list[list[_Shape]], Lx: float, Ly: float, g: float
-          ) -> tuple[list[_Sheet], dict[int, tuple[int, Part]]]:
-    """Straight strips in rows along the long side, each row as full as it can be: it takes
-    the longest strip left and the set of others that fills the rest of the row best."""
-    left = sorted(range(len(shapes)), key=lambda i: (-shapes[i][0].w, i))
-    sheets: list[_Sheet] = []
-    placed: dict[int, tuple[int, Part]] = {}
-    y = np.inf
-    while left:
-        L = np.array([shapes[i][0].w + g for i in left])
-        row = [left[k] for k in _fullest(L, Lx - g + SLACK)]
-        if not row:
-            raise InputError(f"lamella {shapes[left[0]][0].part.strip.lamella}: a piece does "
-                             f"not fit an empty {Lx:g} x {Ly:g} mm sheet; use a larger --sheet")
-        h = max(shapes[i][0].h for i in row)
-        if y + h > Ly - g + 1e-9:
-            sheets.append(_Sheet(Lx, Ly, g))
-            y = g
-        x = g
-        for i in row:
-            s = shapes[i][0]
-            placed[i] = (len(sheets) - 1, sheets[-1].add(s, x, y))
-            x += s.w + g
-        y += h + g
-        left = [i for i in left if i not in row]
-    return sheets, placed
+COLUMNS = 8        # most columns of turned straight strips tried per sheet (rows.plan_rows)
 
 
 def _key(key: str, x: np.ndarray, y: np.ndarray, h: float) -> np.ndarray:
@@ -341,6 +292,48 @@ def _nest_once(shapes: list[list[_Shape]], Lx: float, Ly: float, g: float, key: 
     return sheets, placed
 
 
+def gap_bound(parts: list[Part], sheet: tuple[float, float], gap: float) -> int:
+    """The fewest sheets any layout needs: parts grown by ``gap / 2`` are disjoint and lie
+    in the sheet shrunk by ``gap / 2``, so their areas (mm^2) sum to at most
+    ``(W - gap) (H - gap)`` per sheet (a lower bound; rounded up)."""
+    area = sum(p.polygon(FLAT_TOL).buffer(gap / 2, quad_segs=16).area for p in parts)
+    return int(np.ceil(area / ((sheet[0] - gap) * (sheet[1] - gap)) - 1e-9))
+
+
+def _rows_best(parts: list[Part], shapes: list[list[_Shape]], Lx: float, Ly: float,
+               g: float) -> tuple | None:
+    """The best plan of :func:`fabrication.rows.plan_rows` over 0 .. COLUMNS columns of
+    turned strips (first or last): fewest sheets, then the emptiest last sheet, then the
+    fewest columns. ``(score, None, plan)``; None if no plan holds the parts."""
+    w = np.array([s[0].w for s in shapes])
+    h = np.array([s[0].h for s in shapes])
+    area = np.array([s[0].poly.area for s in shapes])
+    best = None
+    for k in range(COLUMNS + 1):
+        if k and w.min() + 2 * g > Ly + SLACK:
+            break                          # no strip fits a column
+        for first in ((False, True) if k else (False,)):
+            plan = plan_rows(w, h, Lx, Ly, g, columns=k, columns_first=first)
+            if plan is None:
+                continue
+            n = max(s for s, *_ in plan) + 1
+            score = (n, float(area[[s == n - 1 for s, *_ in plan]].sum()), k)
+            if best is None or score < best[0]:
+                best = (score, None, plan)
+    return best
+
+
+def _place_plan(shapes: list[list[_Shape]], plan: list, Lx: float, Ly: float, g: float
+                ) -> tuple[list[_Sheet], dict[int, tuple[int, Part]]]:
+    """Sheets and placed parts of a :func:`fabrication.rows.plan_rows` plan."""
+    sheets = [_Sheet(Lx, Ly, g) for _ in range(max(s for s, *_ in plan) + 1)]
+    placed = {}
+    for i, (k, x, y, turned) in enumerate(plan):
+        s = _shape(shapes[i][0].part, np.pi / 2, False) if turned else shapes[i][0]
+        placed[i] = (k, sheets[k].add(s, float(x), float(y)))
+    return sheets, placed
+
+
 def nest(parts: list[Part], params: FabParams) -> Layout:
     """Place ``parts`` on as many sheets as needed; see the module docstring.
 
@@ -356,10 +349,12 @@ def nest(parts: list[Part], params: FabParams) -> Layout:
     shapes = [_shapes(p, p.strip.axis.kind != "line") for p in parts]
     curved = any(len(s) > 1 for s in shapes)
     best = None
-    if not curved and all(len(s) == 1 for s in shapes):
-        sheets, placed = _rows(shapes, Lx, Ly, g)
-        best = ((len(sheets), sum(q.poly.area for q in sheets[-1].placed)), sheets, placed)
+    floor = gap_bound(parts, params.sheet, g)
+    if not curved:
+        best = _rows_best(parts, shapes, Lx, Ly, g)
     for key, turn, order in STRATEGIES:
+        if best is not None and best[0][0] <= floor:
+            break                         # no layout has fewer sheets
         if turn and not curved:
             continue
         first: list[int] = []
@@ -375,6 +370,8 @@ def nest(parts: list[Part], params: FabParams) -> Layout:
             first = first + [i for i, (k, _) in placed.items()
                              if k == len(sheets) - 1 and i not in first]
     _, sheets, placed = best
+    if isinstance(placed, list):           # a rows-and-columns plan: place it now
+        sheets, placed = _place_plan(shapes, placed, Lx, Ly, g)
     idx = sorted(placed)
     return Layout([placed[i][1].moved(to_sheet) for i in idx], [placed[i][0] for i in idx],
                   len(sheets), (W, H))
