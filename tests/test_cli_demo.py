@@ -108,6 +108,10 @@ def test_quick_demo_figures_meet_the_paper_bounds(quick_demo):
     assert saved["summary"]["GG Delta_a [%]"] == s["GG Delta_a [%]"]
     assert saved["ncp"]["fabrication"]["shape"] == "arc"
     assert saved["gg"]["fabrication"]["shape"] == "line"
+    for part, key in (("gg", "GG cut files"), ("ncp", "CNC cut files")):   # sheets and use
+        f = saved[part]["fabrication"]
+        used = ", ".join(f"{100 * u:.1f}" for u in f["material_used_per_sheet"])
+        assert s[key].startswith(f"{f['n_sheets']} x 600 x 400 mm ({used} % of the sheet area")
     # the 1 mm polypropylene strips are checked: structure.json, a line per design
     for part, key in (("gg", "GG strips 1 mm pp"), ("ncp", "CNC strips 1 mm pp")):
         r = json.loads((out / part / "structure.json").read_text())

@@ -215,7 +215,9 @@ def _mm(d: dict) -> dict[str, float]:
 def _sheets(fab: dict) -> str:
     W, H = fab["params"]["sheet"]
     f = FABRICATION
-    return (f"{fab['n_sheets']} x {W:g} x {H:g} mm, {fab['n_pieces']} {fab['shape']} strips "
+    used = ", ".join(f"{100 * u:.1f}" for u in fab["material_used_per_sheet"])
+    return (f"{fab['n_sheets']} x {W:g} x {H:g} mm ({used} % of the sheet area used), "
+            f"{fab['n_pieces']} {fab['shape']} strips "
             f"({f['scale']}, {f['width']:g} mm wide, {f['thickness']:g} mm polypropylene)")
 
 
@@ -270,7 +272,8 @@ def _nested(summary: dict, gg: dict | None, ncp: dict | None) -> dict[str, Any]:
         keep = {k: v for k, v in r.items() if k not in ("dir", "fabrication")}
         f = r["fabrication"]
         keep["fabrication"] = {k: f[k] for k in ("n_strips", "n_pieces", "n_sheets", "shape",
-                                                  "utilisation", "structure")}
+                                                  "utilisation", "material_used",
+                                                  "material_used_per_sheet", "structure")}
         return keep
 
     return {"summary": summary, "gg": part(gg), "ncp": part(ncp)}

@@ -222,7 +222,7 @@ def _fabrication_section(d: Path) -> str:
         except (OSError, ValueError):
             rep = {}
         keys = ("shape", "n_strips", "n_pieces", "n_sheets", "n_joint_marks", "utilisation",
-                "labels_dropped", "radius_mm")
+                "material_used", "labels_dropped", "radius_mm")
         parts.append(_kv_table((k, rep[k]) for k in keys if k in rep))
     plan = fab / "plan.png"
     if plan.is_file():
