@@ -9,6 +9,10 @@ the part drops from above the sheet until it comes ``gap`` from a part below it 
 bottom margin) - the true outlines, not their bounding boxes: arcs of one radius fall into
 each other, a short strip goes into the room a row leaves. Sheets are opened as needed.
 
+Straight strips are also laid out in rows and in columns of strips turned by 90 degrees
+(:mod:`fabrication.rows`); the best layout of all strategies is kept, and the search stops at
+:func:`gap_bound`, the fewest sheets any layout needs.
+
 All parts keep ``gap`` mm from each other and from the sheet edges. The drop uses outer
 approximations of the outlines (grown by ``DROP_TOL``, simplified by as much), so a dropped
 part never comes closer than ``gap``; :func:`check_layout` checks the result with the fine
@@ -337,7 +341,8 @@ def _place_plan(shapes: list[list[_Shape]], plan: list, Lx: float, Ly: float, g:
 def nest(parts: list[Part], params: FabParams) -> Layout:
     """Place ``parts`` on as many sheets as needed; see the module docstring.
 
-    Each strategy of :data:`STRATEGIES` nests all parts, first fit decreasing: each part
+    Straight strips first go in rows and columns (:func:`_rows_best`). Each strategy of
+    :data:`STRATEGIES` nests all parts, first fit decreasing: each part
     goes onto the first sheet with room for it, at the best of its drop places there; then
     again (:data:`RETRIES` times) with the parts the last sheet got placed first. The layout
     with the fewest sheets wins, then the one whose last sheet is emptiest. Raises
