@@ -28,7 +28,8 @@ NCP_SMALL = ["--samples", "24", "24", "--collapse-samples", "200", "200", "--fra
              "--rounds", "1", "--no-render", "--phlw-samples", "12", "12", "--phlw-outer", "2"]
 
 #: corpus designs (reference, CLI words), and "hypar-cnc": a CNC gridshell on the hyperbolic
-#: paraboloid z = x y / 4 m over a 4 x 4 m square, 10 curves per family
+#: paraboloid z = x y / 4.5 m over a 4.5 x 4.5 m square, 12 curves per family (24 arcs,
+#: 43 % of one sheet)
 CORPUS = {
     "associate-03-gg": ("associate-03", ["gg", *GG_SMALL]),
     "hill-06-gg": ("hill-06", ["gg", *GG_SMALL]),
@@ -36,7 +37,7 @@ CORPUS = {
     "pseudosphere-03-aa": ("pseudosphere-03", ["ncp", "--mode", "aa", "--curves", "6",
                                                *NCP_SMALL]),
     "saddle-04-cnc": ("saddle-04", ["ncp", "--mode", "cnc", "--curves", "6", *NCP_SMALL]),
-    "hypar-cnc": (None, ["ncp", "--mode", "cnc", "--curves", "10", *NCP_SMALL]),
+    "hypar-cnc": (None, ["ncp", "--mode", "cnc", "--curves", "12", *NCP_SMALL]),
 }
 #: the demo's CNC pavilion: 24 arcs (radius 231 mm) take 49.8 % of one 600 x 400 sheet and
 #: 64.8 % grown by half the gap, yet the nesting needs 2 sheets (45.1 % + 4.7 %): nested arcs
@@ -96,7 +97,7 @@ def _design(case: str, root) -> tuple:
     return read_bundle(out), FabParams()
 
 
-def _hypar(path, side=4.0, c=4.0, n=13):
+def _hypar(path, side=4.5, c=4.5, n=13):
     """OBJ of the hyperbolic paraboloid ``z = x y / c`` over ``side x side`` m, n x n."""
     import numpy as np
 
