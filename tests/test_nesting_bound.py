@@ -161,3 +161,34 @@ def test_hypar_cnc_on_one_sheet_if_its_area_allows(designs):
     else:
         assert gap_bound(parts, params.sheet, g) > 1 and layout.n_sheets == gap_bound(
             parts, params.sheet, g), f"grown parts {grown:.0f} mm^2 > {(W - g) * (H - g):.0f}"
+
+
+def test_sheet_count_and_material_used_in_summary_cut_list_and_plan(tmp_path, capsys):
+    """``gridshell fabricate``: the summary, the cut list and the plan's title give the sheet
+    count and the material used (part outlines over sheet area) of fabrication.json."""
+    import csv
+    import json
+
+    from fab_cases import make_bundle
+
+    from gridshell.bundle import write_bundle
+    from gridshell.cli.main import main
+
+    write_bundle(tmp_path / "b", make_bundle("CNC", nr=5, nc=6))
+    out = tmp_path / "fab"
+    assert main(["fabricate", "--force", str(tmp_path / "b"), "-o", str(out), "--sheet",
+                 "300x200", "-q", "--json"]) == 0
+    s = json.loads(capsys.readouterr().out)
+    rep = json.loads((out / "fabrication.json").read_text())
+    n, used, per = rep["n_sheets"], rep["material_used"], rep["material_used_per_sheet"]
+    assert n >= 2 and sum(per) == pytest.approx(n * used)
+    assert s["sheets"].startswith(f"{n} x 300 x 200 mm")
+    assert s["material used [% of sheet area]"] == (
+        ", ".join(f"{100 * u:.1f}" for u in per) + f" (all sheets {100 * used:.1f})")
+    with open(out / "cutlist.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    assert {int(r["n_sheets"]) for r in rows} == {n}
+    assert {r["material_used_pct"] for r in rows} == {f"{100 * used:.1f}"}
+    assert all(r["sheet_used_pct"] == f"{100 * per[int(r['sheet']) - 1]:.1f}" for r in rows)
+    title = f"{n} sheets 300 x 200 mm, {100 * used:.0f} % of their area used"
+    assert title in (out / "plan.svg").read_text()
