@@ -89,6 +89,14 @@ def polygon_vector_areas(V: np.ndarray, F: np.ndarray) -> np.ndarray:
     return 0.5 * np.cross(P, nxt).sum(axis=1)
 
 
+def unique_ints(a: np.ndarray) -> np.ndarray:
+    """``np.unique`` of an integer array (flattened), by sorting: numpy 2.4's default unique
+    hashes, ~30x slower on big arrays (0.33 s against 0.01 s for the 600k edge keys of a
+    200k-triangle mesh)."""
+    s = np.sort(np.asarray(a).ravel())
+    return s[np.r_[True, s[1:] != s[:-1]]] if len(s) else s
+
+
 def _unit(X: np.ndarray) -> np.ndarray:
     """Rows of ``X`` normalized to unit length (zero rows stay zero)."""
     n = np.linalg.norm(X, axis=1, keepdims=True)
@@ -280,7 +288,7 @@ def _topology_problem(P: np.ndarray, n: int, vertices: bool = True) -> str | Non
     G = coo_matrix((np.ones(len(ca)), (ca, cb)), shape=(nc, nc))
     _, label = connected_components(G, directed=False)
     vert = src  # vertex of each corner (corner = src of its edge)
-    pair = np.unique(vert * np.int64(nc) + label)
+    pair = unique_ints(vert * np.int64(nc) + label)
     fans = np.bincount(pair // nc, minlength=n)
     if np.any(fans > 1):
         bad = np.flatnonzero(fans > 1)

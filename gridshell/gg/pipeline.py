@@ -24,7 +24,7 @@ from scipy.sparse.linalg import lsqr
 from ..bundle import Design, DesignBundle, report_json, write_bundle
 from ..errors import ConvergenceError, GridshellError, InputError, NoNetError
 from ..grid import grid_quads
-from ..metrics import (alignability_error, alignability_error_arc, coverage, delta_l, deviation,
+from ..metrics import (alignability_error, alignability_error_arc, coverage, delta_l, deviations,
                        geodesic_turning, summary, target_deviation)
 from ..net import Net
 from ..quality import Gate, design_gates, gate_lines, gate_summary, passed
@@ -243,8 +243,7 @@ def gg_metrics(net: Net, V: np.ndarray, F: np.ndarray, *, net_rev: Net | None = 
     out["geodesic_turning"] = 100.0 * geodesic_turning(net, V, F)["ratio"]
     if target is not None:
         tV, tF = target
-        dv = deviation(V, tV, tF)
-        dj = deviation(net.joints, tV, tF)
+        dv, dj = deviations([V, net.joints], tV, tF)  # one closest-point tree of the target
         out["deviation"] = {"mean": dv["mean"], "max": dv["max"]}
         out["deviation_joints"] = {"mean": dj["mean"], "max": dj["max"]}
         sV, sF = target_samples if target_samples is not None else target
