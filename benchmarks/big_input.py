@@ -35,8 +35,19 @@ STAGES = [
     ("gridshell.gg.pipeline", "gg_net_from_mesh", "trace the net"),
     ("gridshell.igl_adapter", "closest_points", "closest points (igl AABB)"),
     ("gridshell.gg.pipeline", "gg_metrics", "figures (excl. closest points)"),
+    ("gridshell.gg.pipeline", "gg_alignment_sequence", "alignment sequence"),
     ("gridshell.api", "write", "bundle writing"),
+    ("gridshell.render.net_preview", "net_preview", "pictures"),
+    ("gridshell.render.states", "sequence_pngs", "pictures"),
+    ("gridshell.render.states", "states_png", "pictures"),
+    ("gridshell.render.ncp_maps", "gif", "pictures"),
 ]
+
+#: the runs per size: name -> options of ``gridshell gg``
+MODES = {
+    "design": ["--no-preview", "--frames", "0"],  # the design and its bundle (the goal's run)
+    "defaults": [],  # as a user runs it: also the 12-step alignment sequence and the pictures
+}
 
 
 def _child(argv: list[str], marks_path: str) -> int:
@@ -44,7 +55,10 @@ def _child(argv: list[str], marks_path: str) -> int:
     w0, c0 = time.perf_counter(), time.process_time()
     from gridshell.cli.main import main  # the CLI's own imports
 
-    for mod, _, _ in STAGES:  # the modules the gg command loads anyway
+    # the modules the gg command loads anyway (the pictures' only when it draws them)
+    stages = [st for st in STAGES
+              if "--no-preview" not in argv or not st[0].startswith("gridshell.render")]
+    for mod, _, _ in stages:
         importlib.import_module(mod)
     w1, c1 = time.perf_counter(), time.process_time()
     totals: dict[str, list[float]] = {"imports": [w1 - w0, c1 - c0, 1]}
@@ -69,7 +83,7 @@ def _child(argv: list[str], marks_path: str) -> int:
                     stack[-1][1] += dc
         return wrapper
 
-    for mod, name, label in STAGES:
+    for mod, name, label in stages:
         m = sys.modules[mod]
         setattr(m, name, timed(getattr(m, name), label))
     stack.append([0.0, 0.0])
@@ -81,10 +95,10 @@ def _child(argv: list[str], marks_path: str) -> int:
     return code
 
 
-def run(target: Path, out: Path) -> dict:
+def run(target: Path, out: Path, options: list[str]) -> dict:
     load = os.getloadavg()[0]
     marks = out.with_suffix(".stages.json")
-    gg = ["gg", str(target), "-o", str(out), "--no-preview", "--frames", "0", "-q", "--json"]
+    gg = ["gg", str(target), "-o", str(out), *options, "-q", "--json"]
     cmd = [sys.executable, __file__, "--child", str(marks), *gg]
     t0 = time.perf_counter()
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
@@ -116,31 +130,35 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--sizes", nargs="+", type=int, default=[40, 355],
                     help="grid points along the 12 m side (40: ~2.4k triangles, 355: ~200k)")
+    ap.add_argument("--modes", nargs="+", choices=tuple(MODES), default=list(MODES),
+                    help="design: --no-preview --frames 0 (the goal's run); defaults: the "
+                         "command as a user runs it, with the alignment sequence and pictures")
     ap.add_argument("--keep", type=Path, help="keep the targets and bundles here")
     args = ap.parse_args()
     root = args.keep or Path(tempfile.mkdtemp(prefix="big_input_"))
     root.mkdir(parents=True, exist_ok=True)
     print(f"gg on a 12 x 8 m hill; {os.cpu_count()} CPUs, load average "
           f"{os.getloadavg()[0]:.1f} (shared machine: compare CPU times)")
-    print(f"{'triangles':>10} {'wall s':>8} {'CPU s':>8} {'peak MB':>8} {'load':>5}  "
+    print(f"{'triangles':>10} {'run':>9} {'wall s':>8} {'CPU s':>8} {'peak MB':>8} {'load':>5}  "
           "deviation mean/max [% diag]  verdict")
     runs = []
     for n in args.sizes:
         V, T = hill(n, int(n * 0.8))
         target = root / f"hill_{len(T)}.obj"
         write_mesh(target, V, T)
-        r = run(target, root / f"gg_{len(T)}")
-        runs.append((len(T), r))
-        s = r["summary"]
-        dev = s.get("deviation [% diag]") or {}
-        verdict = s.get("verdict", f"exit {r['exit']}")
-        print(f"{len(T):>10} {r['wall']:>8.1f} {r['cpu']:>8.1f} {r['peak_mb']:>8.0f} "
-              f"{r['load']:>5.1f}  {dev.get('mean', float('nan')):.3f} / "
-              f"{dev.get('max', float('nan')):.3f}  {str(verdict)[:40]}")
+        for mode in args.modes:
+            r = run(target, root / f"gg_{len(T)}_{mode}", MODES[mode])
+            runs.append((f"{len(T)} {mode}", r))
+            s = r["summary"]
+            dev = s.get("deviation [% diag]") or {}
+            verdict = s.get("verdict", f"exit {r['exit']}")
+            print(f"{len(T):>10} {mode:>9} {r['wall']:>8.1f} {r['cpu']:>8.1f} "
+                  f"{r['peak_mb']:>8.0f} {r['load']:>5.1f}  {dev.get('mean', float('nan')):.3f}"
+                  f" / {dev.get('max', float('nan')):.3f}  {str(verdict)[:40]}", flush=True)
     print("\nper stage, wall / CPU seconds (calls)")
     labels = ["python start + exit", "imports"] + list(dict.fromkeys(
         lab for _, _, lab in STAGES)) + ["other (CLI, collapse, gates)"]
-    print(f"{'stage':<38}" + "".join(f"{f'{n} triangles':>22}" for n, _ in runs))
+    print(f"{'stage':<38}" + "".join(f"{name:>22}" for name, _ in runs))
     for lab in labels:
         cells = []
         for _, r in runs:
