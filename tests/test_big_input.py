@@ -71,3 +71,21 @@ def test_the_working_copy_of_a_big_target_is_a_disk_on_it():
     # and a small target is used as it is
     V2, T2, info2 = working_mesh(V, T, max_faces=len(T))
     assert info2 is None and V2 is V
+
+
+def test_polygon_vector_areas_are_the_shoelace_sums_bit_for_bit():
+    from gridshell.quadmesh import polygon_vector_areas
+
+    rng = np.random.default_rng(2)
+    V = rng.normal(size=(60, 3))
+    for k in (3, 4, 9):
+        F = np.stack([rng.permutation(60)[:k] for _ in range(40)])
+        F[::3, k - 1] = -1  # padded: some faces one vertex shorter
+        got = polygon_vector_areas(V, F)
+        for f, row in zip(F, got):
+            P = V[f[f >= 0]]
+            want = np.cross(P, np.roll(P, -1, axis=0))
+            acc = want[0].copy()
+            for c in want[1:]:
+                acc += c
+            assert np.array_equal(_bits(row), _bits(0.5 * acc))
