@@ -8,6 +8,7 @@ from io_cases import hill
 
 import gridshell.gg.pipeline as pipeline
 from gridshell.gg.pipeline import TracedNets, design_gg, gg_net_from_mesh, gg_score
+from gridshell.metrics import alignability_error, summary
 
 OPTIONS = dict(grid=(10, 8), n_lamellae=4, frames=0, polish_iter=8, allow_unconverged=True)
 
@@ -18,6 +19,7 @@ def _design(monkeypatch, *, cache: bool):
     trace = pipeline.gg_net_from_mesh
 
     def counted(P, **kw):
+        assert kw["revolution_net"] is False  # a score needs no net on the revolution
         calls.append(np.array(P, copy=True))
         return trace(P, **kw)
 
@@ -40,8 +42,11 @@ def test_the_returned_checkpoint_is_not_traced_again(monkeypatch):
     assert any(np.array_equal(P, c) for c in calls)  # the checkpoint was traced by its check
     assert any("tracing geodesics: the net traced when the design checked" in m for m in msgs)
     # and that net is the one a new trace gives
-    fresh = gg_net_from_mesh(P, n_lamellae=4)["net"]
-    assert np.array_equal(fresh.joints, bundle.net.joints)
+    fresh = gg_net_from_mesh(P, n_lamellae=4)
+    assert np.array_equal(fresh["net"].joints, bundle.net.joints)
+    rev = fresh["net_rev"]  # and the net on the revolution, added to the kept one
+    assert bundle.metrics["alignability_revolution"] == {
+        k: 100.0 * v for k, v in summary(alignability_error(rev.joints, rev.loops)).items()}
     assert report["design"]["score"] == gg_score(P, n_lamellae=4)
 
 

@@ -94,7 +94,7 @@ def gg_net_from_mesh(P: np.ndarray, *, n_lamellae: int | None = 10, spacing: flo
                      crossing_angle: float = 90.0, at_parallel: float = 0.5,
                      offsets: tuple[Sequence[float], Sequence[float]] | None = None,
                      angle: float | None = None, step: float | None = None,
-                     progress: Progress = None) -> dict[str, Any]:
+                     revolution_net: bool = True, progress: Progress = None) -> dict[str, Any]:
     """The geodesic alignable net of a GG mesh (paper 4.1.2).
 
     Parameters
@@ -111,6 +111,9 @@ def gg_net_from_mesh(P: np.ndarray, *, n_lamellae: int | None = 10, spacing: flo
         Total angle of the surface of revolution, radians (default: chosen automatically).
     step : float, optional
         Sampling step of the traced curves, metres.
+    revolution_net : bool
+        Also map the net onto the surface of revolution (``net_rev``; a score needs only
+        ``net``).
 
     Returns
     -------
@@ -147,8 +150,10 @@ def gg_net_from_mesh(P: np.ndarray, *, n_lamellae: int | None = 10, spacing: flo
             "of arc length: give positions in that range (metres)") from None
     _say(progress, f"mapping {len(inet.curves1)} + {len(inet.curves3)} curves onto the surface")
     net, extra = map_back(inet, P, rev)
-    net_rev, _ = map_to_revolution(inet, rev)
-    return {"rev": rev, "inet": inet, "net": net, "extra": extra, "net_rev": net_rev}
+    stage = {"rev": rev, "inet": inet, "net": net, "extra": extra}
+    if revolution_net:
+        stage["net_rev"] = map_to_revolution(inet, rev)[0]
+    return stage
 
 
 def _metres(values: Sequence[float]) -> str:
@@ -288,9 +293,10 @@ def _stage_score(stage: dict[str, Any]) -> float:
 class TracedNets:
     """The nets traced on GG meshes, kept by mesh: the design scores its checkpoints by their
     traced nets (:meth:`score`, :func:`gg_score`) and returns one of them, whose net
-    :meth:`net` then gives without tracing it again (one trace less per design: ~0.2 s
-    of the 200k-triangle ``gg``). The key is the mesh's exact bytes, so a reused net is the
-    net a new trace would give. ``traced`` counts the traces made."""
+    :meth:`net` then gives without tracing it again (one trace less per design; the scores
+    skip the net on the surface of revolution, which :meth:`net` adds). The key is the mesh's
+    exact bytes, so a reused net is the net a new trace would give. ``traced`` counts the
+    traces made."""
 
     def __init__(self, **net_options: Any) -> None:
         self.options = net_options
@@ -302,21 +308,28 @@ class TracedNets:
         P = np.ascontiguousarray(P, dtype=float)
         return P.shape, P.tobytes()
 
+    def _traced(self, P: np.ndarray, progress: Progress = None) -> dict[str, Any]:
+        key = self._key(P)
+        stage = self._nets.get(key)
+        if stage is None:
+            self.traced += 1  # the scores need no net on the surface of revolution
+            stage = self._nets[key] = gg_net_from_mesh(P, **self.options, progress=progress,
+                                                       revolution_net=False)
+        else:
+            _say(progress, "tracing geodesics: the net traced when the design checked this mesh")
+        return stage
+
     def net(self, P: np.ndarray, progress: Progress = None) -> dict[str, Any]:
         """:func:`gg_net_from_mesh` of ``P`` with the options given, traced once per mesh."""
-        key = self._key(P)
-        if key in self._nets:
-            _say(progress, "tracing geodesics: the net traced when the design checked this mesh")
-            return self._nets[key]
-        self.traced += 1
-        stage = gg_net_from_mesh(P, **self.options, progress=progress)
-        self._nets[key] = stage
+        stage = self._traced(P, progress)
+        if "net_rev" not in stage:
+            stage["net_rev"] = map_to_revolution(stage["inet"], stage["rev"])[0]
         return stage
 
     def score(self, P: np.ndarray) -> float:
         """:func:`gg_score` of ``P``; its net is kept for :meth:`net`."""
         try:
-            stage = self.net(P)
+            stage = self._traced(P)
         except GridshellError:
             return float("inf")
         return _stage_score(stage)
