@@ -19,13 +19,8 @@ import os
 from pathlib import Path
 from typing import Any, Callable
 
-import functools
-
 from .bundle import Design, DesignBundle, read_bundle, write_bundle
 from .errors import InputError
-from .gg import pipeline as _gg
-from .ncp import pipeline as _ncp
-from .ncp.phlw import optimize_phlw
 from .verification import design_verdict, verify_bundle
 
 __all__ = ["Design", "DesignBundle", "design_gg", "design_ncp", "export_3dm", "fabricate",
@@ -34,16 +29,31 @@ __all__ = ["Design", "DesignBundle", "design_gg", "design_ncp", "export_3dm", "f
 Progress = Callable[[str], None] | None
 
 
-# the pipelines' functions, looked up at each call (a test or a plug-in replacing
-# gridshell.gg.pipeline.design_gg reaches the CLI and the API alike)
-@functools.wraps(_gg.design_gg)
+# The pipelines are imported by the functions that run them (``gridshell gg`` loads neither
+# NCP nor PHLW: ~0.2 s of a command) and looked up at each call (a test or a plug-in
+# replacing gridshell.gg.pipeline.design_gg reaches the CLI and the API alike).
 def design_gg(*args: Any, **kwargs: Any) -> Design:
-    return _gg.design_gg(*args, **kwargs)
+    """Design a geodesic (GG) gridshell on a target surface: ``(bundle, report)``;
+    parameters and results of :func:`gridshell.gg.pipeline.design_gg`."""
+    from .gg import pipeline
+
+    return pipeline.design_gg(*args, **kwargs)
 
 
-@functools.wraps(_ncp.design_ncp)
 def design_ncp(*args: Any, **kwargs: Any) -> Design:
-    return _ncp.design_ncp(*args, **kwargs)
+    """Design an NCP gridshell (PHLW, CNC or AA) on a reference surface: ``(bundle,
+    report)``; parameters and results of :func:`gridshell.ncp.pipeline.design_ncp`."""
+    from .ncp import pipeline
+
+    return pipeline.design_ncp(*args, **kwargs)
+
+
+def optimize_phlw(*args: Any, **kwargs: Any) -> Any:
+    """The PHLW optimization of a B-spline surface (paper 4.2.1); parameters and result of
+    :func:`gridshell.ncp.phlw.optimize_phlw`."""
+    from .ncp import phlw
+
+    return phlw.optimize_phlw(*args, **kwargs)
 
 
 def _parts(design: Any, report: dict | None = None) -> tuple[DesignBundle, dict | None]:
@@ -79,17 +89,18 @@ def write(path: str | os.PathLike, design: Design | DesignBundle, report: dict |
     render : bool
         Also draw the pictures and the animation (the slowest part).
     """
-    from .gg.pipeline import gg_files
-    from .ncp.pipeline import ncp_files
-
     bundle, report = _parts(design, report)
     if bundle.kind == "GG":
+        from .gg.pipeline import gg_files
+
         extra = gg_files(bundle, report, render=render, frames=frames, progress=progress)
     else:
         if not isinstance(report, dict) or "state" not in report:
             raise InputError(f"an {bundle.kind} design is written with the report of "
                              "design_ncp (it holds the B-spline and the rotation axes): "
                              "write(path, design_ncp(...))")
+        from .ncp.pipeline import ncp_files
+
         extra = ncp_files(bundle, report, render=render, progress=progress)
     return write_bundle(path, bundle, extra=extra)
 

@@ -199,17 +199,29 @@ def deviation(P: np.ndarray, V: np.ndarray, F: np.ndarray) -> dict[str, float]:
         ``max``, ``mean``: distances in % of the bounding-box diagonal of the referenced
         vertices of ``(V, F)``; ``diagonal`` in metres.
     """
+    return deviations([P], V, F)[0]
+
+
+def deviations(Ps: Sequence[np.ndarray], V: np.ndarray, F: np.ndarray) -> list[dict[str, float]]:
+    """:func:`deviation` of each point set of ``Ps`` from one surface, with one closest-point
+    query (igl builds its AABB tree once per query: on a 200k-triangle target ~0.15 s)."""
     from .igl_adapter import closest_points
 
     V = _V("V", V)
-    used = V[np.unique(np.asarray(F, dtype=np.int64))]
-    diag = float(np.linalg.norm(used.max(axis=0) - used.min(axis=0)))
+    used = np.zeros(len(V), dtype=bool)  # the referenced vertices (a mask: O(n), no sort)
+    used[np.asarray(F, dtype=np.int64).ravel()] = True
+    used = V[used]
+    diag = float(np.linalg.norm(used.max(axis=0) - used.min(axis=0))) if len(used) else 0.0
     if not diag > 0:
         raise InputError("the reference surface has a zero bounding box; give a real surface")
-    sq, _, _ = closest_points(_V("P", P), V, F)
+    Ps = [_V("P", P) for P in Ps]
+    sq, _, _ = closest_points(np.concatenate(Ps) if Ps else np.zeros((0, 3)), V, F)
     d = np.sqrt(np.maximum(sq, 0.0)) / diag * 100.0
-    return {"max": float(d.max()) if len(d) else 0.0, "mean": float(d.mean()) if len(d) else 0.0,
-            "diagonal": diag}
+    out = []
+    for part in np.split(d, np.cumsum([len(P) for P in Ps])[:-1]):
+        out.append({"max": float(part.max()) if len(part) else 0.0,
+                    "mean": float(part.mean()) if len(part) else 0.0, "diagonal": diag})
+    return out
 
 
 def surface_area(V: np.ndarray, F: np.ndarray) -> float:
@@ -264,9 +276,10 @@ def target_deviation(V: np.ndarray, F: np.ndarray, target_V: np.ndarray,
         of the bounding-box diagonal of the referenced target vertices; ``diagonal`` in metres.
     """
     from .igl_adapter import closest_points, triangulate
+    from .quadmesh import unique_ints
 
     tV, T, _ = triangulate(_V("target_V", target_V), target_F)
-    used = tV[np.unique(T)]
+    used = tV[unique_ints(T)]
     diag = float(np.linalg.norm(used.max(axis=0) - used.min(axis=0)))
     if not diag > 0:
         raise InputError("the target has a zero bounding box; give a real surface")

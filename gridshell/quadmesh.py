@@ -80,13 +80,30 @@ def polygon_vector_areas(V: np.ndarray, F: np.ndarray) -> np.ndarray:
         return np.zeros((0, 3))
     valid = F >= 0
     Fi = np.where(valid, F, F[:, :1])  # padding repeats the first vertex: zero contribution
-    P = V[Fi]  # (m,k,3)
-    nxt = np.roll(P, -1, axis=1)
+    nxt = np.roll(Fi, -1, axis=1)
     # the last valid vertex must close onto the first one
     last = valid.sum(axis=1) - 1
-    nxt[np.arange(m), last] = P[:, 0]
-    nxt[~valid] = P[:, :1].repeat(k, axis=1)[~valid]
-    return 0.5 * np.cross(P, nxt).sum(axis=1)
+    nxt[np.arange(m), last] = Fi[:, 0]
+    nxt[~valid] = np.broadcast_to(Fi[:, :1], (m, k))[~valid]
+    # np.cross(P, P_next).sum(axis=1) by coordinates, the same operations in the same order
+    # (3-4x faster on the 200k faces of a big target: no (m, k, 3) temporaries)
+    x, y, z = (V[:, i][Fi] for i in range(3))
+    xn, yn, zn = (V[:, i][nxt] for i in range(3))
+    out = np.empty((m, 3))
+    for i, c in enumerate((y * zn - z * yn, z * xn - x * zn, x * yn - y * xn)):
+        acc = c[:, 0].copy()
+        for j in range(1, k):
+            acc += c[:, j]
+        out[:, i] = acc
+    return 0.5 * out
+
+
+def unique_ints(a: np.ndarray) -> np.ndarray:
+    """``np.unique`` of an integer array (flattened), by sorting: numpy 2.4's default unique
+    hashes, ~30x slower on big arrays (0.33 s against 0.01 s for the 600k edge keys of a
+    200k-triangle mesh)."""
+    s = np.sort(np.asarray(a).ravel())
+    return s[np.r_[True, s[1:] != s[:-1]]] if len(s) else s
 
 
 def _unit(X: np.ndarray) -> np.ndarray:
@@ -280,7 +297,7 @@ def _topology_problem(P: np.ndarray, n: int, vertices: bool = True) -> str | Non
     G = coo_matrix((np.ones(len(ca)), (ca, cb)), shape=(nc, nc))
     _, label = connected_components(G, directed=False)
     vert = src  # vertex of each corner (corner = src of its edge)
-    pair = np.unique(vert * np.int64(nc) + label)
+    pair = unique_ints(vert * np.int64(nc) + label)
     fans = np.bincount(pair // nc, minlength=n)
     if np.any(fans > 1):
         bad = np.flatnonzero(fans > 1)

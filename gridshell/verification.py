@@ -179,7 +179,7 @@ def verify_bundle(path: str | Path) -> dict[str, Any]:
     from .errors import InputError
     from .metrics import (alignability_error, alignability_error_arc,
                            crossing_normal_curvature_on_mesh, delta_l, delta_n,
-                           deviation, geodesic_turning, summary)
+                           deviation, deviations, geodesic_turning, summary)
     from .net import Net
     from .quality import design_gates, failing
     from .meshfile import read_configuration, read_mesh, read_polylines
@@ -226,8 +226,7 @@ def verify_bundle(path: str | Path) -> dict[str, Any]:
         except InputError as exc:
             out["deviation"] = {"skipped": f"target {target} unreadable: {exc}"}
         else:
-            dv = deviation(surf.V, t.V, t.F)
-            dj = deviation(net.joints, t.V, t.F)
+            dv, dj = deviations([surf.V, net.joints], t.V, t.F)
             out["deviation"] = {"mean": dv["mean"], "max": dv["max"]}
             out["deviation_joints"] = {"mean": dj["mean"], "max": dj["max"]}
     problems = [f"{name} is missing: the figures that need it were not computed"

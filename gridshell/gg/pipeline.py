@@ -24,7 +24,7 @@ from scipy.sparse.linalg import lsqr
 from ..bundle import Design, DesignBundle, report_json, write_bundle
 from ..errors import ConvergenceError, GridshellError, InputError, NoNetError
 from ..grid import grid_quads
-from ..metrics import (alignability_error, alignability_error_arc, coverage, delta_l, deviation,
+from ..metrics import (alignability_error, alignability_error_arc, coverage, delta_l, deviations,
                        geodesic_turning, summary, target_deviation)
 from ..net import Net
 from ..quality import Gate, design_gates, gate_lines, gate_summary, passed
@@ -34,7 +34,7 @@ from .revolution import rebuild_revolution
 from .simulate import GGSequence, gg_alignment_sequence
 
 __all__ = ["check_offsets", "collapse_gg", "design_gg", "gg_files", "gg_gates", "gg_metrics",
-           "gg_net_from_mesh", "gg_score", "write_gg"]
+           "gg_net_from_mesh", "gg_score", "TracedNets", "write_gg"]
 
 Progress = Callable[[str], None] | None
 
@@ -94,7 +94,7 @@ def gg_net_from_mesh(P: np.ndarray, *, n_lamellae: int | None = 10, spacing: flo
                      crossing_angle: float = 90.0, at_parallel: float = 0.5,
                      offsets: tuple[Sequence[float], Sequence[float]] | None = None,
                      angle: float | None = None, step: float | None = None,
-                     progress: Progress = None) -> dict[str, Any]:
+                     revolution_net: bool = True, progress: Progress = None) -> dict[str, Any]:
     """The geodesic alignable net of a GG mesh (paper 4.1.2).
 
     Parameters
@@ -111,6 +111,9 @@ def gg_net_from_mesh(P: np.ndarray, *, n_lamellae: int | None = 10, spacing: flo
         Total angle of the surface of revolution, radians (default: chosen automatically).
     step : float, optional
         Sampling step of the traced curves, metres.
+    revolution_net : bool
+        Also map the net onto the surface of revolution (``net_rev``; a score needs only
+        ``net``).
 
     Returns
     -------
@@ -147,8 +150,10 @@ def gg_net_from_mesh(P: np.ndarray, *, n_lamellae: int | None = 10, spacing: flo
             "of arc length: give positions in that range (metres)") from None
     _say(progress, f"mapping {len(inet.curves1)} + {len(inet.curves3)} curves onto the surface")
     net, extra = map_back(inet, P, rev)
-    net_rev, _ = map_to_revolution(inet, rev)
-    return {"rev": rev, "inet": inet, "net": net, "extra": extra, "net_rev": net_rev}
+    stage = {"rev": rev, "inet": inet, "net": net, "extra": extra}
+    if revolution_net:
+        stage["net_rev"] = map_to_revolution(inet, rev)[0]
+    return stage
 
 
 def _metres(values: Sequence[float]) -> str:
@@ -243,8 +248,7 @@ def gg_metrics(net: Net, V: np.ndarray, F: np.ndarray, *, net_rev: Net | None = 
     out["geodesic_turning"] = 100.0 * geodesic_turning(net, V, F)["ratio"]
     if target is not None:
         tV, tF = target
-        dv = deviation(V, tV, tF)
-        dj = deviation(net.joints, tV, tF)
+        dv, dj = deviations([V, net.joints], tV, tF)  # one closest-point tree of the target
         out["deviation"] = {"mean": dv["mean"], "max": dv["max"]}
         out["deviation_joints"] = {"mean": dj["mean"], "max": dj["max"]}
         sV, sF = target_samples if target_samples is not None else target
@@ -267,8 +271,12 @@ def gg_score(P: np.ndarray, **net_options: Any) -> float:
     """How far the net traced on a GG mesh ``P (R, C, 3)`` is from the paper's figures: the
     largest ``figure / threshold`` over :func:`gg_gates` (below 1: every gate passes); ``inf``
     where no net can be traced. ``net_options`` as in :func:`gg_net_from_mesh`."""
+    return TracedNets(**net_options).score(P)
+
+
+def _stage_score(stage: dict[str, Any]) -> float:
+    """:func:`gg_score` of a traced net (a :func:`gg_net_from_mesh` result)."""
     try:
-        stage = gg_net_from_mesh(P, **net_options)
         net = stage["net"]
         if len(net.loops) == 0:
             return float("inf")
@@ -280,6 +288,51 @@ def gg_score(P: np.ndarray, **net_options: Any) -> float:
     ratios = [g.value / g.limit if g.value is not None and np.isfinite(g.value) else np.inf
               for g in gates]
     return float(max(ratios))
+
+
+class TracedNets:
+    """The nets traced on GG meshes, kept by mesh: the design scores its checkpoints by their
+    traced nets (:meth:`score`, :func:`gg_score`) and returns one of them, whose net
+    :meth:`net` then gives without tracing it again (one trace less per design; the scores
+    skip the net on the surface of revolution, which :meth:`net` adds). The key is the mesh's
+    exact bytes, so a reused net is the net a new trace would give. ``traced`` counts the
+    traces made."""
+
+    def __init__(self, **net_options: Any) -> None:
+        self.options = net_options
+        self.traced = 0
+        self._nets: dict[tuple, dict[str, Any]] = {}
+
+    @staticmethod
+    def _key(P: np.ndarray) -> tuple:
+        P = np.ascontiguousarray(P, dtype=float)
+        return P.shape, P.tobytes()
+
+    def _traced(self, P: np.ndarray, progress: Progress = None) -> dict[str, Any]:
+        key = self._key(P)
+        stage = self._nets.get(key)
+        if stage is None:
+            self.traced += 1  # the scores need no net on the surface of revolution
+            stage = self._nets[key] = gg_net_from_mesh(P, **self.options, progress=progress,
+                                                       revolution_net=False)
+        else:
+            _say(progress, "tracing geodesics: the net traced when the design checked this mesh")
+        return stage
+
+    def net(self, P: np.ndarray, progress: Progress = None) -> dict[str, Any]:
+        """:func:`gg_net_from_mesh` of ``P`` with the options given, traced once per mesh."""
+        stage = self._traced(P, progress)
+        if "net_rev" not in stage:
+            stage["net_rev"] = map_to_revolution(stage["inet"], stage["rev"])[0]
+        return stage
+
+    def score(self, P: np.ndarray) -> float:
+        """:func:`gg_score` of ``P``; its net is kept for :meth:`net`."""
+        try:
+            stage = self._traced(P)
+        except GridshellError:
+            return float("inf")
+        return _stage_score(stage)
 
 
 # ----------------------------------------------------------------------------- the pipeline
@@ -385,14 +438,14 @@ def design_gg(target: Any, *, meridians: str = "cols", grid: tuple[int, int] | N
     net_options = {"n_lamellae": n_lamellae, "spacing": spacing,
                    "crossing_angle": crossing_angle, "at_parallel": at_parallel,
                    "offsets": offsets, "angle": angle}
+    nets = TracedNets(**net_options)
     design = design_gg_surface(Vw, Fw, P0, weights=weights, outer=rounds,
-                               polish_iter=polish_iter, progress=progress,
-                               evaluate=lambda P: gg_score(P, **net_options))
+                               polish_iter=polish_iter, progress=progress, evaluate=nets.score)
     P, design_report = design.P, dict(design.report, converged=design.converged,
                                       history=design.history, stop=design.stop,
                                       checkpoint=design.checkpoint, score=design.score,
                                       deviation=design.deviation)
-    stage = gg_net_from_mesh(P, **net_options, progress=progress)
+    stage = nets.net(P, progress=progress)  # the checkpoint's net, traced by its check
     net, rev = stage["net"], stage["rev"]
     _say(progress, f"net: {len(net.joints)} joints, {len(net.loops)} loops, "
          f"{len(net.lamellae)} lamellae; collapsing and measuring")

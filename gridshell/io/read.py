@@ -252,6 +252,8 @@ def check_disk(V: np.ndarray, F: np.ndarray, name: str, report: Any = None, *,
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 
+    from ..quadmesh import unique_ints
+
     F = np.asarray(F, dtype=np.int64)
     n = len(V)
     k = F.shape[1]
@@ -260,7 +262,7 @@ def check_disk(V: np.ndarray, F: np.ndarray, name: str, report: Any = None, *,
     a, b = np.minimum(src, dst), np.maximum(src, dst)
     key = a * n + b
     uk, cnt = np.unique(key, return_counts=True)
-    used = np.unique(F)
+    used = unique_ints(F)
     chi = len(used) - len(uk) + len(F)
     g = coo_matrix((np.ones(len(src)), (src, dst)), shape=(n, n))
     n_comp = connected_components(g, directed=False)[0] - (n - len(used))
@@ -269,7 +271,7 @@ def check_disk(V: np.ndarray, F: np.ndarray, name: str, report: Any = None, *,
     if len(bk):
         ba, bb = bk // n, bk % n
         gb = coo_matrix((np.ones(len(bk)), (ba, bb)), shape=(n, n))
-        on = np.unique(np.concatenate([ba, bb]))
+        on = unique_ints(np.concatenate([ba, bb]))
         loops = connected_components(gb, directed=False)[0] - (n - len(on))
     if n_comp == 1 and chi == 1 and loops == 1:
         return

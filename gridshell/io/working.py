@@ -99,6 +99,8 @@ def _largest_piece(V: np.ndarray, T: np.ndarray) -> tuple[np.ndarray, np.ndarray
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 
+    from ..quadmesh import unique_ints
+
     n = len(V)
     src, dst = T.ravel(), np.roll(T, -1, axis=1).ravel()
     _, label = connected_components(coo_matrix((np.ones(len(src)), (src, dst)), shape=(n, n)),
@@ -106,7 +108,7 @@ def _largest_piece(V: np.ndarray, T: np.ndarray) -> tuple[np.ndarray, np.ndarray
     face_label = label[T[:, 0]]
     best = np.bincount(face_label).argmax()
     T = T[face_label == best]
-    used = np.unique(T)
+    used = unique_ints(T)
     renum = np.full(n, -1, np.int64)
     renum[used] = np.arange(len(used))
     return V[used], renum[T]

@@ -1,0 +1,32 @@
+"""``import gridshell.api`` loads no pipeline: each design function imports its own when
+called, so ``gridshell gg`` does not load the NCP and PHLW modules, nor ``ncp`` the GG ones
+(issue 18, big inputs: the command's start is part of its time)."""
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+PIPELINES = ("gridshell.gg", "gridshell.ncp", "fabrication", "scipy.integrate", "pymeshlab")
+
+
+def _loaded(code: str) -> list[str]:
+    """The modules of :data:`PIPELINES` loaded after running ``code`` in a new interpreter."""
+    probe = (f"{code}\nimport json, sys\n"
+             f"print(json.dumps(sorted(m for m in sys.modules if m.startswith({PIPELINES!r}))))")
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
+                         check=True, timeout=120)
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def test_the_api_and_the_command_line_load_no_pipeline_until_one_runs():
+    assert _loaded("import gridshell.api") == []
+    assert _loaded("import gridshell as gs; gs.write, gs.design_gg, gs.optimize_phlw") == []
+    assert _loaded("from gridshell.cli.main import build_parser; build_parser(['gg'])") == []
+
+
+def test_a_design_function_loads_its_own_pipeline_only():
+    loaded = _loaded("import gridshell.api as api\n"
+                     "try:\n    api.design_gg('missing.obj')\nexcept Exception:\n    pass")
+    assert "gridshell.gg.pipeline" in loaded
+    assert not any(m.startswith("gridshell.ncp") for m in loaded), loaded
