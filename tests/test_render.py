@@ -165,6 +165,33 @@ def test_sequence_frames_and_gif(tmp_path):
         assert im.format == "GIF" and im.n_frames == 3 and im.info.get("loop") == 0
 
 
+def test_sequence_frames_one_crop_and_gif_one_palette():
+    """The frames share one size and one crop (content reaches near every side in some
+    frame), and the GIF's frames decode to the PNGs' colours."""
+    import io
+
+    from gridshell.render.ncp_maps import _PAD, gif, sequence_frames
+
+    frames, E, _, _ = _states_case()
+    pngs = sequence_frames(frames, E, title="t", dpi=50)
+    imgs = [np.asarray(Image.open(io.BytesIO(b)).convert("RGB"), float) for b in pngs]
+    assert len(pngs) == 3 and len({a.shape for a in imgs}) == 1
+    ink = np.zeros(imgs[0].shape[:2], bool)
+    for a in imgs:
+        ink |= (a < 250).any(axis=2)
+    ys, xs = np.nonzero(ink.any(axis=1))[0], np.nonzero(ink.any(axis=0))[0]
+    h, w = ink.shape
+    assert ys[0] <= _PAD and xs[0] <= _PAD and ys[-1] >= h - 1 - _PAD and xs[-1] >= w - 1 - _PAD
+    assert not np.array_equal(imgs[0], imgs[-1])          # the states differ
+    with Image.open(io.BytesIO(gif(pngs))) as im:
+        assert im.n_frames == 3 and im.info.get("loop") == 0
+        assert len(im.getpalette()) <= 3 * 256
+        for k in range(3):
+            im.seek(k)
+            # 255 colours for antialiased lines: within a few levels of the PNG on average
+            assert np.abs(np.asarray(im.convert("RGB"), float) - imgs[k]).mean() < 3.0
+
+
 def test_sequence_missing(tmp_path):
     d = write_case(tmp_path / "b", "GG")
     assert sequence_files(d) == []
