@@ -165,6 +165,21 @@ def test_sequence_frames_and_gif(tmp_path):
         assert im.format == "GIF" and im.n_frames == 3 and im.info.get("loop") == 0
 
 
+def test_png_bytes_crops_to_the_content():
+    """One draw, cropped to the ink plus the pad: a black 40 x 20 px rectangle on a white
+    200 x 100 px figure gives a (20 + 2 pad) x (40 + 2 pad) picture."""
+    import io
+
+    from gridshell.render.figure import png_bytes, pyplot
+
+    fig = pyplot().figure(figsize=(2.0, 1.0), dpi=100)
+    fig.patches.append(__import__("matplotlib").patches.Rectangle(
+        (50, 30), 40, 20, transform=None, facecolor="k", edgecolor="none"))
+    img = np.asarray(Image.open(io.BytesIO(png_bytes(fig, pad=5))).convert("RGB"))
+    assert img.shape == (30, 50, 3)
+    assert (img[5:-5, 5:-5] < 10).all() and (img[:4] > 245).all() and (img[:, -4:] > 245).all()
+
+
 def test_sequence_frames_one_crop_and_gif_one_palette():
     """The frames share one size and one crop (content reaches near every side in some
     frame), and the GIF's frames decode to the PNGs' colours."""

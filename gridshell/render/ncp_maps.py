@@ -13,11 +13,12 @@ from typing import Sequence
 import numpy as np
 
 from ..errors import InputError
-from .figure import cube_limits, png_bytes, pyplot
+from .figure import content_box, cube_limits, png_bytes, pyplot
 
 __all__ = ["edge_map", "vertex_map", "collapse_plot", "sequence_frames", "gif"]
 
-
+#: pixels kept around the cropped content of the sequence frames
+_PAD = 8
 
 
 def edge_map(V: np.ndarray, edges: np.ndarray, values: np.ndarray, *, title: str = "",
@@ -106,7 +107,7 @@ def sequence_frames(frames: Sequence[np.ndarray], edges: np.ndarray, *, title: s
 
     One figure is drawn for all states (the edges and joints are moved, the title changed),
     and every picture is cropped to the one box that holds the content of all of them (plus
-    :data:`_PAD` pixels): all PNGs have one size, ready for :func:`gif`."""
+    :data:`_PAD` pixels, :func:`~.figure.content_box`): all PNGs have one size, ready for :func:`gif`."""
     from mpl_toolkits.mplot3d.art3d import Line3DCollection
     from PIL import Image
 
@@ -135,31 +136,13 @@ def sequence_frames(frames: Sequence[np.ndarray], edges: np.ndarray, *, title: s
             rgb.append(np.asarray(fig.canvas.buffer_rgba())[..., :3].copy())
     finally:
         plt.close(fig)
-    y0, y1, x0, x1 = _content_box(rgb)
+    y0, y1, x0, x1 = content_box(rgb, _PAD)
     out = []
     for a in rgb:
         buf = io.BytesIO()
         Image.fromarray(a[y0:y1, x0:x1]).save(buf, format="PNG")
         out.append(buf.getvalue())
     return out
-
-
-#: pixels kept around the cropped content of the sequence frames
-_PAD = 8
-
-
-def _content_box(images: Sequence[np.ndarray]) -> tuple[int, int, int, int]:
-    """``(y0, y1, x0, x1)``: the smallest box holding every non-white pixel of all the
-    ``(h, w, 3)`` uint8 images, widened by :data:`_PAD` (the whole image when all are white)."""
-    ink = np.zeros(images[0].shape[:2], bool)
-    for a in images:
-        ink |= (a < 250).any(axis=2)
-    ys, xs = np.nonzero(ink.any(axis=1))[0], np.nonzero(ink.any(axis=0))[0]
-    h, w = ink.shape
-    if not len(ys):
-        return 0, h, 0, w
-    return (max(int(ys[0]) - _PAD, 0), min(int(ys[-1]) + 1 + _PAD, h),
-            max(int(xs[0]) - _PAD, 0), min(int(xs[-1]) + 1 + _PAD, w))
 
 
 def gif(pngs: Sequence[bytes], duration_ms: int = 250) -> bytes:
