@@ -17,10 +17,10 @@ instead: the joint mesh is generically over-constrained (7 conditions per interi
 unknowns), so the constraints cannot hold exactly between the two end states, and the blend
 keeps the sequence out of the folded minima the plain homotopy falls into on a pseudosphere
 (edges shrinking by up to 99 %). The last frame (``t = 1``, no proximity) is exact up to the
-solver tolerance. Laplacian fairness of ``V`` and ``r`` (off by default, and always in the last
-frame); scaled units
-(unit bounding-box diagonal of ``V*``) as in the post-optimization, with the length and axis
-constraints weighted by the net's density (:func:`~gridshell.ncp.postopt.net_density`).
+solver tolerance. Laplacian fairness of ``V`` and ``r`` (off by default, and always in the
+last frame); scaled units (unit bounding-box diagonal of ``V*``) as in the post-optimization,
+with the length and axis constraints weighted by the net's density
+(:func:`~gridshell.ncp.postopt.net_density`).
 """
 from __future__ import annotations
 

@@ -107,7 +107,8 @@ def sequence_frames(frames: Sequence[np.ndarray], edges: np.ndarray, *, title: s
 
     One figure is drawn for all states (the edges and joints are moved, the title changed),
     and every picture is cropped to the one box that holds the content of all of them (plus
-    :data:`_PAD` pixels, :func:`~.figure.content_box`): all PNGs have one size, ready for :func:`gif`."""
+    :data:`_PAD` pixels, :func:`~.figure.content_box`): all PNGs have one size, ready for
+    :func:`gif`."""
     from mpl_toolkits.mplot3d.art3d import Line3DCollection
     from PIL import Image
 
