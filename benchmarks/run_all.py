@@ -35,6 +35,14 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable
 
+# The ncp_e2e stage times the command as a user runs it: `gridshell` sets one BLAS thread
+# (gridshell/cli/main.py) before numpy loads OpenBLAS, which calling main() in-process after
+# numpy is imported here could not do (its worker then timed OpenBLAS threads spinning).
+if sys.argv[1:3] == ["--worker", "ncp_e2e"]:
+    import os
+
+    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
 import numpy as np
 
 HERE = Path(__file__).resolve().parent

@@ -62,6 +62,26 @@ def test_fit_rows_recovers_exact_coefficients(mode):
     assert len(fit.clamped) == 0
 
 
+def test_fit_rows_phlw_equals_a_line_fit_per_row():
+    """The rows' lines are fitted all at once: the same coefficients as np.polyfit row by row
+    (noisy rows, and a row whose H is constant, which gets n = mean H)."""
+    rng = np.random.default_rng(7)
+    H = rng.normal(0.3, 0.2, size=(40, 25))
+    n0, t0 = rng.normal(size=(40, 1)), rng.uniform(0.5, 1.0, size=(40, 1))
+    K = 2 * n0 * H - (n0 ** 2 + t0 ** 2) + 1e-3 * rng.normal(size=H.shape)
+    H[5] = 0.7
+    fit = P.fit_rows(K, H, "phlw")
+    for i in range(len(H)):
+        if i == 5:
+            n, beta = H[i].mean(), np.mean(K[i] - 2 * H[i].mean() * H[i])
+        else:
+            alpha, beta = np.polyfit(H[i], K[i], 1)
+            n = alpha / 2
+        assert -beta - n * n > 0 and len(fit.clamped) == 0
+        assert fit.n[i] == pytest.approx(n, rel=1e-10, abs=1e-12)
+        assert fit.t[i] == pytest.approx(np.sqrt(-beta - n * n), rel=1e-9)
+
+
 def test_fit_rows_reports_secant_rows():
     H = np.linspace(-1, 1, 7)[None, :]
     K = 0.5 * H + 0.8               # a line crossing K = H^2: t^2 < 0

@@ -165,6 +165,48 @@ def test_sequence_frames_and_gif(tmp_path):
         assert im.format == "GIF" and im.n_frames == 3 and im.info.get("loop") == 0
 
 
+def test_png_bytes_crops_to_the_content():
+    """One draw, cropped to the ink plus the pad: a black 40 x 20 px rectangle on a white
+    200 x 100 px figure gives a (20 + 2 pad) x (40 + 2 pad) picture."""
+    import io
+
+    from gridshell.render.figure import png_bytes, pyplot
+
+    fig = pyplot().figure(figsize=(2.0, 1.0), dpi=100)
+    fig.patches.append(__import__("matplotlib").patches.Rectangle(
+        (50, 30), 40, 20, transform=None, facecolor="k", edgecolor="none"))
+    img = np.asarray(Image.open(io.BytesIO(png_bytes(fig, pad=5))).convert("RGB"))
+    assert img.shape == (30, 50, 3)
+    assert (img[5:-5, 5:-5] < 10).all() and (img[:4] > 245).all() and (img[:, -4:] > 245).all()
+
+
+def test_sequence_frames_one_crop_and_gif_one_palette():
+    """The frames share one size and one crop (content reaches near every side in some
+    frame), and the GIF's frames decode to the PNGs' colours."""
+    import io
+
+    from gridshell.render.ncp_maps import _PAD, gif, sequence_frames
+
+    frames, E, _, _ = _states_case()
+    pngs = sequence_frames(frames, E, title="t", dpi=50)
+    imgs = [np.asarray(Image.open(io.BytesIO(b)).convert("RGB"), float) for b in pngs]
+    assert len(pngs) == 3 and len({a.shape for a in imgs}) == 1
+    ink = np.zeros(imgs[0].shape[:2], bool)
+    for a in imgs:
+        ink |= (a < 250).any(axis=2)
+    ys, xs = np.nonzero(ink.any(axis=1))[0], np.nonzero(ink.any(axis=0))[0]
+    h, w = ink.shape
+    assert ys[0] <= _PAD and xs[0] <= _PAD and ys[-1] >= h - 1 - _PAD and xs[-1] >= w - 1 - _PAD
+    assert not np.array_equal(imgs[0], imgs[-1])          # the states differ
+    with Image.open(io.BytesIO(gif(pngs))) as im:
+        assert im.n_frames == 3 and im.info.get("loop") == 0
+        assert len(im.getpalette()) <= 3 * 256
+        for k in range(3):
+            im.seek(k)
+            # 255 colours for antialiased lines: within a few levels of the PNG on average
+            assert np.abs(np.asarray(im.convert("RGB"), float) - imgs[k]).mean() < 3.0
+
+
 def test_sequence_missing(tmp_path):
     d = write_case(tmp_path / "b", "GG")
     assert sequence_files(d) == []

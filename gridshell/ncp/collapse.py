@@ -231,7 +231,7 @@ def collapse_curve(surf: BSplineSurface, *, mode: Literal["phlw", "cnc", "aa"] =
     floor = 1.0 / max(surface_size(surf.ctrl), 1e-300)
     for start in range(0, a, block):
         sl = slice(start, min(start + block, a))
-        g = grid_curvature(surf, u[sl], v)
+        g = grid_curvature(surf, u[sl], v, normal=False)
         nr = row_normal_curvature(g["K"], g["H"], mode, n, kI=g["kI"], kII=g["kII"])
         n_rows[sl] = nr
         beta, valid = net_angle(g["kI"], g["kII"], nr[:, None], scale=floor)

@@ -52,13 +52,13 @@ CNC_LINE_RADIUS = 20.0
 
 
 def grid_curvature(surf: BSplineSurface, u: np.ndarray, v: np.ndarray,
-                   points: bool = True) -> dict[str, np.ndarray]:
+                   points: bool = True, normal: bool = True) -> dict[str, np.ndarray]:
     """Curvature data on the grid ``u (a,) x v (b,)`` (eqs. 4.2-4.6).
 
     Returns
     -------
     dict
-        ``S`` (only if ``points``), ``Su``, ``Sv``, ``normal`` ``(a, b, 3)``;
+        ``S`` (only if ``points``), ``Su``, ``Sv``, ``normal`` (only if ``normal``) ``(a, b, 3)``;
         ``E, G, kI, kII, K, H`` ``(a, b)`` (``kI = L/E``, ``kII = N/G``, 1/m).
     """
     u = np.atleast_1d(np.asarray(u, float))
@@ -71,11 +71,12 @@ def grid_curvature(surf: BSplineSurface, u: np.ndarray, v: np.ndarray,
     K, H, _, _ = curvatures(ff["E"], ff["F"], ff["G"], ff["L"], ff["M"], ff["N"])
     with np.errstate(divide="ignore", invalid="ignore"):
         kI, kII = ff["L"] / ff["E"], ff["N"] / ff["G"]
-    nrm = np.cross(D["Su"], D["Sv"])
-    with np.errstate(divide="ignore", invalid="ignore"):
-        nrm /= np.linalg.norm(nrm, axis=1)[:, None]
-    out = {"Su": D["Su"].reshape(a, b, 3), "Sv": D["Sv"].reshape(a, b, 3),
-           "normal": nrm.reshape(a, b, 3)}
+    out = {"Su": D["Su"].reshape(a, b, 3), "Sv": D["Sv"].reshape(a, b, 3)}
+    if normal:
+        nrm = np.cross(D["Su"], D["Sv"])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            nrm /= np.linalg.norm(nrm, axis=1)[:, None]
+        out["normal"] = nrm.reshape(a, b, 3)
     for k, val in (("E", ff["E"]), ("G", ff["G"]), ("kI", kI), ("kII", kII), ("K", K), ("H", H)):
         out[k] = np.asarray(val).reshape(a, b)
     if points:

@@ -67,15 +67,16 @@ def fit_rows(K: np.ndarray, H: np.ndarray, mode: Mode = "phlw", rtol: float = 1e
         n = np.zeros(R)
         beta = K.mean(axis=1)
     elif mode == "phlw":
-        n, beta = np.empty(R), np.empty(R)
-        for i in range(R):
-            h, kk = H[i], K[i]
-            if np.std(h) <= rtol * scale:
-                n[i] = h.mean()
-                beta[i] = np.mean(kk - 2 * n[i] * h)
-            else:
-                alpha, beta[i] = np.polyfit(h, kk, 1)
-                n[i] = alpha / 2
+        # all rows at once: the least-squares line of centred data (what np.polyfit(h, k, 1)
+        # returns per row, tests/test_phlw.py compares them)
+        hm, km = H.mean(axis=1), K.mean(axis=1)
+        Hc = H - hm[:, None]
+        var = np.einsum("ij,ij->i", Hc, Hc)
+        flat = np.sqrt(var / m) <= rtol * scale          # np.std(h) <= rtol * scale
+        with np.errstate(divide="ignore", invalid="ignore"):
+            alpha = np.einsum("ij,ij->i", Hc, K - km[:, None]) / var
+        n = np.where(flat, hm, 0.5 * alpha)
+        beta = np.where(flat, km - 2 * hm * hm, km - alpha * hm)
     else:  # cnc: K_ij = 2 n H_ij + beta_i
         A = sp.hstack([sp.csr_matrix(2 * H.reshape(-1, 1)),
                        sp.kron(sp.identity(R), np.ones((m, 1)))]).toarray()

@@ -1,12 +1,13 @@
-"""Matplotlib set-up shared by the headless pictures: the Agg backend, cube axes, PNG bytes."""
+"""Matplotlib set-up shared by the headless pictures: the Agg backend, cube axes, PNG bytes
+cropped to their content."""
 from __future__ import annotations
 
 import io
-from typing import Any
+from typing import Any, Sequence
 
 import numpy as np
 
-__all__ = ["pyplot", "cube_limits", "png_bytes"]
+__all__ = ["pyplot", "cube_limits", "png_bytes", "content_box"]
 
 
 def pyplot() -> Any:
@@ -31,9 +32,33 @@ def cube_limits(ax: Any, P: np.ndarray) -> None:
     ax.set_axis_off()
 
 
-def png_bytes(fig: Any) -> bytes:
-    """The figure as PNG bytes (tight bounding box); the figure is closed."""
+def png_bytes(fig: Any, pad: int = 8) -> bytes:
+    """The figure as PNG bytes, cropped to its content (every pixel that is not the white
+    background, plus ``pad`` pixels); the figure is closed. One draw, where
+    ``savefig(bbox_inches="tight")`` draws twice (once to measure the bounding box)."""
+    from PIL import Image
+
+    try:
+        fig.canvas.draw()
+        img = np.asarray(fig.canvas.buffer_rgba())[..., :3]
+    finally:
+        pyplot().close(fig)
+    y0, y1, x0, x1 = content_box([img], pad)
     buf = io.BytesIO()
-    fig.savefig(buf, format="png", bbox_inches="tight")
-    pyplot().close(fig)
+    Image.fromarray(np.ascontiguousarray(img[y0:y1, x0:x1])).save(buf, format="PNG")
     return buf.getvalue()
+
+
+def content_box(images: Sequence[np.ndarray], pad: int = 8) -> tuple[int, int, int, int]:
+    """``(y0, y1, x0, x1)``: the smallest box holding every non-white pixel of all the
+    ``(h, w, 3)`` uint8 images (one size), widened by ``pad`` pixels; the whole image when all
+    are white."""
+    ink = np.zeros(images[0].shape[:2], bool)
+    for a in images:
+        ink |= (a < 250).any(axis=2)
+    ys, xs = np.nonzero(ink.any(axis=1))[0], np.nonzero(ink.any(axis=0))[0]
+    h, w = ink.shape
+    if not len(ys):
+        return 0, h, 0, w
+    return (max(int(ys[0]) - pad, 0), min(int(ys[-1]) + 1 + pad, h),
+            max(int(xs[0]) - pad, 0), min(int(xs[-1]) + 1 + pad, w))

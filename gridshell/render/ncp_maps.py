@@ -13,11 +13,12 @@ from typing import Sequence
 import numpy as np
 
 from ..errors import InputError
-from .figure import cube_limits, png_bytes, pyplot
+from .figure import content_box, cube_limits, png_bytes, pyplot
 
 __all__ = ["edge_map", "vertex_map", "collapse_plot", "sequence_frames", "gif"]
 
-
+#: pixels kept around the cropped content of the sequence frames
+_PAD = 8
 
 
 def edge_map(V: np.ndarray, edges: np.ndarray, values: np.ndarray, *, title: str = "",
@@ -102,28 +103,52 @@ def collapse_plot(points: np.ndarray, normals: np.ndarray, joints: np.ndarray | 
 
 def sequence_frames(frames: Sequence[np.ndarray], edges: np.ndarray, *, title: str = "",
                     dpi: int = 80, elev: float = 25.0, azim: float = -60.0) -> list[bytes]:
-    """PNG bytes of every state ``(n, 3)`` of the alignment sequence, same axes for all."""
+    """PNG bytes of every state ``(n, 3)`` of the alignment sequence, same axes for all.
+
+    One figure is drawn for all states (the edges and joints are moved, the title changed),
+    and every picture is cropped to the one box that holds the content of all of them (plus
+    :data:`_PAD` pixels, :func:`~.figure.content_box`): all PNGs have one size, ready for
+    :func:`gif`."""
     from mpl_toolkits.mplot3d.art3d import Line3DCollection
+    from PIL import Image
 
     plt = pyplot()
     E = np.asarray(edges, np.int64).reshape(-1, 2)
-    allP = np.concatenate([np.asarray(f, float) for f in frames])
+    frames = [np.asarray(f, float).reshape(-1, 3) for f in frames]
+    if not frames:
+        raise InputError("sequence_frames needs at least one state")
+    allP = np.concatenate(frames)
+    fig = plt.figure(figsize=(5.0, 4.2), dpi=dpi)
+    ax = fig.add_axes((0.0, 0.0, 1.0, 0.93), projection="3d")   # the net fills the picture
+    lines = Line3DCollection(frames[0][E], colors=(0.1, 0.2, 0.5, 0.9), linewidths=1.0)
+    ax.add_collection3d(lines)
+    V = frames[0]
+    dots, = ax.plot(V[:, 0], V[:, 1], V[:, 2], "o", ms=2.2, mew=0.4, color="tab:red")
+    cube_limits(ax, allP)
+    ax.view_init(elev=elev, azim=azim)
+    text = ax.set_title("", fontsize=9)
+    rgb = []
+    try:
+        for k, V in enumerate(frames):
+            lines.set_segments(V[E])
+            dots.set_data_3d(V[:, 0], V[:, 1], V[:, 2])
+            text.set_text(f"{title} frame {k}/{len(frames) - 1}".strip())
+            fig.canvas.draw()
+            rgb.append(np.asarray(fig.canvas.buffer_rgba())[..., :3].copy())
+    finally:
+        plt.close(fig)
+    y0, y1, x0, x1 = content_box(rgb, _PAD)
     out = []
-    for k, V in enumerate(frames):
-        V = np.asarray(V, float)
-        fig = plt.figure(figsize=(5.0, 4.2), dpi=dpi)
-        ax = fig.add_subplot(projection="3d")
-        ax.add_collection3d(Line3DCollection(V[E], colors=(0.1, 0.2, 0.5, 0.9), linewidths=1.0))
-        ax.scatter(V[:, 0], V[:, 1], V[:, 2], s=3, color="tab:red", depthshade=False)
-        cube_limits(ax, allP)
-        ax.view_init(elev=elev, azim=azim)
-        ax.set_title(f"{title} frame {k}/{len(frames) - 1}".strip(), fontsize=9)
-        out.append(png_bytes(fig))
+    for a in rgb:
+        buf = io.BytesIO()
+        Image.fromarray(a[y0:y1, x0:x1]).save(buf, format="PNG")
+        out.append(buf.getvalue())
     return out
 
 
 def gif(pngs: Sequence[bytes], duration_ms: int = 250) -> bytes:
-    """An animated GIF (looping) of PNG frames, via Pillow."""
+    """An animated GIF (looping) of PNG frames, via Pillow, with one palette for all frames
+    (quantized once from all of them: no colour flicker between frames, one colour table)."""
     from PIL import Image
 
     if not pngs:
@@ -131,7 +156,14 @@ def gif(pngs: Sequence[bytes], duration_ms: int = 250) -> bytes:
     imgs = [Image.open(io.BytesIO(b)).convert("RGB") for b in pngs]
     size = imgs[0].size
     imgs = [im if im.size == size else im.resize(size) for im in imgs]
+    w, h = size
+    sheet = Image.new("RGB", (w, h * len(imgs)))
+    for k, im in enumerate(imgs):
+        sheet.paste(im, (0, k * h))
+    sheet = sheet.quantize(colors=255, method=Image.Quantize.MEDIANCUT,
+                           dither=Image.Dither.NONE)
+    frames = [sheet.crop((0, k * h, w, (k + 1) * h)) for k in range(len(imgs))]
     buf = io.BytesIO()
-    imgs[0].save(buf, format="GIF", save_all=True, append_images=imgs[1:], duration=duration_ms,
-                 loop=0)
+    frames[0].save(buf, format="GIF", save_all=True, append_images=frames[1:],
+                   duration=duration_ms, loop=0)
     return buf.getvalue()

@@ -49,7 +49,7 @@ def net_preview(path: str | Path, V: np.ndarray, F: np.ndarray, joints: np.ndarr
     import matplotlib
     from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
 
-    from .figure import cube_limits, pyplot
+    from .figure import cube_limits, png_bytes, pyplot
 
     plt = pyplot()
 
@@ -88,6 +88,5 @@ def net_preview(path: str | Path, V: np.ndarray, F: np.ndarray, joints: np.ndarr
     if title:
         ax.set_title(title, fontsize=9)
     path = Path(path)
-    fig.savefig(path, format="png", bbox_inches="tight")
-    plt.close(fig)
+    path.write_bytes(png_bytes(fig))
     return path
