@@ -5,6 +5,12 @@ Within a solve the Jacobian's structure does not change, so neither does the pat
 its :func:`~.linear.pattern_key`, refills the values every iteration and adds the damping to
 the stored diagonal positions in place; a rejected Levenberg-Marquardt step changes the
 diagonal only. The linear solver then recognises the pattern and reuses its analysis.
+
+The values are filled in place: the transpose of ``J`` is a fixed gather of ``J``'s values
+(its structure computed once per pattern of ``J``), and the product ``J^T J`` (scipy's
+sparse product, whose output order depends only on its inputs' patterns) is scattered into
+the kept pattern through positions computed once, with no sorting and no search. At 1e5
+unknowns this halves the cost of an update (benchmarks/README.md).
 """
 from __future__ import annotations
 
@@ -31,26 +37,47 @@ class NormalEquations:
         self.JTJ: sp.csc_matrix | None = None
         self.key: tuple = ()
         self.patterns = 0
+        self.fast = 0  # updates that took the in-place path
         self._diag: np.ndarray = np.zeros(0, dtype=np.int64)
+        self._T: tuple | None = None  # J's pattern, J^T's pattern and the gather J -> J^T
+        self._M: tuple | None = None  # the product's (unsorted) pattern and its positions
 
     def update(self, J: sp.spmatrix) -> sp.csc_matrix:
         """Set ``J^T J`` for the Jacobian ``J (m, n)``; returns it ``(n, n)``, CSC."""
         J = J.tocsr()
-        M = (J.T.tocsr() @ J).tocsr()  # symmetric: its CSR arrays are its CSC arrays
-        M.sort_indices()
-        P = self.JTJ
-        if P is not None and P.shape == M.shape and np.array_equal(P.indptr, M.indptr) \
-                and np.array_equal(P.indices, M.indices):
-            P.data[:] = M.data  # the usual case: the same pattern as before
-            return P
-        if P is not None and P.shape == M.shape:
-            pos = self._positions(M)
-            if pos is not None:  # M lost entries that cancelled exactly: keep the pattern
+        M = self._transpose(J) @ J  # symmetric: its CSR arrays are its CSC arrays
+        P, m = self.JTJ, self._M
+        if P is not None and m is not None and m[0] == M.shape \
+                and np.array_equal(m[1], M.indptr) and np.array_equal(m[2], M.indices):
+            if m[4]:  # the product covers the kept pattern (the usual case)
+                P.data[m[3]] = M.data
+            else:
                 P.data[:] = 0.0
-                P.data[pos] = M.data
-                return P
-        self._new_pattern(M)
-        return self.JTJ
+                P.data[m[3]] = M.data
+            self.fast += 1
+            return P
+        pos = self._positions(M) if P is not None and P.shape == M.shape else None
+        if pos is None:  # a new pattern (or an entry outside the kept one)
+            S = M.copy()
+            S.sort_indices()
+            self._new_pattern(S)
+            P = self.JTJ
+            pos = self._positions(M)
+        P.data[:] = 0.0  # entries of the pattern that cancelled exactly stay explicit zeros
+        P.data[pos] = M.data
+        self._M = (M.shape, M.indptr.copy(), M.indices.copy(), pos, len(pos) == P.nnz)
+        return P
+
+    def _transpose(self, J: sp.csr_matrix) -> sp.csr_matrix:
+        """``J^T`` in CSR, its values gathered from ``J``'s through a kept permutation."""
+        t = self._T
+        if t is None or t[0] != J.shape or not (np.array_equal(t[1], J.indptr)
+                                                and np.array_equal(t[2], J.indices)):
+            slots = sp.csr_matrix((np.arange(J.nnz, dtype=float), J.indices, J.indptr),
+                                  shape=J.shape).T.tocsr()
+            t = self._T = (J.shape, J.indptr.copy(), J.indices.copy(), slots.indptr,
+                           slots.indices, slots.data.astype(np.int64))
+        return sp.csr_matrix((J.data[t[5]], t[4], t[3]), shape=J.shape[::-1])
 
     def _positions(self, M: sp.csr_matrix) -> np.ndarray | None:
         """Where ``M``'s entries sit in the kept pattern, or None if one is not in it."""
