@@ -58,11 +58,16 @@ class NormalEquations:
             return P
         pos = self._positions(M) if P is not None and P.shape == M.shape else None
         if pos is None:  # a new pattern (or an entry outside the kept one)
-            S = M.copy()
-            S.sort_indices()
+            km = _keys(M)
+            order = np.argsort(km, kind="stable")  # M's slots in sorted (CSR) order
+            S = sp.csr_matrix((M.data[order], M.indices[order], M.indptr), shape=M.shape)
             self._new_pattern(S)
             P = self.JTJ
-            pos = self._positions(M)
+            pos = np.empty(len(order), dtype=np.int64)
+            if P.nnz == M.nnz:  # S's pattern is the kept one: slot order[k] goes to k
+                pos[order] = np.arange(len(order))
+            else:  # the diagonal was added
+                pos = np.searchsorted(_keys(P), km)
         P.data[:] = 0.0  # entries of the pattern that cancelled exactly stay explicit zeros
         P.data[pos] = M.data
         self._M = (M.shape, M.indptr.copy(), M.indices.copy(), pos, len(pos) == P.nnz)
@@ -81,10 +86,7 @@ class NormalEquations:
 
     def _positions(self, M: sp.csr_matrix) -> np.ndarray | None:
         """Where ``M``'s entries sit in the kept pattern, or None if one is not in it."""
-        P = self.JTJ
-        n = P.shape[0]
-        kp = np.repeat(np.arange(n, dtype=np.int64), np.diff(P.indptr)) * n + P.indices
-        km = np.repeat(np.arange(n, dtype=np.int64), np.diff(M.indptr)) * n + M.indices
+        kp, km = _keys(self.JTJ), _keys(M)
         pos = np.searchsorted(kp, km)
         pos = np.minimum(pos, len(kp) - 1)
         return pos if np.array_equal(kp[pos], km) else None
@@ -120,3 +122,10 @@ class NormalEquations:
         data = self.JTJ.data.copy()
         data[self._diag] += mu
         return sp.csc_matrix((data, self.JTJ.indices, self.JTJ.indptr), shape=self.JTJ.shape)
+
+
+def _keys(M: sp.spmatrix) -> np.ndarray:
+    """``row * n + column`` of every stored entry of the compressed matrix ``M``, in storage
+    order (for CSC read row as column: symmetric patterns only)."""
+    n = M.shape[1]
+    return np.repeat(np.arange(M.shape[0], dtype=np.int64), np.diff(M.indptr)) * n + M.indices
