@@ -12,7 +12,9 @@ Backends (chosen by measurement, see benchmarks/README.md, "Linear solver"):
 ``"cholmod"``
     CHOLMOD's supernodal Cholesky through scikit-sparse 0.4.16 (built by ``make`` against
     Debian's libsuitesparse-dev; BLAS from OpenBLAS). The analysis is ``cholmod.analyze``, the
-    numeric factorization ``Factor.cholesky_inplace``.
+    numeric factorization ``Factor.cholesky_inplace``. Ordering: AMD, or, when the matrix has
+    dense columns (auxiliary variables coupled to whole curves), those last and METIS for the
+    rest (:mod:`.ordering`).
 ``"superlu"``
     scipy's SuperLU, the fallback that always works: the analysis is the MMD ordering of
     ``A^T + A`` (computed by a first factorization); later factorizations of the same pattern
@@ -41,6 +43,7 @@ import scipy.sparse.linalg as spla
 
 from ..errors import InputError
 from .iterative import pcg
+from .ordering import dense_last, permuted
 
 #: backends in order of preference (the first one that imports is the default)
 BACKENDS = ("cholmod", "superlu")
@@ -151,6 +154,7 @@ class LinearSolver:
         self.factorizations = 0
         self.iterative = 0
         self.fallbacks = 0
+        self.ordering = ""  # the last analysis' ordering (CHOLMOD)
 
     def clear(self) -> None:
         """Forget every cached analysis (frees the factors)."""
@@ -203,16 +207,41 @@ class LinearSolver:
     # ---------------------------------------------------------------- CHOLMOD
     def _factor_cholmod(self, A: sp.csc_matrix, key: tuple) -> Callable:
         cholmod = _cholmod()
-        f, new = self._analysis(A, key)
+        an, new = self._analysis(A, key)
         try:
             if new:
-                f = cholmod.analyze(A, mode="supernodal", ordering_method="amd")
-                self._store(key, f)
-            f.cholesky_inplace(A)
+                an = self._analyse_cholmod(A, cholmod)
+                self._store(key, an)
+            f, perm, gather, Ap = an
+            if perm is None:
+                f.cholesky_inplace(A)
+            else:
+                Ap.data[:] = A.data[gather]
+                f.cholesky_inplace(Ap)
         except cholmod.CholmodNotPositiveDefiniteError as exc:
             raise NotPositiveDefinite(str(exc)) from None
         self.factorizations += 1
-        return f
+        if perm is None:
+            return f
+
+        def solve(b: np.ndarray) -> np.ndarray:
+            x = np.empty_like(np.asarray(b, dtype=float))
+            x[perm] = f(np.asarray(b)[perm])
+            return x
+
+        return solve
+
+    def _analyse_cholmod(self, A: sp.csc_matrix, cholmod: Any) -> tuple:
+        """``(factor, perm, gather, A[perm][:, perm])``: dense columns last when ``A`` has
+        some (:mod:`.ordering`), else CHOLMOD's AMD (``perm`` None)."""
+        order = dense_last(A, cholmod)
+        if order is None:
+            self.ordering = "amd"
+            return cholmod.analyze(A, mode="supernodal", ordering_method="amd"), None, None, None
+        perm, self.ordering = order[0], f"{order[1]}, dense columns last"
+        Ap, gather = permuted(A, perm)
+        f = cholmod.analyze(Ap, mode="supernodal", ordering_method="natural")
+        return f, perm, gather, Ap
 
     # ---------------------------------------------------------------- SuperLU
     def _factor_superlu(self, A: sp.csc_matrix, key: tuple) -> Callable:

@@ -78,10 +78,10 @@ class NormalEquations:
         t = self._T
         if t is None or t[0] != J.shape or not (np.array_equal(t[1], J.indptr)
                                                 and np.array_equal(t[2], J.indices)):
-            slots = sp.csr_matrix((np.arange(J.nnz, dtype=float), J.indices, J.indptr),
-                                  shape=J.shape).T.tocsr()
+            slots = sp.csr_matrix((np.arange(1, J.nnz + 1, dtype=float), J.indices, J.indptr),
+                                  shape=J.shape).T.tocsr()  # 1-based: no slot is a zero
             t = self._T = (J.shape, J.indptr.copy(), J.indices.copy(), slots.indptr,
-                           slots.indices, slots.data.astype(np.int64))
+                           slots.indices, slots.data.astype(np.int64) - 1)
         return sp.csr_matrix((J.data[t[5]], t[4], t[3]), shape=J.shape[::-1])
 
     def _positions(self, M: sp.csr_matrix) -> np.ndarray | None:
