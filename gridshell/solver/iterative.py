@@ -32,6 +32,11 @@ def _dot(u: np.ndarray, v: np.ndarray) -> float:
     return float(np.einsum("i,i->", u, v))
 
 
+#: every this many iterations, give up if the mean rate so far would need more than
+#: ``maxiter`` iterations in all (a stiff system is recognised in ~50 iterations, not 300)
+CHECK_EVERY = 50
+
+
 @dataclass
 class PCGResult:
     """Outcome of :func:`pcg`: solution, iterations run, whether ``rtol`` was reached, and
@@ -47,7 +52,8 @@ def pcg(A: sp.spmatrix, b: np.ndarray, rtol: float = RTOL, maxiter: int = MAXITE
     """Solve the SPD system ``A x = b`` by CG with the Jacobi (diagonal) preconditioner.
 
     ``A`` is symmetric with both triangles stored (CSR or CSC); stops (not converged) on a
-    non-positive curvature ``p^T A p`` (``A`` not positive definite) or a non-finite value.
+    non-positive curvature ``p^T A p`` (``A`` not positive definite), a non-finite value, or
+    when the mean convergence rate so far cannot reach ``rtol`` within ``maxiter``.
     """
     b = np.asarray(b, dtype=float)
     n = len(b)
@@ -79,6 +85,8 @@ def pcg(A: sp.spmatrix, b: np.ndarray, rtol: float = RTOL, maxiter: int = MAXITE
         res = rn / bn
         if rn <= tol:
             return PCGResult(x, k, True, res)
+        if k % CHECK_EVERY == 0 and (res >= 1.0 or k * np.log(rtol) / np.log(res) > maxiter):
+            return PCGResult(x, k, False, res)  # at this rate rtol is out of reach
         np.multiply(r, dinv, out=z)
         rz_new = _dot(r, z)
         p *= rz_new / rz

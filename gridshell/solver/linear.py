@@ -157,8 +157,9 @@ class LinearSolver:
         self.ordering = ""  # the last analysis' ordering (CHOLMOD)
 
     def clear(self) -> None:
-        """Forget every cached analysis (frees the factors)."""
+        """Forget every cached analysis (frees the factors) and where CG gave up."""
         self._cache.clear()
+        self._direct.clear()
 
     def _analysis(self, A: sp.csc_matrix, key: tuple) -> tuple[Any, bool]:
         """The cached analysis of ``A``'s pattern, or ``(None, True)`` to make one."""
