@@ -52,6 +52,13 @@ def rel_residual(A, x, b):
     return np.linalg.norm(A @ x - b) / np.linalg.norm(b)
 
 
+@pytest.fixture(autouse=True)
+def small_dense_last(monkeypatch):
+    """The dense-last ordering from any size (it starts at 5e4 unknowns), so that these small
+    matrices take that path."""
+    monkeypatch.setattr(ordering, "MIN_SIZE", 0)
+
+
 def test_dense_columns_found_and_ordered_last():
     J = mesh_jacobian()
     A = damped(J)
@@ -90,6 +97,15 @@ def test_direct_paths_match_superlu_and_dense(backend, hubs):
     assert (s.analyses, s.factorizations, s.iterative) == (1, 2, 0)
     if backend == "cholmod":
         assert s.ordering == ("amd" if hubs == 0 else "metis, dense columns last")
+
+
+@needs_cholmod
+def test_dense_last_only_from_its_size(monkeypatch):
+    monkeypatch.setattr(ordering, "MIN_SIZE", 10_000)
+    A = damped(mesh_jacobian())
+    s = lin.LinearSolver("cholmod", iterative_min=None)
+    s.factor(A)
+    assert s.ordering == "amd"
 
 
 @needs_cholmod

@@ -5,8 +5,9 @@ every vertex of its curve) are columns of ``J^T J`` with ~10-25x the median degr
 every separator of the mesh, so METIS / nested dissection on the whole matrix fills badly
 (section 1 of benchmarks/solver.py at 1e5 unknowns: 50 Gflop per factorization against 31 for
 AMD), while ordering them last and the mesh part by METIS takes 20 Gflop and 20 % less time than
-AMD (benchmarks/README.md, "Ordering"). Without such columns CHOLMOD's AMD is kept: it is the
-fastest there (1e4 unknowns: 0.54 Gflop, METIS 0.76).
+AMD (benchmarks/README.md, "One LM iteration at 1e5 unknowns"). Without such columns, or
+below :data:`MIN_SIZE` unknowns, CHOLMOD's AMD is kept: it is the fastest there (1e4 unknowns:
+0.54 Gflop, METIS 0.76).
 """
 from __future__ import annotations
 
@@ -20,6 +21,12 @@ DENSE_RATIO = 10.0
 
 #: at most this fraction of the columns is ordered last (more: no dense/sparse split)
 DENSE_MAX_FRACTION = 0.05
+
+#: unknowns from which the split is used: METIS's analysis costs ~4x AMD's (1e5: 0.8 s against
+#: 0.2 s CPU), repaid after two factorizations at 1e5; below, on the GG pipeline at 100 x 100
+#: (30k unknowns, ~11 factorizations per pattern) the factorizations were no faster and the
+#: analyses made the stage 30 % slower
+MIN_SIZE = 50_000
 
 #: orderings tried for the sparse part, first available first ("metis" needs a CHOLMOD
 #: built with METIS, as Debian's is; "amd" always exists)
@@ -42,7 +49,10 @@ def dense_last(A: sp.csc_matrix, cholmod: Any) -> tuple[np.ndarray, str] | None:
     """A fill-reducing permutation of ``A`` (``A[p][:, p]`` is factored in natural order)
     with the dense columns last and the rest ordered by the first of
     :data:`SPARSE_ORDERINGS` that this CHOLMOD has; and that ordering's name.
-    None when ``A`` has no dense column (let CHOLMOD order it with AMD)."""
+    None when ``A`` has no dense column or fewer than :data:`MIN_SIZE` unknowns (let CHOLMOD
+    order it with AMD)."""
+    if A.shape[0] < MIN_SIZE:
+        return None
     dense = dense_columns(A)
     if len(dense) == 0:
         return None
