@@ -100,6 +100,10 @@ def _check(backend: str) -> str:
 
 def describe() -> str:
     """One line naming the backend in use and why (for ``gridshell --version``)."""
+    return f"{_describe_backend()}; Jacobi-CG first from {ITERATIVE_MIN} unknowns"
+
+
+def _describe_backend() -> str:
     b = default_backend()
     if b == "cholmod":
         import sksparse
