@@ -209,3 +209,20 @@ def test_assembly_structure_matches_scipy_coo():
         ref.sort_indices()
         assert np.array_equal(J.indptr, ref.indptr) and np.array_equal(J.indices, ref.indices)
         assert np.allclose(J.data, ref.data, rtol=1e-13, atol=1e-13)
+
+
+def test_lm_with_cg_steps_matches_factored_steps():
+    """An LM solve whose steps come from CG (tolerance 1e-8) takes the same iterations to the
+    same energy and point as one with factored steps (the GG dome problem of test_linear)."""
+    from test_linear import gg_problem
+
+    from gridshell.solver import solve
+
+    prob, x0 = gg_problem(12)
+    cg = lin.LinearSolver(iterative_min=1)
+    res = solve(prob, x0, method="lm", max_iter=30, linear=cg)
+    ref = solve(prob, x0, method="lm", max_iter=30, linear=lin.LinearSolver(iterative_min=None))
+    assert cg.iterative >= res.iterations and cg.fallbacks == 0
+    assert res.iterations == ref.iterations and res.energy < 0.5 * res.energy0
+    assert res.energy == pytest.approx(ref.energy, rel=1e-9)
+    assert np.allclose(res.x, ref.x, atol=1e-9)
