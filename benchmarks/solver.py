@@ -16,8 +16,9 @@ see ``_measure.py``):
 
 1. ``iterations``: Levenberg-Marquardt (``solve(method="lm")``) from the noisy grid; seconds
    per iteration, peak memory, and one iteration's cost split into assembly
-   (``Problem.assemble``), normal equations (column selection + ``J^T J``), factorization
-   (``factorized``) and back-substitution.
+   (``Problem.assemble``), normal equations (``J^T J`` on its kept pattern) and the linear
+   solve as ``solve()`` does it (CG first from ``linear.ITERATIVE_MIN`` unknowns), next to
+   the linear solve with the factorization forced, in the same run.
 2. ``least_squares``: on three problems - section 1's; round 1 of the GG surface design
    (``design_gg_surface``'s terms and default weights on the dome, from the grid itself); and
    round 1 of the PHLW optimization (``optimize_phlw``'s terms and weights on the saddle of
@@ -123,15 +124,17 @@ def _timed(fn: Callable[[], Any]) -> tuple[float, Any]:
 
 
 def iteration_split(prob: Problem, x: np.ndarray) -> dict[str, float]:
-    """Seconds of one iteration's parts at ``x`` (the steps of solve()): assembly, normal
-    equations on their kept pattern (a second update, as in every iteration after the first),
-    the first factorization (analysis included), a refactorization (the analysis reused, as in
-    every later iteration and rejected step) and the back-substitution; wall and CPU."""
+    """Seconds of one iteration's parts at ``x`` (the steps of solve()), wall and CPU:
+    assembly, normal equations on their kept pattern (a second update, as in every iteration
+    after the first), then the linear solve as solve() does it (``LinearSolver()``: CG first
+    at ``ITERATIVE_MIN`` unknowns and more) - the first solve and one again at another damping
+    (a rejected step) - and the same two with the factorization forced (``iterative_min=0``:
+    analysis + factor + solve, then refactor + solve), side by side in one run."""
     from gridshell.solver.linear import LinearSolver
     from gridshell.solver.normal import NormalEquations
 
-    lin, ne = LinearSolver(), NormalEquations()
-    out: dict[str, float] = {}
+    ne = NormalEquations()
+    out: dict[str, Any] = {}
 
     def timed(name: str, fn: Callable[[], Any]) -> Any:
         t0, c0 = time.perf_counter(), time.process_time()
@@ -139,16 +142,18 @@ def iteration_split(prob: Problem, x: np.ndarray) -> dict[str, float]:
         out[name], out[name + "_cpu"] = time.perf_counter() - t0, time.process_time() - c0
         return v
 
+    prob.assemble(x)  # the first assembly also sets up J's structure, kept for later ones
     a = timed("assemble", lambda: prob.assemble(x))
     ne.update(a.J)
-    JTJ = timed("normal_eq", lambda: ne.update(a.J))
+    timed("normal_eq", lambda: ne.update(a.J))
     g = a.J.T @ a.r
     mu = DAMPING * float(np.mean(ne.diagonal()))
-    timed("first_factor", lambda: lin.factor(ne.damped(mu), ne.key))
-    solver = timed("factor", lambda: lin.factor(ne.damped(2 * mu), ne.key))
-    timed("backsolve", lambda: solver(g))
-    out["backend"] = lin.backend  # type: ignore[assignment]
-    del JTJ
+    for path, lin in (("", LinearSolver()), ("direct_", LinearSolver(iterative_min=0))):
+        timed(path + "first", lambda: lin.factor(ne.damped(mu), ne.key)(g))
+        timed(path + "again", lambda: lin.factor(ne.damped(2 * mu), ne.key)(g))
+        out[path + "how"] = ("CG" if lin.iterative == 2 else "CG, then factor"
+                             if lin.iterative else "factor")
+    out["backend"] = LinearSolver().backend
     return out
 
 
@@ -587,7 +592,8 @@ def section_iterations(sizes: list[str], iter_big: int, timeout: float) -> list[
           f"solver {default_backend()}; wall s (CPU s, all threads)")
     print(f"  {'size':>4} {'unknowns':>9} {'nnz(J)':>9} {'nnz(JTJ)':>9} {'its':>4} "
           f"{'s/it':>16} {'total s':>8} {'peak MB':>8}   one iteration: assemble / J^T J / "
-          "first factor / refactor / solve [s wall (CPU)]")
+          "linear solve, first / again (how) | factorization forced: first / again "
+          "[s wall (CPU)]")
     rows = []
     for s in sizes:
         max_iter = 100 if SIZES[s] < 100 else iter_big
@@ -596,8 +602,11 @@ def section_iterations(sizes: list[str], iter_big: int, timeout: float) -> list[
             print(f"  {s:>4}  {'timed out' if d is None else d['error']} (limit {timeout:.0f} s)")
             continue
         sp_ = d["split"]
-        parts = " / ".join(f"{sp_[k]:.3f} ({sp_[k + '_cpu']:.3f})" for k in
-                           ("assemble", "normal_eq", "first_factor", "factor", "backsolve"))
+        def part(k: str) -> str:
+            return f"{sp_[k]:.3f} ({sp_[k + '_cpu']:.3f})"
+
+        parts = (" / ".join(part(k) for k in ("assemble", "normal_eq", "first", "again"))
+                 + f" ({sp_['how']}) | {part('direct_first')} / {part('direct_again')}")
         print(f"  {s:>4} {d['unknowns']:>9} {d['nnz_J']:>9} {d['nnz_A']:>9} {d['iterations']:>4} "
               f"{d['s_per_it']:>7.3f} ({d['cpu_per_it']:>6.3f}) {d['seconds']:>8.2f} "
               f"{d['peak_mb']:>8.0f}   {parts}"

@@ -12,7 +12,9 @@ Backends (chosen by measurement, see benchmarks/README.md, "Linear solver"):
 ``"cholmod"``
     CHOLMOD's supernodal Cholesky through scikit-sparse 0.4.16 (built by ``make`` against
     Debian's libsuitesparse-dev; BLAS from OpenBLAS). The analysis is ``cholmod.analyze``, the
-    numeric factorization ``Factor.cholesky_inplace``.
+    numeric factorization ``Factor.cholesky_inplace``. Ordering: AMD, or, when the matrix has
+    dense columns (auxiliary variables coupled to whole curves), those last and METIS for the
+    rest (:mod:`.ordering`).
 ``"superlu"``
     scipy's SuperLU, the fallback that always works: the analysis is the MMD ordering of
     ``A^T + A`` (computed by a first factorization); later factorizations of the same pattern
@@ -21,6 +23,12 @@ Backends (chosen by measurement, see benchmarks/README.md, "Linear solver"):
 
 The default is the first available of :data:`BACKENDS`; the environment variable
 ``GRIDSHELL_LINEAR`` (``cholmod`` or ``superlu``) or the ``backend`` argument forces one.
+
+Large systems (``n >= ITERATIVE_MIN`` unknowns) are first tried with Jacobi-preconditioned
+CG (:mod:`.iterative`): on well-conditioned mesh problems it converges in ~100 matrix-vector
+products whatever the size, 3-5x faster than the factorization at 1e5 unknowns. If CG does not
+reach its tolerance within its iteration cap, the solve falls back to the backend's
+factorization and the pattern is remembered as a direct one (no more CG tries on it).
 """
 from __future__ import annotations
 
@@ -34,12 +42,18 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..errors import InputError
+from .iterative import pcg
+from .ordering import dense_last, permuted
 
 #: backends in order of preference (the first one that imports is the default)
 BACKENDS = ("cholmod", "superlu")
 
 #: environment variable naming the backend to use (overrides the preference order)
 ENV = "GRIDSHELL_LINEAR"
+
+#: unknowns from which CG is tried before the factorization (see benchmarks/README.md,
+#: "One LM iteration at 1e5 unknowns"); below it the factorization is as fast or faster
+ITERATIVE_MIN = 50_000
 
 
 class NotPositiveDefinite(RuntimeError):
@@ -86,6 +100,10 @@ def _check(backend: str) -> str:
 
 def describe() -> str:
     """One line naming the backend in use and why (for ``gridshell --version``)."""
+    return f"{_describe_backend()}; Jacobi-CG first from {ITERATIVE_MIN} unknowns"
+
+
+def _describe_backend() -> str:
     b = default_backend()
     if b == "cholmod":
         import sksparse
@@ -123,19 +141,29 @@ class LinearSolver:
 
     ``factor(A)`` returns a function ``solve(b) -> x``; it is valid until the next ``factor``
     of a matrix with the same pattern (the numeric factor is refilled in place).
-    ``analyses`` and ``factorizations`` count the symbolic and numeric phases run.
+    ``analyses`` and ``factorizations`` count the symbolic and numeric phases run,
+    ``iterative`` the solves done by CG and ``fallbacks`` the CG tries that gave up (then the
+    matrix was factored). ``iterative_min``: unknowns from which CG is tried first (default
+    :data:`ITERATIVE_MIN`; ``None`` or 0 never).
     """
 
-    def __init__(self, backend: str | None = None, cache_size: int = 2) -> None:
+    def __init__(self, backend: str | None = None, cache_size: int = 2,
+                 iterative_min: int | None = ITERATIVE_MIN) -> None:
         self.backend = _check(backend) if backend is not None else default_backend()
         self.cache_size = max(int(cache_size), 1)
+        self.iterative_min = int(iterative_min) if iterative_min else 0
         self._cache: OrderedDict[tuple, Any] = OrderedDict()
+        self._direct: set[tuple] = set()  # patterns on which CG gave up
         self.analyses = 0
         self.factorizations = 0
+        self.iterative = 0
+        self.fallbacks = 0
+        self.ordering = ""  # the last analysis' ordering (CHOLMOD)
 
     def clear(self) -> None:
-        """Forget every cached analysis (frees the factors)."""
+        """Forget every cached analysis (frees the factors) and where CG gave up."""
         self._cache.clear()
+        self._direct.clear()
 
     def _analysis(self, A: sp.csc_matrix, key: tuple) -> tuple[Any, bool]:
         """The cached analysis of ``A``'s pattern, or ``(None, True)`` to make one."""
@@ -159,23 +187,66 @@ class LinearSolver:
         if not np.all(np.isfinite(A.data)):
             raise NotPositiveDefinite("the matrix has NaN or infinite entries")
         key = pattern_key(A) if key is None else key
+        if self.iterative_min and A.shape[0] >= self.iterative_min and key not in self._direct:
+            return self._iterative(A, key)
+        return self._factor_direct(A, key)
+
+    def _factor_direct(self, A: sp.csc_matrix, key: tuple) -> Callable:
         if self.backend == "cholmod":
             return self._factor_cholmod(A, key)
         return self._factor_superlu(A, key)
 
+    def _iterative(self, A: sp.csc_matrix, key: tuple) -> Callable:
+        """CG first; the factorization if CG gives up (and from then on for this pattern)."""
+        def solve(b: np.ndarray) -> np.ndarray:
+            res = pcg(A, b)
+            if res.converged:
+                self.iterative += 1
+                return res.x
+            self.fallbacks += 1
+            self._direct.add(key)
+            return self._factor_direct(A, key)(b)
+
+        return solve
+
     # ---------------------------------------------------------------- CHOLMOD
     def _factor_cholmod(self, A: sp.csc_matrix, key: tuple) -> Callable:
         cholmod = _cholmod()
-        f, new = self._analysis(A, key)
+        an, new = self._analysis(A, key)
         try:
             if new:
-                f = cholmod.analyze(A, mode="supernodal", ordering_method="amd")
-                self._store(key, f)
-            f.cholesky_inplace(A)
+                an = self._analyse_cholmod(A, cholmod)
+                self._store(key, an)
+            f, perm, gather, Ap = an
+            if perm is None:
+                f.cholesky_inplace(A)
+            else:
+                Ap.data[:] = A.data[gather]
+                f.cholesky_inplace(Ap)
         except cholmod.CholmodNotPositiveDefiniteError as exc:
             raise NotPositiveDefinite(str(exc)) from None
         self.factorizations += 1
-        return f
+        if perm is None:
+            return f
+
+        def solve(b: np.ndarray) -> np.ndarray:
+            x = np.empty_like(np.asarray(b, dtype=float))
+            x[perm] = f(np.asarray(b)[perm])
+            return x
+
+        return solve
+
+    def _analyse_cholmod(self, A: sp.csc_matrix, cholmod: Any) -> tuple:
+        """``(factor, perm, gather, A[perm][:, perm])``: dense columns last when ``A`` has
+        some (:mod:`.ordering`), else CHOLMOD's AMD (``perm`` None)."""
+        order = dense_last(A, cholmod)
+        if order is None:
+            self.ordering = "amd"
+            return cholmod.analyze(A, mode="supernodal", ordering_method="amd"), None, None, None
+        perm, self.ordering = order[0], f"{order[1]}, dense columns last"
+        Ap, gather = permuted(A, perm)
+        f = cholmod.analyze(Ap, mode="supernodal", ordering_method="natural")
+        return f, perm, gather, Ap
 
     # ---------------------------------------------------------------- SuperLU
     def _factor_superlu(self, A: sp.csc_matrix, key: tuple) -> Callable:

@@ -5,6 +5,12 @@ Within a solve the Jacobian's structure does not change, so neither does the pat
 its :func:`~.linear.pattern_key`, refills the values every iteration and adds the damping to
 the stored diagonal positions in place; a rejected Levenberg-Marquardt step changes the
 diagonal only. The linear solver then recognises the pattern and reuses its analysis.
+
+The values are filled in place: the transpose of ``J`` is a fixed gather of ``J``'s values
+(its structure computed once per pattern of ``J``), and the product ``J^T J`` (scipy's
+sparse product, whose output order depends only on its inputs' patterns) is scattered into
+the kept pattern through positions computed once, with no sorting and no search. At 1e5
+unknowns this halves the cost of an update (benchmarks/README.md).
 """
 from __future__ import annotations
 
@@ -31,33 +37,56 @@ class NormalEquations:
         self.JTJ: sp.csc_matrix | None = None
         self.key: tuple = ()
         self.patterns = 0
+        self.fast = 0  # updates that took the in-place path
         self._diag: np.ndarray = np.zeros(0, dtype=np.int64)
+        self._T: tuple | None = None  # J's pattern, J^T's pattern and the gather J -> J^T
+        self._M: tuple | None = None  # the product's (unsorted) pattern and its positions
 
     def update(self, J: sp.spmatrix) -> sp.csc_matrix:
         """Set ``J^T J`` for the Jacobian ``J (m, n)``; returns it ``(n, n)``, CSC."""
         J = J.tocsr()
-        M = (J.T.tocsr() @ J).tocsr()  # symmetric: its CSR arrays are its CSC arrays
-        M.sort_indices()
-        P = self.JTJ
-        if P is not None and P.shape == M.shape and np.array_equal(P.indptr, M.indptr) \
-                and np.array_equal(P.indices, M.indices):
-            P.data[:] = M.data  # the usual case: the same pattern as before
-            return P
-        if P is not None and P.shape == M.shape:
-            pos = self._positions(M)
-            if pos is not None:  # M lost entries that cancelled exactly: keep the pattern
+        M = self._transpose(J) @ J  # symmetric: its CSR arrays are its CSC arrays
+        P, m = self.JTJ, self._M
+        if P is not None and m is not None and m[0] == M.shape \
+                and np.array_equal(m[1], M.indptr) and np.array_equal(m[2], M.indices):
+            if m[4]:  # the product covers the kept pattern (the usual case)
+                P.data[m[3]] = M.data
+            else:
                 P.data[:] = 0.0
-                P.data[pos] = M.data
-                return P
-        self._new_pattern(M)
-        return self.JTJ
+                P.data[m[3]] = M.data
+            self.fast += 1
+            return P
+        pos = self._positions(M) if P is not None and P.shape == M.shape else None
+        if pos is None:  # a new pattern (or an entry outside the kept one)
+            km = _keys(M)
+            order = np.argsort(km, kind="stable")  # M's slots in sorted (CSR) order
+            S = sp.csr_matrix((M.data[order], M.indices[order], M.indptr), shape=M.shape)
+            self._new_pattern(S)
+            P = self.JTJ
+            pos = np.empty(len(order), dtype=np.int64)
+            if P.nnz == M.nnz:  # S's pattern is the kept one: slot order[k] goes to k
+                pos[order] = np.arange(len(order))
+            else:  # the diagonal was added
+                pos = np.searchsorted(_keys(P), km)
+        P.data[:] = 0.0  # entries of the pattern that cancelled exactly stay explicit zeros
+        P.data[pos] = M.data
+        self._M = (M.shape, M.indptr.copy(), M.indices.copy(), pos, len(pos) == P.nnz)
+        return P
+
+    def _transpose(self, J: sp.csr_matrix) -> sp.csr_matrix:
+        """``J^T`` in CSR, its values gathered from ``J``'s through a kept permutation."""
+        t = self._T
+        if t is None or t[0] != J.shape or not (np.array_equal(t[1], J.indptr)
+                                                and np.array_equal(t[2], J.indices)):
+            slots = sp.csr_matrix((np.arange(1, J.nnz + 1, dtype=float), J.indices, J.indptr),
+                                  shape=J.shape).T.tocsr()  # 1-based: no slot is a zero
+            t = self._T = (J.shape, J.indptr.copy(), J.indices.copy(), slots.indptr,
+                           slots.indices, slots.data.astype(np.int64) - 1)
+        return sp.csr_matrix((J.data[t[5]], t[4], t[3]), shape=J.shape[::-1])
 
     def _positions(self, M: sp.csr_matrix) -> np.ndarray | None:
         """Where ``M``'s entries sit in the kept pattern, or None if one is not in it."""
-        P = self.JTJ
-        n = P.shape[0]
-        kp = np.repeat(np.arange(n, dtype=np.int64), np.diff(P.indptr)) * n + P.indices
-        km = np.repeat(np.arange(n, dtype=np.int64), np.diff(M.indptr)) * n + M.indices
+        kp, km = _keys(self.JTJ), _keys(M)
         pos = np.searchsorted(kp, km)
         pos = np.minimum(pos, len(kp) - 1)
         return pos if np.array_equal(kp[pos], km) else None
@@ -93,3 +122,10 @@ class NormalEquations:
         data = self.JTJ.data.copy()
         data[self._diag] += mu
         return sp.csc_matrix((data, self.JTJ.indices, self.JTJ.indptr), shape=self.JTJ.shape)
+
+
+def _keys(M: sp.spmatrix) -> np.ndarray:
+    """``row * n + column`` of every stored entry of the compressed matrix ``M``, in storage
+    order (for CSC read row as column: symmetric patterns only)."""
+    n = M.shape[1]
+    return np.repeat(np.arange(M.shape[0], dtype=np.int64), np.diff(M.indptr)) * n + M.indices

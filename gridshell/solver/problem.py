@@ -117,7 +117,15 @@ class Problem:
         if c is None or c[0] != shape or not (np.array_equal(c[1], rows)
                                               and np.array_equal(c[2], cols)):
             key = rows.astype(np.int64) * shape[1] + cols
-            uniq, slot = np.unique(key, return_inverse=True)
+            # np.unique(key, return_inverse=True), through a stable sort: the terms emit
+            # their triplets in sorted runs, which timsort merges (1e5 unknowns: 4x faster)
+            order = np.argsort(key, kind="stable")
+            ks = key[order]
+            new = np.ones(len(ks), dtype=bool)
+            np.not_equal(ks[1:], ks[:-1], out=new[1:])
+            uniq = ks[new]
+            slot = np.empty(len(ks), dtype=np.int64)
+            slot[order] = np.cumsum(new) - 1
             indptr = np.zeros(shape[0] + 1, dtype=np.int64)
             np.cumsum(np.bincount(uniq // shape[1], minlength=shape[0]), out=indptr[1:])
             c = self._csr = (shape, rows.copy(), cols.copy(), indptr, uniq % shape[1], slot)
