@@ -20,6 +20,7 @@ from ..errors import ConvergenceError, InputError
 from .linear import LinearSolver, NotPositiveDefinite, shared_solver
 from .normal import NormalEquations
 from .problem import Problem
+from .threads import one_blas_thread
 
 Method = Literal["lm", "gn", "guided"]
 
@@ -88,6 +89,7 @@ def factorized(A: sp.csc_matrix) -> Callable[[np.ndarray], np.ndarray]:
     return lu.solve
 
 
+@one_blas_thread
 def solve(problem: Problem, x0: np.ndarray, *, fixed: np.ndarray | None = None,
           method: Method = "lm", max_iter: int = 100, damping: float = 1e-3,
           tol_energy: float = 1e-20, tol_rel: float = 1e-10, tol_step: float = 1e-12,
