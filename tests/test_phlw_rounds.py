@@ -14,6 +14,7 @@ import pytest
 from gridshell.bspline import BSplineSurface, fit_grid, uniform_params
 from gridshell.grid import grid_quads
 from gridshell.ncp import phlw as P
+from gridshell.ncp import phlw_rounds
 from gridshell.ncp.reference import initial_surface
 
 
@@ -118,7 +119,7 @@ def test_the_same_design_up_to_scale():
 
 
 def test_a_round_that_raises_the_true_energy_is_cut_back_or_rejected():
-    """_round judges the solver's end point by the surface's own energy."""
+    """run_round judges the solver's end point by the surface's own energy."""
     V, F = height_mesh(hill, 12, 8, 30, 20)
     init = initial_surface(V, F, n_ctrl=(7, 7))
     center = V.mean(0)
@@ -129,7 +130,7 @@ def test_a_round_that_raises_the_true_energy_is_cut_back_or_rejected():
     lay = P.make_layout(s0.n_ctrl, 100, 10, "cnc")
     prob, x, _ = P.phlw_problem(s0, data, lay, dict(P.DEFAULT_WEIGHTS), ((V - center) / diag, F),
                                 "cnc")
-    step = P._round(prob, lay, data, x, 15)
+    step = phlw_rounds.run_round(prob, lay, data, x, 15)
     E0 = prob.energy(x)
     assert np.isclose(step["energy0"], E0)
     if step["accepted"]:
@@ -211,7 +212,7 @@ def test_an_optimizer_that_only_makes_things_worse_raises_convergence_error(monk
         bad = lay.pack({**lay.unpack(x), "C": lay.view(x, "C") * 1.5})
         return SimpleNamespace(x=bad, iterations=1, energy=0.0, message="test")
 
-    monkeypatch.setattr(P, "solve", worse)
+    monkeypatch.setattr(phlw_rounds, "solve", worse)
     V, F = height_mesh(random_saddle(3), 16, 12, 16, 12)
     with pytest.raises(ConvergenceError, match="every round made the surface worse"):
         run(V, F, "cnc", samples=6, outer=2, max_iter=3)

@@ -96,7 +96,7 @@ def row_normal_curvature(K: np.ndarray, H: np.ndarray, mode: Mode = "phlw",
     ``cnc``: the given constant ``n``, else one slope fitted over all rows (on a subsampled grid
     of at most :data:`CNC_FIT_SAMPLES` squared samples); ``aa``: ``n = 0``.
     """
-    from .phlw import fit_rows
+    from .phlw_checks import fit_rows
 
     K = np.atleast_2d(np.asarray(K, float))
     H = np.atleast_2d(np.asarray(H, float))
@@ -210,7 +210,7 @@ def cnc_normal_curvature(kI: np.ndarray, kII: np.ndarray, K: np.ndarray, H: np.n
     n : float
     info : ``{"lo", "hi", "lo_at", "hi_at" (sample indices (i, j)), "fit", "choice", "note"}``
     """
-    from .phlw import fit_rows
+    from .phlw_checks import fit_rows
 
     c = classify_samples(kI, kII, np.zeros(1), floor=1.0 / max(size, 1e-300))
     keep = ~c["umbilic"]

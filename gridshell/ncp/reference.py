@@ -134,7 +134,7 @@ def _aligned(fit: InitialFit, P: np.ndarray, u: np.ndarray, v: np.ndarray,
     step's coverage and deviation tolerances (the first fit's own deviation if larger), else
     none (measured: a full 44 degree turn of corpus associate-07 left coverage 16 % before
     and 28 % after the PHLW step, tolerance 10 %)."""
-    from .phlw import COVERAGE_TOL, DEVIATION_TOL, coverage_percent, deviation_percent
+    from .phlw_figures import COVERAGE_TOL, DEVIATION_TOL, coverage_percent, deviation_percent
     from .principal_frame import ALIGN_BUDGET, ALIGN_MIN_DEG, principal_angle, rotated_fit
 
     pa = principal_angle(fit.surface)
