@@ -172,6 +172,7 @@ class GGWeights:
     polish_proximity: float = 1e-4
     polish_elastic: float = 3e-3
     polish_elastic_decay: float = 1.0
+    polish_decay: float = 0.3
 
     @classmethod
     def coerce(cls, weights: "GGWeights | Mapping[str, float] | None") -> "GGWeights":
@@ -335,9 +336,24 @@ ROUNDS_TOL = 5e-7
 #: the polish stops when an iteration lowers the constraint energy by less than this fraction
 POLISH_STALL = 1e-2
 
+#: a polish step that lowers the constraint energy by less than this fraction has reached the
+#: floor of the (slightly inconsistent) constraints: with an ``evaluate`` score the score is
+#: checked, and the polish ends if it is acceptable
+POLISH_SLOW = 0.5
+
+#: the polish' regularisation stops shrinking at this fraction of its base weights
+POLISH_FLOOR = 1e-6
+
 #: with an ``evaluate`` score: the polish stops when the score is acceptable (< 1) and improved
 #: by less than this fraction since the previous check
 SCORE_STALL = 0.05
+
+#: grids with a side above this many vertices are designed coarse to fine (at 120 x 120 the
+#: rounds alone took 100+ s CPU; each LM iteration there costs ~1.7 s, 16x one at 30 x 30)
+COARSE_ABOVE = 40
+
+#: rounds run at full resolution after the coarse design (the last ones of the continuation)
+FINE_ROUNDS = 2
 
 _CONSTRAINTS = ("geodesic", "parallel_lengths", "meridian_lengths", "orthogonal")
 
@@ -347,7 +363,8 @@ def design_gg_surface(target_V: Any, target_F: Any, P0: Any, *,
                       max_iter: int = 4, polish_iter: int = 20, tol_geodesic: float = 1e-9,
                       tol_length: float = 1e-9,
                       evaluate: Callable[[np.ndarray], float] | None = None,
-                      check_every: int = 4, progress: Progress = None) -> GGDesign:
+                      check_every: int = 4, coarse: bool = True,
+                      progress: Progress = None) -> GGDesign:
     """Optimize ``P0`` into a rotationally isometric geodesic-parallel mesh near a target
     (paper 4.1.1, Fig. 12a; Wang et al. 2019).
 
@@ -381,6 +398,10 @@ def design_gg_surface(target_V: Any, target_F: Any, P0: Any, *,
         at the end; the best-scoring of these meshes is returned.
     check_every : int
         Polish iterations between two calls of ``evaluate``.
+    coarse : bool
+        Coarse to fine: a grid with a side above :data:`COARSE_ABOVE` vertices is first
+        designed at half the resolution (recursively), and the result, interpolated back to
+        ``R x C``, starts the last :data:`FINE_ROUNDS` rounds (see :func:`_coarse_start`).
     progress : callable, optional
         Receives one line per round.
 
@@ -433,12 +454,19 @@ def design_gg_surface(target_V: Any, target_F: Any, P0: Any, *,
     prob = build(P0flat)
     before = prob.report(x)
     history: list[dict] = []
+    k0 = 0
+    if coarse and max(R, C) > COARSE_ABOVE and int(outer) > FINE_ROUNDS:
+        Pc = _coarse_start(V, Ft, P0, w, int(outer), int(max_iter), progress)
+        x = lay.pack({"P": Pc.reshape(-1, 3), "l": init_group_lengths(Pc.reshape(-1, 3), par),
+                      "h": init_group_lengths(Pc.reshape(-1, 3), mer)})
+        k0 = int(outer) - FINE_ROUNDS
+        history.append({"round": "coarse", "time": time.perf_counter() - t0})
     g0, l0 = _figures(P0)
     _say(progress, f"GG design {R} x {C}: geodesic residual {g0:.2e} rad, length spread "
                    f"{l0:.2e} at the start")
-    for k in range(int(outer)):
+    for k in range(k0, int(outer)):
         X = lay.view(x, "P")
-        if k > 0:
+        if k > k0:
             prob = build(X)
         wf = w.fairness * w.fairness_decay ** k
         soft = w.soften ** k
@@ -482,9 +510,36 @@ def design_gg_surface(target_V: Any, target_F: Any, P0: Any, *,
                     stop=stop, score=score, checkpoint=checkpoint)
 
 
-def _constraint_energy(prob: Problem, x: np.ndarray) -> float:
-    rep = prob.report(x)
-    return float(sum(rep[n]["energy"] for n in _CONSTRAINTS if n in rep))
+def _constraint_energy(report: Mapping[str, Mapping[str, float]]) -> float:
+    """Sum of the constraint terms' energies in a :meth:`Problem.report`."""
+    return float(sum(report[n]["energy"] for n in _CONSTRAINTS if n in report))
+
+
+def _resample(P: np.ndarray, R: int, C: int) -> np.ndarray:
+    """Grid ``P (r, c, 3)`` interpolated (bicubic per coordinate, in grid-index space) at
+    ``R x C`` points spanning the same index range, metres."""
+    from scipy.interpolate import RectBivariateSpline
+
+    r, c = P.shape[:2]
+    u, v = np.arange(r, dtype=float), np.arange(c, dtype=float)
+    uu, vv = np.linspace(0, r - 1, R), np.linspace(0, c - 1, C)
+    return np.stack([RectBivariateSpline(u, v, P[:, :, k], kx=min(3, r - 1), ky=min(3, c - 1),
+                                         s=0)(uu, vv) for k in range(3)], axis=-1)
+
+
+def _coarse_start(V: np.ndarray, F: np.ndarray, P0: np.ndarray, w: GGWeights, outer: int,
+                  max_iter: int, progress: Progress) -> np.ndarray:
+    """Start of a fine design: ``P0 (R, C, 3)`` resampled at half the resolution, designed
+    there (every round, no polish; recursively coarser still if still above
+    :data:`COARSE_ABOVE`), and interpolated back to ``R x C``, metres. The fine rounds then
+    only refine a mesh that is near a GG surface near the target: at 120 x 120 every fine LM
+    iteration costs ~16 coarse ones."""
+    R, C = P0.shape[:2]
+    Rc, Cc = max(4, (R + 1) // 2), max(4, (C + 1) // 2)
+    _say(progress, f"coarse to fine: designing at {Rc} x {Cc} first")
+    d = design_gg_surface(V, F, _resample(P0, Rc, Cc), weights=w, outer=outer,
+                          max_iter=max_iter, polish_iter=0, progress=progress)
+    return _resample(d.P, R, C)
 
 
 def _polish(x: np.ndarray, lay: Layout, shape: tuple[int, int], w: GGWeights,
@@ -515,25 +570,28 @@ def _polish(x: np.ndarray, lay: Layout, shape: tuple[int, int], w: GGWeights,
     stop = "iteration limit" if polish_iter > 0 else "no polish"
     ec_prev = None
     done = 0
+    g, lr = _figures(lay.view(x, "P").reshape(R, C, 3))
     while done < polish_iter:
-        g, lr = _figures(lay.view(x, "P").reshape(R, C, 3))
         if g <= tol_geodesic and lr <= tol_length:
             stop = "tolerance"
             break
         # the references are the start of every step: the proximity and elastic terms change
-        # the metric of the step only (a stale reference would pull back and stall it)
+        # the metric of the step only (a stale reference would pull back and stall it); both
+        # shrink together by polish_decay per step (same metric shape, vanishing size)
         Xs = lay.view(x, "P").copy()
+        dk = max(w.polish_decay ** done, POLISH_FLOOR)
         pol = (Problem(lay)
                .add("geodesic", w.geodesic, geodesic_meridians, GridShape((R, C)))
                .add("parallel_lengths", w.lengths * s2, equal_lengths, par)
                .add("meridian_lengths", w.lengths * s2, equal_lengths, mer)
                .add("orthogonal", w.orthogonal * s2, equal_diagonals, GridShape((R, C)))
-               .add("proximity", w.polish_proximity * s2, T.closeness, T.Closeness("P", Xs)))
+               .add("proximity", w.polish_proximity * dk * s2, T.closeness,
+                    T.Closeness("P", Xs)))
         if w.polish_elastic > 0:
-            pol.add("elastic", w.polish_elastic * w.polish_elastic_decay ** done * s2, T.linear,
-                    T.Linear("P", D, D @ Xs))
+            pol.add("elastic", w.polish_elastic * dk * w.polish_elastic_decay ** done * s2,
+                    T.linear, T.Linear("P", D, D @ Xs))
         if ec_prev is None:
-            ec_prev = _constraint_energy(pol, x)
+            ec_prev = _constraint_energy(pol.report(x))
         res = solve(pol, x, method="lm", max_iter=1, damping=lam, tol_energy=0.0, tol_rel=0.0,
                     tol_step=0.0, tol_grad=0.0)
         done += 1
@@ -543,11 +601,11 @@ def _polish(x: np.ndarray, lay: Layout, shape: tuple[int, int], w: GGWeights,
             stop = "no descent"
             break
         x = res.x
-        ec = _constraint_energy(pol, x)
+        ec = _constraint_energy(res.report)  # res.report is at res.x
         g, lr = _figures(lay.view(x, "P").reshape(R, C, 3))
         history.append({"round": "polish", "energy0": res.energy0, "energy": res.energy,
-                        "constraint_energy": ec, "iterations": res.iterations,
-                        "message": res.message,
+                        "constraint_energy": ec, "regularisation": dk,
+                        "iterations": res.iterations, "message": res.message,
                         "terms": {n: v["energy"] for n, v in res.report.items()},
                         "geodesic_max": g, "length_rel_max": lr,
                         "time": time.perf_counter() - t0})
@@ -555,10 +613,11 @@ def _polish(x: np.ndarray, lay: Layout, shape: tuple[int, int], w: GGWeights,
                        f"length spread {lr:.2e}")
         rel = (ec_prev - ec) / max(ec_prev, 1e-300)
         ec_prev = ec
-        if evaluate is not None and done % check_every == 0:
+        slow = rel < POLISH_SLOW
+        if evaluate is not None and (done % check_every == 0 or slow):
             sc = check(f"polish {done}")
             last_checked = done
-            stalled = sc_prev is not None and sc_prev - sc < SCORE_STALL * sc_prev
+            stalled = slow or (sc_prev is not None and sc_prev - sc < SCORE_STALL * sc_prev)
             if sc < 1.0 and stalled:
                 stop = "figures"
                 break
