@@ -43,7 +43,8 @@ Optimization (Tang et al. 2014 style, one :class:`~gridshell.solver.Layout` with
   when the constraint energy stagnates (:data:`POLISH_STALL`), or - given an ``evaluate``
   score, e.g. the design's figures on the traced net - when the score is acceptable and
   stagnates (:data:`SCORE_STALL`, or a step lowered the constraint energy by less than
-  :data:`POLISH_SLOW`: the floor of slightly inconsistent constraints on a freeform target),
+  :data:`POLISH_SLOW` with the regularisation below :data:`POLISH_GN`: the floor of slightly
+  inconsistent constraints on a freeform target),
   or is far inside the thresholds (:data:`SCORE_DONE`); the score is computed every
   ``check_every`` steps and when the polish slows down. With a score the best-scoring
   checkpoint is returned, so a longer polish never returns a worse design.
@@ -359,6 +360,11 @@ POLISH_STALL = 1e-2
 #: checked, and the polish ends if it is acceptable
 POLISH_SLOW = 0.5
 
+#: the polish' steps count as Gauss-Newton steps (a slow one has met the floor of the
+#: constraints) once the regularisation is below this fraction of its base weights; above,
+#: a slow step is the metric's damping (the former fixed weights: 3-15 % per step)
+POLISH_GN = 1e-2
+
 #: constraint energy (dimensionless: radians^2 and relative lengths^2) below which the
 #: polish' regularisation shrinks in proportion to it (see :func:`_polish`)
 POLISH_EREF = 1e-4
@@ -487,13 +493,14 @@ def design_gg_surface(target_V: Any, target_F: Any, P0: Any, *,
         x = lay.pack({"P": Pc.reshape(-1, 3), "l": init_group_lengths(Pc.reshape(-1, 3), par),
                       "h": init_group_lengths(Pc.reshape(-1, 3), mer)})
         k0 = int(outer) - FINE_ROUNDS
-        history.append({"round": "coarse", "time": time.perf_counter() - t0})
+        history.append({"round": "coarse", "shape": list(_coarse_shape(R, C)),
+                        "time": time.perf_counter() - t0})
     g0, l0 = _figures(P0)
     _say(progress, f"GG design {R} x {C}: geodesic residual {g0:.2e} rad, length spread "
                    f"{l0:.2e} at the start")
     for k in range(k0, int(outer)):
         X = lay.view(x, "P")
-        if k > k0:
+        if k > 0:  # (after a coarse start: refreshed at the interpolated coarse design)
             prob = build(X)
         wf = w.fairness * w.fairness_decay ** k
         soft = w.soften ** k
@@ -564,6 +571,12 @@ def _resample(P: np.ndarray, R: int, C: int) -> np.ndarray:
                                          s=0)(uu, vv) for k in range(3)], axis=-1)
 
 
+def _coarse_shape(R: int, C: int) -> tuple[int, int]:
+    """The grid a coarse-to-fine design starts from: each side above ``COARSE_ABOVE / 2``
+    halved (a short side of an elongated grid is kept)."""
+    return tuple((n + 1) // 2 if n > COARSE_ABOVE // 2 else n for n in (R, C))
+
+
 def _coarse_start(V: np.ndarray, F: np.ndarray, P0: np.ndarray, w: GGWeights, outer: int,
                   max_iter: int, progress: Progress) -> np.ndarray:
     """Start of a fine design: ``P0 (R, C, 3)`` resampled at half the resolution, designed
@@ -572,7 +585,7 @@ def _coarse_start(V: np.ndarray, F: np.ndarray, P0: np.ndarray, w: GGWeights, ou
     only refine a mesh that is near a GG surface near the target: at 120 x 120 every fine LM
     iteration costs ~16 coarse ones."""
     R, C = P0.shape[:2]
-    Rc, Cc = max(4, (R + 1) // 2), max(4, (C + 1) // 2)
+    Rc, Cc = _coarse_shape(R, C)
     _say(progress, f"coarse to fine: designing at {Rc} x {Cc} first")
     d = design_gg_surface(V, F, _resample(P0, Rc, Cc), weights=w, outer=outer,
                           max_iter=max_iter, polish_iter=0, progress=progress)
@@ -647,7 +660,7 @@ def _polish(x: np.ndarray, lay: Layout, shape: tuple[int, int], w: GGWeights,
                        f"length spread {lr:.2e}")
         rel = (ec_prev - ec) / max(ec_prev, 1e-300)
         ec_prev = ec
-        slow = rel < POLISH_SLOW
+        slow = rel < POLISH_SLOW and dk <= POLISH_GN  # a floor, not the metric's damping
         if evaluate is not None and (done % check_every == 0 or slow):
             sc = check(f"polish {done}")
             last_checked = done
