@@ -436,7 +436,8 @@ def design_gg_surface(target_V: Any, target_F: Any, P0: Any, *,
     check_every : int
         Polish iterations between two calls of ``evaluate``.
     coarse : bool
-        Coarse to fine: a grid with a side above :data:`COARSE_ABOVE` vertices is first
+        Coarse to fine (unless ``P0`` already meets the constraints to :data:`ROUNDS_TOL`):
+        a grid with a side above :data:`COARSE_ABOVE` vertices is first
         designed at half the resolution (recursively), and the result, interpolated back to
         ``R x C``, starts the last :data:`FINE_ROUNDS` rounds (see :func:`_coarse_start`).
     progress : callable, optional
@@ -488,14 +489,16 @@ def design_gg_surface(target_V: Any, target_F: Any, P0: Any, *,
     before = prob.report(x)
     history: list[dict] = []
     k0 = 0
-    if coarse and max(R, C) > COARSE_ABOVE and int(outer) > FINE_ROUNDS:
+    g0, l0 = _figures(P0)
+    # (a P0 that meets the constraints, e.g. a helicoid grid, ends the rounds after one)
+    if (coarse and max(R, C) > COARSE_ABOVE and int(outer) > FINE_ROUNDS
+            and max(g0, l0) > ROUNDS_TOL):
         Pc = _coarse_start(V, Ft, P0, w, int(outer), int(max_iter), progress)
         x = lay.pack({"P": Pc.reshape(-1, 3), "l": init_group_lengths(Pc.reshape(-1, 3), par),
                       "h": init_group_lengths(Pc.reshape(-1, 3), mer)})
         k0 = int(outer) - FINE_ROUNDS
         history.append({"round": "coarse", "shape": list(_coarse_shape(R, C)),
                         "time": time.perf_counter() - t0})
-    g0, l0 = _figures(P0)
     _say(progress, f"GG design {R} x {C}: geodesic residual {g0:.2e} rad, length spread "
                    f"{l0:.2e} at the start")
     for k in range(k0, int(outer)):
