@@ -342,14 +342,39 @@ def _place_plan(shapes: list[list[_Shape]], plan: list, Lx: float, Ly: float, g:
     return sheets, placed
 
 
+def _drop_best(shapes: list[list[_Shape]], Lx: float, Ly: float, g: float, strategies: list,
+               curved: bool, best: tuple | None, floor: int) -> tuple | None:
+    """``best`` or a better layout of the drop ``strategies`` (of :data:`STRATEGIES`), each
+    again with the last sheet's parts first (:data:`RETRIES`); stops at ``floor`` sheets."""
+    for key, turn, order in strategies:
+        if best is not None and best[0][0] <= floor:
+            break                         # no layout has fewer sheets
+        if turn and not curved:
+            continue
+        first: list[int] = []
+        for _ in range(RETRIES + 1):      # the parts left on the last sheet go first next time
+            sheets, placed = _nest_once(shapes, Lx, Ly, g, key, turn,
+                                        _order(shapes, order, first))
+            last = sum(q.poly.area for q in sheets[-1].placed) if sheets else 0.0
+            score = (len(sheets), last)
+            if best is None or score < best[0]:
+                best = (score, sheets, placed)
+            if len(sheets) < 2:
+                break
+            first = first + [i for i, (k, _) in placed.items()
+                             if k == len(sheets) - 1 and i not in first]
+    return best
+
+
 def _raster_best(parts: list[Part], shapes: list[list[_Shape]], Lx: float, Ly: float,
-                 g: float, rotation: str, best: tuple | None, floor: int) -> tuple | None:
-    """``best`` or a better layout of the raster passes (:data:`RASTER`), parts largest first;
-    stops at ``floor`` sheets. Under ``rotation="grain"`` parts turn by 0 or 180 degrees only
+                 g: float, rotation: str, best: tuple | None, floor: int, passes: list
+                 ) -> tuple | None:
+    """``best`` or a better layout of the raster ``passes`` (of :data:`RASTER`), parts largest
+    first; stops at ``floor`` sheets. Under ``rotation="grain"`` parts turn by 0 or 180 degrees only
     (from their nesting orientation, chord along the long side)."""
     polys = [s[0].poly for s in shapes]
     order = sorted(range(len(parts)), key=lambda i: (-polys[i].area, i))
-    for res, step, key in RASTER:
+    for res, step, key in passes:
         if best is not None and best[0][0] <= floor:
             break
         got = raster_nest(polys, Lx, Ly, g, order, step=step, turns=rotation, res=res,
@@ -371,8 +396,9 @@ def nest(parts: list[Part], params: FabParams) -> Layout:
     :data:`STRATEGIES` nests all parts, first fit decreasing: each part
     goes onto the first sheet with room for it, at the best of its drop places there; then
     again (:data:`RETRIES` times) with the parts the last sheet got placed first. Curved parts
-    then go through the raster passes (:data:`RASTER`, rotation free unless
-    ``params.rotation == "grain"``). The layout with the fewest sheets wins, then the one whose
+    also go through the raster passes (:data:`RASTER`, rotation free unless
+    ``params.rotation == "grain"``): the first after the first drop strategy, the others
+    after all of them. The layout with the fewest sheets wins, then the one whose
     last sheet is emptiest; the search stops at :func:`gap_bound`. Raises
     :class:`InputError` for a part that no empty sheet holds
     (:func:`fabrication.splice.split_strip` cuts such lamellae into pieces first)."""
@@ -386,25 +412,12 @@ def nest(parts: list[Part], params: FabParams) -> Layout:
     if not curved:
         best = _rows_best(parts, shapes, Lx, Ly, g,
                           0 if params.rotation == "grain" else COLUMNS)
-    for key, turn, order in STRATEGIES:
-        if best is not None and best[0][0] <= floor:
-            break                         # no layout has fewer sheets
-        if turn and not curved:
-            continue
-        first: list[int] = []
-        for _ in range(RETRIES + 1):      # the parts left on the last sheet go first next time
-            sheets, placed = _nest_once(shapes, Lx, Ly, g, key, turn,
-                                        _order(shapes, order, first))
-            last = sum(q.poly.area for q in sheets[-1].placed) if sheets else 0.0
-            score = (len(sheets), last)
-            if best is None or score < best[0]:
-                best = (score, sheets, placed)
-            if len(sheets) < 2:
-                break
-            first = first + [i for i, (k, _) in placed.items()
-                             if k == len(sheets) - 1 and i not in first]
+    best = _drop_best(shapes, Lx, Ly, g, STRATEGIES[:1], curved, best, floor)
+    if curved:       # the cheapest raster pass, then the other drop strategies, then the rest
+        best = _raster_best(parts, shapes, Lx, Ly, g, params.rotation, best, floor, RASTER[:1])
+    best = _drop_best(shapes, Lx, Ly, g, STRATEGIES[1:], curved, best, floor)
     if curved:
-        best = _raster_best(parts, shapes, Lx, Ly, g, params.rotation, best, floor)
+        best = _raster_best(parts, shapes, Lx, Ly, g, params.rotation, best, floor, RASTER[1:])
     _, sheets, placed = best
     if isinstance(placed, list):           # a rows-and-columns plan: place it now
         sheets, placed = _place_plan(shapes, placed, Lx, Ly, g)

@@ -109,30 +109,37 @@ class _Sheet:
         self.fft = scipy.fft.rfft2(self.occ)
         self.polys: list[Polygon] = []
 
-    def place(self, poses: list[_Pose], gap: float, res: float, shape: tuple[int, int],
-              key: str = "bottom") -> tuple[_Pose, float, float] | None:
-        """The lowest, then leftmost, free place over the poses (checked exactly), or None."""
+    def place(self, poses: tuple[list[_Pose], np.ndarray | None], gap: float, res: float,
+              shape: tuple[int, int], key: str = "bottom") -> tuple[_Pose, float, float] | None:
+        """The free place over the poses (and their masks' FFTs stacked) whose ranking height
+        (``key``) is lowest, then leftmost, checked exactly; None if there is none."""
+        poses, stack = poses
         if not poses:
             return None
-        F = np.stack([p.fft for p in poses]) * self.fft[None]
-        corr = scipy.fft.irfft2(F, s=shape, axes=(1, 2))
+        if self.polys:
+            F = stack * self.fft[None]
+            corr = scipy.fft.irfft2(F, s=shape, axes=(1, 2))
+        lifts = [_lift(p, key) / res for p in poses]
         best = None
-        for k, p in enumerate(poses):
+        for k in np.argsort(lifts, kind="stable"):
+            p, lift = poses[k], lifts[k]
+            if best is not None and lift >= best[0][0]:
+                break                       # no place of this pose or the next ranks better
             ni, nj = p.n
-            free = np.argwhere(corr[k, :ni, :nj] < FREE) if self.polys else \
-                np.array([[0, 0]])
-            if not len(free):
-                continue
-            lift = _lift(p, key) / res
-            order = np.lexsort((free[:, 1], free[:, 0]))
-            for o in order[:CHECKS]:
-                i, j = free[o]
-                score = (i + lift, j)
-                if best is not None and score >= best[0]:
+            free = corr[k, :ni, :nj] < FREE if self.polys else np.ones((ni, nj), bool)
+            tried = 0
+            for i in np.flatnonzero(free.any(axis=1)):
+                if (best is not None and (i + lift, 0) >= best[0]) or tried >= CHECKS:
                     break
-                if self._clear(p.poly, j * res, i * res, gap):
-                    best = (score, p, i, j)
-                    break
+                for j in np.flatnonzero(free[i])[:CHECKS - tried]:
+                    tried += 1
+                    if self._clear(p.poly, j * res, i * res, gap):
+                        if best is None or (i + lift, j) < best[0]:
+                            best = ((i + lift, j), p, i, j)
+                        break
+                else:
+                    continue
+                break
         if best is None:
             return None
         _, p, i, j = best
@@ -167,7 +174,7 @@ def raster_nest(polys: list[Polygon], Lx: float, Ly: float, gap: float,
 
     Returns per polygon its sheet (0-based) and the motion that places it, and the number of
     sheets; None if a polygon fits no empty sheet."""
-    shape = (int(np.ceil(Ly / res)), int(np.ceil(Lx / res)))
+    shape = tuple(scipy.fft.next_fast_len(int(np.ceil(L / res)), real=True) for L in (Ly, Lx))
     if turns == "grain":
         angles = np.array([0.0, np.pi])
     else:
@@ -178,8 +185,10 @@ def raster_nest(polys: list[Polygon], Lx: float, Ly: float, gap: float,
         same = (round(P.area, 2), round(P.length, 2))     # parts of one outline
         if same not in cache:
             x0, y0, _, _ = P.bounds
-            cache[same] = (x0, y0, _poses(shapely.affinity.translate(P, -x0, -y0), Lx, Ly, gap,
-                                         angles, shape, res))
+            ps = _poses(shapely.affinity.translate(P, -x0, -y0), Lx, Ly, gap, angles, shape,
+                        res)
+            stack = np.stack([p.fft for p in ps]) if ps else None
+            cache[same] = (x0, y0, (ps, stack))
         x0, y0, ps = cache[same]
         poses.append((Motion(0.0, -x0, -y0), P, ps))
     sheets: list[_Sheet] = []
