@@ -10,8 +10,10 @@ bottom margin) - the true outlines, not their bounding boxes: arcs of one radius
 each other, a short strip goes into the room a row leaves. Sheets are opened as needed.
 
 Straight strips are also laid out in rows and in columns of strips turned by 90 degrees
-(:mod:`fabrication.rows`); the best layout of all strategies is kept, and the search stops at
-:func:`gap_bound`, the fewest sheets any layout needs.
+(:mod:`fabrication.rows`); curved parts also go through raster passes that turn them freely
+(:mod:`fabrication.raster`; 0 or 180 degrees only under ``FabParams.rotation == "grain"``);
+the best layout of all strategies is kept, and the search stops at :func:`gap_bound`, the
+fewest sheets any layout needs.
 
 All parts keep ``gap`` mm from each other and from the sheet edges. The drop uses outer
 approximations of the outlines (grown by ``DROP_TOL``, simplified by as much), so a dropped
