@@ -5,8 +5,9 @@ inside the grown outline plus :data:`MARGIN`) at every ``step`` degrees of rotat
 sheet is a pixel grid whose placed parts mark their pixels. The free places of a part at one
 rotation are the pixel offsets where the correlation of the sheet's occupancy with the part's
 mask is zero: one FFT product per rotation (all rotations at once), found with
-:func:`scipy.fft.irfft2`. A part goes to the lowest, then leftmost, free place of the first
-open sheet where one exists. The offsets are chosen so that the part's box keeps the gap from
+:func:`scipy.fft.irfft2`. A part goes to the first open sheet with a free place, at the
+place whose ranking point (the part's bottom, top or centroid: :func:`_lift`) is lowest, then
+leftmost. The offsets are chosen so that the part's box keeps the gap from
 the sheet edges exactly; the raster only proposes: each place is checked with the exact
 outlines (shapely distance at least the gap to every placed part) and the next best is taken
 when the check fails.
@@ -167,7 +168,8 @@ class _Sheet:
 
 def raster_nest(polys: list[Polygon], Lx: float, Ly: float, gap: float,
                 order: list[int], step: float = STEP, turns: str = "free",
-                res: float = RES, key: str = "bottom") -> tuple[list[int], list[Motion], int] | None:
+                res: float = RES, key: str = "bottom"
+                ) -> tuple[list[int], list[Motion], int] | None:
     """Place ``polys`` (part outlines, mm) in ``order`` on sheets ``Lx x Ly`` (``Lx >= Ly``),
     ``gap`` mm apart and from the edges, turned every ``step`` degrees (``turns="free"``) or by
     0 and 180 degrees (``"grain"``); ``key``: the height that ranks places (:func:`_lift`).
@@ -182,15 +184,14 @@ def raster_nest(polys: list[Polygon], Lx: float, Ly: float, gap: float,
     cache: dict = {}
     poses = []
     for P in polys:
-        same = (round(P.area, 2), round(P.length, 2))     # parts of one outline
+        x0, y0, _, _ = P.bounds                   # parts of one outline share their poses
+        same = np.round(np.asarray(P.exterior.coords) - (x0, y0), 3).tobytes()
         if same not in cache:
-            x0, y0, _, _ = P.bounds
             ps = _poses(shapely.affinity.translate(P, -x0, -y0), Lx, Ly, gap, angles, shape,
                         res)
             stack = np.stack([p.fft for p in ps]) if ps else None
-            cache[same] = (x0, y0, (ps, stack))
-        x0, y0, ps = cache[same]
-        poses.append((Motion(0.0, -x0, -y0), P, ps))
+            cache[same] = (ps, stack)
+        poses.append((Motion(0.0, -x0, -y0), P, cache[same]))
     sheets: list[_Sheet] = []
     sheet_of = [0] * len(polys)
     motion = [Motion()] * len(polys)

@@ -57,7 +57,9 @@ def test_fill_matches_pixel_centres_inside():
                                             (2, 5.0, "grain"), (3, 0.0, "free")])
 def test_raster_placement_keeps_gap_and_margin(seed, gap, turns):
     rng = np.random.default_rng(seed)
-    polys = _parts(rng, 12)
+    polys = _parts(rng, 10)
+    polys += [shapely.affinity.translate(polys[0], 70.0, -30.0),      # copies share poses
+              shapely.affinity.translate(polys[1], -20.0, 45.0)]
     Lx, Ly = 400.0, 300.0
     order = sorted(range(len(polys)), key=lambda i: -polys[i].area)
     sheet_of, motion, n = raster_nest(polys, Lx, Ly, gap, order, step=30.0, turns=turns,
