@@ -398,9 +398,8 @@ def nest(parts: list[Part], params: FabParams) -> Layout:
     :data:`STRATEGIES` nests all parts, first fit decreasing: each part
     goes onto the first sheet with room for it, at the best of its drop places there; then
     again (:data:`RETRIES` times) with the parts the last sheet got placed first. Curved parts
-    also go through the raster passes (:data:`RASTER`, rotation free unless
-    ``params.rotation == "grain"``): the first after the first drop strategy, the others
-    after all of them. The layout with the fewest sheets wins, then the one whose
+    then go through the raster passes (:data:`RASTER`, rotation free unless
+    ``params.rotation == "grain"``). The layout with the fewest sheets wins, then the one whose
     last sheet is emptiest; the search stops at :func:`gap_bound`. Raises
     :class:`InputError` for a part that no empty sheet holds
     (:func:`fabrication.splice.split_strip` cuts such lamellae into pieces first)."""
@@ -414,12 +413,9 @@ def nest(parts: list[Part], params: FabParams) -> Layout:
     if not curved:
         best = _rows_best(parts, shapes, Lx, Ly, g,
                           0 if params.rotation == "grain" else COLUMNS)
-    best = _drop_best(shapes, Lx, Ly, g, STRATEGIES[:1], curved, best, floor)
-    if curved:       # the cheapest raster pass, then the other drop strategies, then the rest
-        best = _raster_best(parts, shapes, Lx, Ly, g, params.rotation, best, floor, RASTER[:1])
-    best = _drop_best(shapes, Lx, Ly, g, STRATEGIES[1:], curved, best, floor)
+    best = _drop_best(shapes, Lx, Ly, g, STRATEGIES, curved, best, floor)
     if curved:
-        best = _raster_best(parts, shapes, Lx, Ly, g, params.rotation, best, floor, RASTER[1:])
+        best = _raster_best(parts, shapes, Lx, Ly, g, params.rotation, best, floor, RASTER)
     _, sheets, placed = best
     if isinstance(placed, list):           # a rows-and-columns plan: place it now
         sheets, placed = _place_plan(shapes, placed, Lx, Ly, g)
