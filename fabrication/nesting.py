@@ -10,8 +10,10 @@ bottom margin) - the true outlines, not their bounding boxes: arcs of one radius
 each other, a short strip goes into the room a row leaves. Sheets are opened as needed.
 
 Straight strips are also laid out in rows and in columns of strips turned by 90 degrees
-(:mod:`fabrication.rows`); the best layout of all strategies is kept, and the search stops at
-:func:`gap_bound`, the fewest sheets any layout needs.
+(:mod:`fabrication.rows`); curved parts also go through raster passes that turn them freely
+(:mod:`fabrication.raster`; 0 or 180 degrees only under ``FabParams.rotation == "grain"``);
+the best layout of all strategies is kept, and the search stops at :func:`gap_bound`, the
+fewest sheets any layout needs.
 
 All parts keep ``gap`` mm from each other and from the sheet edges. The drop uses outer
 approximations of the outlines (grown by ``DROP_TOL``, simplified by as much), so a dropped
@@ -33,6 +35,7 @@ from gridshell.errors import InputError
 from .params import FabParams
 from .part import Part
 from .path import Motion
+from .raster import raster_nest
 from .rows import SLACK, fullest as _fullest, plan_rows  # noqa: F401 (_fullest: tests)
 from .splice import chord_frame
 
@@ -240,6 +243,9 @@ STRATEGIES = [("bottom-left", True, "length"), ("bottom-left", False, "length"),
               ("left-bottom", False, "length")]
 RETRIES = 2        # passes more per strategy, with the last sheet's parts placed first
 COLUMNS = 8        # most columns of turned straight strips tried per sheet (rows.plan_rows)
+#: raster passes for curved parts (:mod:`fabrication.raster`), cheapest first: pixel size
+#: (mm), rotation step (degrees; free rotation), the height that ranks places
+RASTER = [(1.5, 15.0, "centre"), (1.0, 10.0, "top"), (1.0, 10.0, "centre")]
 
 
 def _key(key: str, x: np.ndarray, y: np.ndarray, h: float) -> np.ndarray:
@@ -305,15 +311,15 @@ def gap_bound(parts: list[Part], sheet: tuple[float, float], gap: float) -> int:
 
 
 def _rows_best(parts: list[Part], shapes: list[list[_Shape]], Lx: float, Ly: float,
-               g: float) -> tuple | None:
-    """The best plan of :func:`fabrication.rows.plan_rows` over 0 .. COLUMNS columns of
+               g: float, columns: int = COLUMNS) -> tuple | None:
+    """The best plan of :func:`fabrication.rows.plan_rows` over 0 .. ``columns`` columns of
     turned strips (first or last): fewest sheets, then the emptiest last sheet, then the
     fewest columns. ``(score, None, plan)``; None if no plan holds the parts."""
     w = np.array([s[0].w for s in shapes])
     h = np.array([s[0].h for s in shapes])
     area = np.array([s[0].poly.area for s in shapes])
     best = None
-    for k in range(COLUMNS + 1):
+    for k in range(columns + 1):
         if k and w.min() + 2 * g > Ly + SLACK:
             break                          # no strip fits a column
         for first in ((False, True) if k else (False,)):
@@ -338,26 +344,11 @@ def _place_plan(shapes: list[list[_Shape]], plan: list, Lx: float, Ly: float, g:
     return sheets, placed
 
 
-def nest(parts: list[Part], params: FabParams) -> Layout:
-    """Place ``parts`` on as many sheets as needed; see the module docstring.
-
-    Straight strips first go in rows and columns (:func:`_rows_best`). Each strategy of
-    :data:`STRATEGIES` nests all parts, first fit decreasing: each part
-    goes onto the first sheet with room for it, at the best of its drop places there; then
-    again (:data:`RETRIES` times) with the parts the last sheet got placed first. The layout
-    with the fewest sheets wins, then the one whose last sheet is emptiest. Raises
-    :class:`InputError` for a part that no empty sheet holds
-    (:func:`fabrication.splice.split_strip` cuts such lamellae into pieces first)."""
-    W, H = params.sheet
-    Lx, Ly, g = max(W, H), min(W, H), params.gap
-    to_sheet = _frame_to_sheet(W, H)
-    shapes = [_shapes(p, p.strip.axis.kind != "line") for p in parts]
-    curved = any(len(s) > 1 for s in shapes)
-    best = None
-    floor = gap_bound(parts, params.sheet, g)
-    if not curved:
-        best = _rows_best(parts, shapes, Lx, Ly, g)
-    for key, turn, order in STRATEGIES:
+def _drop_best(shapes: list[list[_Shape]], Lx: float, Ly: float, g: float, strategies: list,
+               curved: bool, best: tuple | None, floor: int) -> tuple | None:
+    """``best`` or a better layout of the drop ``strategies`` (of :data:`STRATEGIES`), each
+    again with the last sheet's parts first (:data:`RETRIES`); stops at ``floor`` sheets."""
+    for key, turn, order in strategies:
         if best is not None and best[0][0] <= floor:
             break                         # no layout has fewer sheets
         if turn and not curved:
@@ -374,12 +365,64 @@ def nest(parts: list[Part], params: FabParams) -> Layout:
                 break
             first = first + [i for i, (k, _) in placed.items()
                              if k == len(sheets) - 1 and i not in first]
+    return best
+
+
+def _raster_best(parts: list[Part], shapes: list[list[_Shape]], Lx: float, Ly: float,
+                 g: float, rotation: str, best: tuple | None, floor: int, passes: list
+                 ) -> tuple | None:
+    """``best`` or a better layout of the raster ``passes`` (of :data:`RASTER`), parts largest
+    first; stops at ``floor`` sheets. Under ``rotation="grain"`` parts turn by 0 or 180 degrees only
+    (from their nesting orientation, chord along the long side)."""
+    polys = [s[0].poly for s in shapes]
+    order = sorted(range(len(parts)), key=lambda i: (-polys[i].area, i))
+    for res, step, key in passes:
+        if best is not None and best[0][0] <= floor:
+            break
+        got = raster_nest(polys, Lx, Ly, g, order, step=step, turns=rotation, res=res,
+                          key=key)
+        if got is None:
+            continue
+        sheet_of, motion, n = got
+        last = sum(polys[i].area for i in range(len(parts)) if sheet_of[i] == n - 1)
+        if best is None or (n, last) < best[0]:
+            best = ((n, last), n, {i: (sheet_of[i], shapes[i][0].part.moved(motion[i]))
+                                   for i in range(len(parts))})
+    return best
+
+
+def nest(parts: list[Part], params: FabParams) -> Layout:
+    """Place ``parts`` on as many sheets as needed; see the module docstring.
+
+    Straight strips first go in rows and columns (:func:`_rows_best`). Each strategy of
+    :data:`STRATEGIES` nests all parts, first fit decreasing: each part
+    goes onto the first sheet with room for it, at the best of its drop places there; then
+    again (:data:`RETRIES` times) with the parts the last sheet got placed first. Curved parts
+    then go through the raster passes (:data:`RASTER`, rotation free unless
+    ``params.rotation == "grain"``). The layout with the fewest sheets wins, then the one whose
+    last sheet is emptiest; the search stops at :func:`gap_bound`. Raises
+    :class:`InputError` for a part that no empty sheet holds
+    (:func:`fabrication.splice.split_strip` cuts such lamellae into pieces first)."""
+    W, H = params.sheet
+    Lx, Ly, g = max(W, H), min(W, H), params.gap
+    to_sheet = _frame_to_sheet(W, H)
+    shapes = [_shapes(p, p.strip.axis.kind != "line") for p in parts]
+    curved = any(len(s) > 1 for s in shapes)
+    best = None
+    floor = gap_bound(parts, params.sheet, g)
+    if not curved:
+        best = _rows_best(parts, shapes, Lx, Ly, g,
+                          0 if params.rotation == "grain" else COLUMNS)
+    best = _drop_best(shapes, Lx, Ly, g, STRATEGIES, curved, best, floor)
+    if curved:
+        best = _raster_best(parts, shapes, Lx, Ly, g, params.rotation, best, floor, RASTER)
     _, sheets, placed = best
     if isinstance(placed, list):           # a rows-and-columns plan: place it now
         sheets, placed = _place_plan(shapes, placed, Lx, Ly, g)
+    n = sheets if isinstance(sheets, int) else len(sheets)
     idx = sorted(placed)
     return Layout([placed[i][1].moved(to_sheet) for i in idx], [placed[i][0] for i in idx],
-                  len(sheets), (W, H))
+                  n, (W, H))
 
 
 def check_layout(layout: Layout, gap: float, tol: float = 1e-3) -> None:

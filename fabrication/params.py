@@ -11,6 +11,7 @@ from gridshell.errors import InputError
 
 JOINT_STYLES = ("hole", "slots", "marks")
 AXIS_PLACES = ("centre", "edge")
+ROTATIONS = ("free", "grain")
 DXF_VERSIONS = ("R2010", "R12")
 
 
@@ -78,6 +79,11 @@ class FabParams:
         Sheet width x height.
     gap : float
         Clearance between parts and from the sheet edges.
+    rotation : str
+        How nesting may turn parts on the sheet: ``"free"`` (any angle; isotropic materials
+        such as polypropylene, acrylic, MDF) or ``"grain"`` (curved parts by 0 or 180 degrees
+        from their chord along the sheet's long side, straight strips along it: plywood whose
+        grain should run along the strips).
     overlap : float or None
         Length of a splice (lap) between two pieces of a split lamella; None: at a joint,
         one joint spacing plus two end margins, so that the pieces share two joints; between
@@ -108,6 +114,7 @@ class FabParams:
     scale: float = 0.1
     sheet: tuple[float, float] = (600.0, 400.0)
     gap: float = 5.0
+    rotation: str = "free"
     overlap: float | None = None
     kerf: float = 0.0
     dxf_version: str = "R2010"
@@ -149,6 +156,9 @@ class FabParams:
         if self.joints not in JOINT_STYLES:
             raise InputError(f"--joints must be one of {', '.join(JOINT_STYLES)}, "
                              f"got {self.joints!r}")
+        if self.rotation not in ROTATIONS:
+            raise InputError(f"--rotation must be one of {', '.join(ROTATIONS)}, "
+                             f"got {self.rotation!r}")
         if self.axis not in AXIS_PLACES:
             raise InputError(f"--axis must be one of {', '.join(AXIS_PLACES)}, got {self.axis!r}")
         if self.dxf_version not in DXF_VERSIONS:

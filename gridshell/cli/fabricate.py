@@ -23,7 +23,7 @@ DXF_HELP = {"R2010": "AutoCAD 2010", "R12": "through ezdxf's R12 export"}
 
 
 def add_args(p: argparse.ArgumentParser) -> None:
-    from fabrication.params import AXIS_PLACES, DXF_VERSIONS, JOINT_STYLES, FabParams
+    from fabrication.params import AXIS_PLACES, DXF_VERSIONS, JOINT_STYLES, ROTATIONS, FabParams
 
     p.add_argument("bundle", metavar="DIR",
                    help="design bundle (output of 'gridshell gg' or 'ncp')")
@@ -52,6 +52,10 @@ def add_args(p: argparse.ArgumentParser) -> None:
                    help="sheet size WIDTHxHEIGHT mm (default 600x400)")
     g.add_argument("--gap", type=float, default=5.0,
                    help="gap between parts and to the sheet edges, mm (default 5)")
+    g.add_argument("--rotation", choices=ROTATIONS, default=FabParams.rotation,
+                   help="how parts may turn on the sheet: free (any angle, isotropic sheets such "
+                        "as polypropylene; default) or grain (along the sheet's long side, "
+                        "turned by 180 degrees at most: plywood grain along the strips)")
     g.add_argument("--overlap", type=float, default=None,
                    help="splice overlap of lamellae split to fit a sheet, mm (default: at a joint, "
                         "one joint spacing plus two margins, so the pieces share two joints; "
@@ -120,7 +124,8 @@ def run(args: Any) -> int:
                        fallback_marks=args.joints is None, clearance=args.clearance,
                        margin=args.margin,
                        axis=args.axis, scale=args.scale, sheet=args.sheet, gap=args.gap,
-                       overlap=args.overlap, kerf=args.kerf, dxf_version=args.dxf_version,
+                       rotation=args.rotation, overlap=args.overlap, kerf=args.kerf,
+                       dxf_version=args.dxf_version,
                        segments=args.segments, labels=not args.no_labels)
     read_design_json(args.bundle)  # a bad bundle is named before its output location
     out = Path(args.out) if args.out else Path(args.bundle) / "fabrication"
