@@ -20,21 +20,14 @@ from .phlw_checks import NetCheck, phlw_energy, principal_angle_error, row_relat
 #: counts as held even when it did not fall: a reference that already is PHLW (a torus zone in
 #: cnc starts at 1.9e-7 and ends at 1.4e-6 with relation 1.6e-4, while the total energy fell).
 RELATION_TOL = 1e-2
-
-
 ANGLE_TOL_DEG = 1.0
-
-
 DEVIATION_TOL = 5.0
-
 
 #: Acceptance: max distance of the reference to the surface (% of its diagonal). Looser than
 #: DEVIATION_TOL: a principal patch is bounded by principal lines and trims the corners of a
 #: reference whose edges are not principal lines; a shrunk surface (a 12 x 8 m hill returned
 #: 7.7 x 5.3 m: 15 %) fails.
 COVERAGE_TOL = 10.0
-
-
 E_PHLW_FLOOR = 1e-4
 
 

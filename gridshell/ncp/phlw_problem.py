@@ -26,7 +26,6 @@ from .reference import boundary_segments, closest_on_segments
 #: parameter speeds may halve, the area element fall to a quarter, never collapse.
 REGULAR_FLOOR = 0.25
 
-
 #: The optimized surface keeps ``(kappa_2 - kappa_1) / 2 >= UMBILIC_MARGIN *`` the reference's
 #: curvature scale (RMS over the samples of ``max |kappa_i|``) at every sample
 #: (:func:`~gridshell.ncp.phlw_terms.umbilic_guard`).

@@ -13,11 +13,11 @@ from ..bspline import BSplineSurface, uniform_params
 from ..solver import Layout, Problem, solve
 from ..solver import terms as T
 from .phlw_checks import NetCheck, net_direction_check, start_rows
-from .phlw_terms import Mode, SampleGliding, Samples, init_auxiliary, make_layout, make_samples
 from .phlw_figures import (ANGLE_TOL_DEG, COVERAGE_TOL, DEVIATION_TOL, RELATION_TOL,
                            acceptance_figures, coverage_percent, deviation_percent,
                            surface_figures)
 from .phlw_problem import boundary_gliding, boundary_operator, phlw_problem, reference_boundary
+from .phlw_terms import Mode, SampleGliding, Samples, init_auxiliary, make_layout, make_samples
 
 
 #: Levenberg-Marquardt settings of every round: initial damping (relative to the mean of
@@ -27,18 +27,12 @@ from .phlw_problem import boundary_gliding, boundary_operator, phlw_problem, ref
 #: these take 57 iterations to an energy within 10 % of that run's, the same deviation and
 #: row relation (benchmarks/README.md).
 SOLVER_DAMPING = 1e-9
-
-
 SOLVER_TOL_REL = 1e-3
-
 
 #: An outer round that lowers the true energy by less than this fraction ends the loop
 #: (stagnation); a solver step that raises it is halved up to BACKTRACK times, then rejected.
 ROUND_TOL_REL = 1e-3
-
-
 BACKTRACK = 6
-
 
 #: Continuation in the sampling: rounds run first on at most this many samples per direction
 #: (the paper's 18) when more are asked for, then on the asked sampling, started from the
@@ -46,12 +40,10 @@ BACKTRACK = 6
 #: the asked sampling, so the fine level runs only when the coarse one cannot make them hold.
 COARSE_SAMPLES = 18
 
-
 #: Rounds on the coarse level: the first round makes the large move (on the saddle of
 #: benchmarks/phlw.py the energy falls 4e4-fold in it, later rounds by < 10 % each), the
 #: later ones refine what only the asked sampling can judge.
 COARSE_ROUNDS = 1
-
 
 #: The in-round stop (:meth:`Judge.holds`): a round's Levenberg-Marquardt iterations end as
 #: soon as every acceptance figure holds, with the relation and the principal angle this many
