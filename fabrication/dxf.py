@@ -15,6 +15,7 @@ from __future__ import annotations
 from pathlib import Path as FsPath
 
 import ezdxf
+import numpy as np
 from ezdxf import units
 
 from gridshell.atomic import atomic_path
@@ -47,24 +48,45 @@ def sheet_document(parts: list[Part], sheet: tuple[float, float], params: FabPar
     for p in parts:
         for c, r in zip(p.holes, p.radii):
             msp.add_circle(tuple(c), float(r), dxfattribs=att("CUT"))
+    outlines = []
     for p in parts:
         path = p.outline.segments(params.tolerance) if params.segments else p.outline
         pts = [(float(x), float(y), float(b)) for (x, y), b in zip(path.V, path.B)]
-        msp.add_lwpolyline(pts, format="xyb", close=True, dxfattribs=att("CUT"))
-    set_extents(doc, sheet)
+        outlines.append(msp.add_lwpolyline(pts, format="xyb", close=True,
+                                           dxfattribs=att("CUT")))
+    set_extents(doc, sheet, outlines, _inner_points(parts))
     return doc
 
 
-def set_extents(doc, sheet: tuple[float, float]) -> None:
-    """``$EXTMIN`` / ``$EXTMAX`` of ``doc``: the bounding box of its modelspace entities
-    (ezdxf.bbox, bulge arcs included), mm; the sheet for an empty drawing."""
+def _inner_points(parts: list[Part]) -> np.ndarray:
+    """Corner points of everything drawn inside the outlines (engravings, score lines, the
+    holes' boxes), ``(k, 2)`` mm."""
+    pts = [np.zeros((0, 2))]
+    for p in parts:
+        pts += [np.asarray(L, float).reshape(-1, 2) for L in p.engrave]
+        pts += [np.asarray(ab, float).reshape(-1, 2) for ab in p.scores]
+        for c, r in zip(p.holes, p.radii):
+            pts.append(np.asarray(c, float).reshape(1, 2) + np.array([[-r, -r], [r, r]]))
+    return np.concatenate(pts)
+
+
+def set_extents(doc, sheet: tuple[float, float], outlines: list | None = None,
+                inner: np.ndarray | None = None) -> None:
+    """``$EXTMIN`` / ``$EXTMAX`` of ``doc``, mm: the bounding box of the cut ``outlines``
+    (ezdxf.bbox, bulge arcs included) and of the ``inner`` points (what is drawn inside them:
+    a corner list is exact for polylines, lines and the holes' boxes), or of every modelspace
+    entity when ``outlines`` is None; the sheet for an empty drawing. Measuring the outlines
+    instead of the ~17k engraved label strokes of a 192-part plan: 5.2 -> 0.1 s."""
     from ezdxf import bbox
 
     msp = doc.modelspace()
-    box = bbox.extents(msp, fast=False)
-    if box.has_data:
-        lo = (float(box.extmin.x), float(box.extmin.y), 0.0)
-        hi = (float(box.extmax.x), float(box.extmax.y), 0.0)
+    box = bbox.extents(msp if outlines is None else outlines, fast=False)
+    lo = np.array([box.extmin.x, box.extmin.y]) if box.has_data else np.full(2, np.inf)
+    hi = np.array([box.extmax.x, box.extmax.y]) if box.has_data else np.full(2, -np.inf)
+    if inner is not None and len(inner):
+        lo, hi = np.minimum(lo, inner.min(0)), np.maximum(hi, inner.max(0))
+    if np.all(np.isfinite(lo)):
+        lo, hi = (float(lo[0]), float(lo[1]), 0.0), (float(hi[0]), float(hi[1]), 0.0)
     else:
         lo, hi = (0.0, 0.0, 0.0), (float(sheet[0]), float(sheet[1]), 0.0)
     doc.header["$EXTMIN"], doc.header["$EXTMAX"] = lo, hi
