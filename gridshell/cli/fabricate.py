@@ -50,8 +50,8 @@ def add_args(p: argparse.ArgumentParser) -> None:
     g = p.add_argument_group("sheets and cutting")
     g.add_argument("--sheet", default="600x400",
                    help="sheet size WIDTHxHEIGHT mm (default 600x400)")
-    g.add_argument("--gap", type=float, default=5.0,
-                   help="gap between parts and to the sheet edges, mm (default 5)")
+    g.add_argument("--gap", type=float, default=2.0,
+                   help="gap between parts and to the sheet edges, mm (default 2)")
     g.add_argument("--rotation", choices=ROTATIONS, default=FabParams.rotation,
                    help="how parts may turn on the sheet: free (any angle, isotropic sheets such "
                         "as polypropylene; default) or grain (along the sheet's long side, "
