@@ -247,7 +247,7 @@ def render_ribbons(path: str | os.PathLike, axes: Sequence[np.ndarray],
     fig = Figure(figsize=(size[0] / dpi, size[1] / dpi), dpi=dpi)
     ax = fig.add_axes((0.01, 0.01, 0.98, 0.91 if title else 0.98))
     painter.draw(ax, linewidth=0.2)
-    xy = np.concatenate(painter.polys)
+    xy = np.concatenate([p.reshape(-1, 2) for p in painter.polys])
     lo, hi = xy.min(axis=0), xy.max(axis=0)
     box = np.array([0.98 * size[0], (0.91 if title else 0.98) * size[1]])  # axes, pixels
     scale = 1.06 * float(np.max((hi - lo) / box)) or 1.0  # metres per pixel, equal both ways
