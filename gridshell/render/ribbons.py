@@ -271,7 +271,8 @@ def render_ribbons(path: str | os.PathLike, axes: Sequence[np.ndarray],
     if title:
         fig.suptitle(title, fontsize=max(6.0, min(10.0, size[0] / 60.0)))
     with atomic_path(path) as tmp:
-        fig.savefig(tmp, format="png", dpi=dpi)
+        # zlib level 3: the same pixels, half the encoding time of the default 6, ~10 % larger
+        fig.savefig(tmp, format="png", dpi=dpi, pil_kwargs={"compress_level": 3})
     return Path(path)
 
 
