@@ -58,3 +58,21 @@ def test_bulk_mesh_rejects_faces_that_are_not_triangles_or_quads():
         geo.mesh(V, np.array([[0, 1, -1, -1]]))
     with pytest.raises(InputError, match="5 corners"):
         geo.mesh(V, np.array([[0, 1, 2, 3, 4]]))
+
+
+def test_unwelded_sides_equal_the_row_wise_unique():
+    """The integer-key unique gives what np.unique over (side, vertex) rows gives."""
+    from gridshell.export.rhino import unwelded_sides
+    from gridshell.strips3d import strip_solid
+
+    t = np.linspace(0, 1, 17)
+    P = np.column_stack([t, np.sin(2 * t), 0.1 * t])
+    V, F = strip_solid(P, np.tile([0.0, 0.3, 1.0], (17, 1)), 0.2, 0.01, False)
+    n_side = (len(F) - 4) // 4
+    side = np.concatenate([np.repeat(np.arange(4), n_side), [4, 4, 5, 5]])
+    key = np.stack([np.repeat(side, 3), np.asarray(F, np.int64).reshape(-1)], axis=1)
+    uniq, inverse = np.unique(key, axis=0, return_inverse=True)
+    V2, F2 = unwelded_sides(V, F)
+    assert np.array_equal(V2, np.asarray(V, float)[uniq[:, 1]])
+    assert np.array_equal(F2, inverse.reshape(-1, 3))
+    assert np.array_equal(V2[F2], np.asarray(V, float)[F])     # the same triangles
