@@ -145,9 +145,11 @@ def unwelded_sides(V: np.ndarray, F: np.ndarray) -> tuple[np.ndarray, np.ndarray
     F = np.asarray(F, np.int64)
     n_side = (len(F) - 4) // 4
     side = np.concatenate([np.repeat(np.arange(4), n_side), [4, 4, 5, 5]])
-    key = np.stack([np.repeat(side, 3), F.reshape(-1)], axis=1)
-    uniq, inverse = np.unique(key, axis=0, return_inverse=True)
-    return np.asarray(V, float)[uniq[:, 1]], inverse.reshape(-1, 3)
+    # the pairs (side, vertex) as one integer each, in the same (lexicographic) order as
+    # np.unique(pairs, axis=0) gives, at a fraction of its time (no row-wise sort)
+    M = int(F.max()) + 1 if F.size else 1
+    uniq, inverse = np.unique(np.repeat(side, 3) * M + F.reshape(-1), return_inverse=True)
+    return np.asarray(V, float)[uniq % M], inverse.reshape(-1, 3)
 
 
 def _strips(m: _Model, bundle, params, with_holes: bool) -> dict[str, Any]:

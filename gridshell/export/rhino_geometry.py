@@ -19,19 +19,30 @@ def mesh(V: np.ndarray, F: np.ndarray, what: str = "surface"):
     triangle in a quad array)."""
     import rhino3dm
 
+    V = np.asarray(V, float).reshape(-1, 3)
+    F = np.asarray(F, np.int64)
+    F = F.reshape(len(F), -1) if F.size else F.reshape(0, 3)
     m = rhino3dm.Mesh()
-    m.Vertices.UseDoublePrecisionVertices = True     # float64 coordinates, as the bundle's
-    for x, y, z in np.asarray(V, float).reshape(-1, 3).tolist():
-        m.Vertices.AddPoint3d(x, y, z)
-    for f in np.asarray(F, np.int64).tolist():
-        f = [i for i in f if i >= 0]
-        if len(f) == 4:
-            m.Faces.AddFace(*f)
-        elif len(f) == 3:
-            m.Faces.AddFace(f[0], f[1], f[2])
-        else:
-            raise InputError(f"{what} face {f} has {len(f)} corners; only triangles and quads "
-                             "can go into a Rhino mesh")
+    verts, faces = m.Vertices, m.Faces   # one wrapper each (every attribute access makes one)
+    verts.UseDoublePrecisionVertices = True     # float64 coordinates, as the bundle's
+    # one Python-level call per vertex / face through map(), the arrays' columns as arguments
+    # (rhino3dm 8 has no bulk constructor); same vertices and faces, same order, as adding
+    # them one by one (tests/test_export_rhino.py)
+    if len(V):
+        list(map(verts.AddPoint3d, *V.T.tolist()))
+    n_corners = (F >= 0).sum(axis=1)
+    bad = np.flatnonzero((n_corners < 3) | (n_corners > 4))
+    if len(bad):
+        f = [i for i in F[bad[0]].tolist() if i >= 0]
+        raise InputError(f"{what} face {f} has {len(f)} corners; only triangles and quads "
+                         "can go into a Rhino mesh")
+    if F.shape[1] == 3 or (F.shape[1] == 4 and np.all(n_corners == 4)):
+        if len(F):
+            list(map(faces.AddFace, *F.T.tolist()))
+    else:       # mixed triangles (padded with negative indices) and quads: keep the order
+        add = faces.AddFace
+        for f in F.tolist():
+            add(*[i for i in f if i >= 0])
     m.Normals.ComputeNormals()
     m.Compact()
     return m

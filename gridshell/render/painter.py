@@ -91,9 +91,9 @@ class Painter:
     """Polygons collected with their colours and sort keys, drawn far to near."""
 
     camera: Camera
-    polys: list[np.ndarray] = field(default_factory=list)     # (k_i, 2) screen
-    keys: list[float] = field(default_factory=list)
-    face: list[np.ndarray] = field(default_factory=list)      # RGBA
+    polys: list[np.ndarray] = field(default_factory=list)     # (m_i, k_i, 2) screen, per add
+    keys: list[np.ndarray] = field(default_factory=list)      # (m_i,)
+    face: list[np.ndarray] = field(default_factory=list)      # (m_i, 4) RGBA
     edge: list[np.ndarray] = field(default_factory=list)
 
     def add(self, Q: np.ndarray, face_rgba: np.ndarray, edge_rgba: np.ndarray,
@@ -104,10 +104,10 @@ class Painter:
             return
         xy, z = self.camera.project(Q)
         key = z.mean(axis=1) + np.broadcast_to(np.asarray(bias, float), (len(Q),))
-        self.polys.extend(xy)
-        self.keys.extend(key.tolist())
-        self.face.extend(np.broadcast_to(face_rgba, (len(Q), 4)))
-        self.edge.extend(np.broadcast_to(edge_rgba, (len(Q), 4)))
+        self.polys.append(xy)
+        self.keys.append(key)
+        self.face.append(np.broadcast_to(np.asarray(face_rgba, float), (len(Q), 4)))
+        self.edge.append(np.broadcast_to(np.asarray(edge_rgba, float), (len(Q), 4)))
 
     def add_strip(self, Q: np.ndarray, side: np.ndarray, axis_normals: np.ndarray,
                   rgb: np.ndarray, light: np.ndarray, bias: float, layer: float = 0.0) -> None:
@@ -132,14 +132,26 @@ class Painter:
         b = np.where(s * viewer_side >= 0, bias, -bias) + layer * np.where(viewer_side >= 0, 1, -1)
         self.add(Q[keep], face, edge, b)
 
+    def sorted_polygons(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """All polygons far to near as one array ``(m, k, 2)`` (``k`` the most corners of
+        any; a polygon with fewer repeats its last corner, which draws the same shape) and
+        their face and edge colours ``(m, 4)``."""
+        k = max(p.shape[1] for p in self.polys)
+        P = np.concatenate([p if p.shape[1] == k else
+                            np.concatenate([p, np.repeat(p[:, -1:], k - p.shape[1], axis=1)],
+                                           axis=1) for p in self.polys])
+        order = np.argsort(np.concatenate(self.keys), kind="stable")
+        return (P[order], np.concatenate(self.face)[order],
+                np.concatenate(self.edge)[order])
+
     def draw(self, ax, linewidth: float = 0.2) -> None:
-        """Paint everything, far to near, into a 2D matplotlib ``ax``."""
+        """Paint everything, far to near, into a 2D matplotlib ``ax`` (one collection; its
+        limits are the caller's: the collection does not autoscale the axes)."""
         from matplotlib.collections import PolyCollection
 
         if not self.polys:
             return
-        order = np.argsort(np.asarray(self.keys), kind="stable")
-        coll = PolyCollection([self.polys[i] for i in order],
-                              facecolors=np.asarray(self.face)[order],
-                              edgecolors=np.asarray(self.edge)[order], linewidths=linewidth)
-        ax.add_collection(coll)
+        P, face, edge = self.sorted_polygons()
+        # an (m, k, 2) array takes matplotlib's fast path (one template path shared by all)
+        coll = PolyCollection(P, facecolors=face, edgecolors=edge, linewidths=linewidth)
+        ax.add_collection(coll, autolim=False)

@@ -247,7 +247,7 @@ def render_ribbons(path: str | os.PathLike, axes: Sequence[np.ndarray],
     fig = Figure(figsize=(size[0] / dpi, size[1] / dpi), dpi=dpi)
     ax = fig.add_axes((0.01, 0.01, 0.98, 0.91 if title else 0.98))
     painter.draw(ax, linewidth=0.2)
-    xy = np.concatenate(painter.polys)
+    xy = np.concatenate([p.reshape(-1, 2) for p in painter.polys])
     lo, hi = xy.min(axis=0), xy.max(axis=0)
     box = np.array([0.98 * size[0], (0.91 if title else 0.98) * size[1]])  # axes, pixels
     scale = 1.06 * float(np.max((hi - lo) / box)) or 1.0  # metres per pixel, equal both ways
@@ -271,7 +271,8 @@ def render_ribbons(path: str | os.PathLike, axes: Sequence[np.ndarray],
     if title:
         fig.suptitle(title, fontsize=max(6.0, min(10.0, size[0] / 60.0)))
     with atomic_path(path) as tmp:
-        fig.savefig(tmp, format="png", dpi=dpi)
+        # zlib level 3: the same pixels, half the encoding time of the default 6, ~10 % larger
+        fig.savefig(tmp, format="png", dpi=dpi, pil_kwargs={"compress_level": 3})
     return Path(path)
 
 

@@ -1,0 +1,78 @@
+"""The .3dm export's bulk mesh construction gives the mesh that adding vertices and faces one
+by one gives (same double-precision vertices, same faces in the same order)."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import rhino3dm
+
+from gridshell.errors import InputError
+from gridshell.export import rhino_geometry as geo
+
+
+def _one_by_one(V, F):
+    """The straightforward construction (the code before the bulk path)."""
+    m = rhino3dm.Mesh()
+    m.Vertices.UseDoublePrecisionVertices = True
+    for x, y, z in np.asarray(V, float).tolist():
+        m.Vertices.AddPoint3d(x, y, z)
+    for f in np.asarray(F, np.int64).tolist():
+        f = [i for i in f if i >= 0]
+        m.Faces.AddFace(*f)
+    m.Normals.ComputeNormals()
+    m.Compact()
+    return m
+
+
+def _arrays(m):
+    V = np.array([[p.X, p.Y, p.Z] for p in
+                  (m.Vertices.Point3dAt(i) for i in range(len(m.Vertices)))])
+    F = np.array([list(m.Faces[i]) for i in range(m.Faces.Count)])
+    N = np.array([[n.X, n.Y, n.Z] for n in (m.Normals[i] for i in range(len(m.Normals)))])
+    return V, F, N
+
+
+@pytest.mark.parametrize("shape", ["tri", "quad", "mixed"])
+def test_bulk_mesh_equals_one_by_one(shape):
+    rng = np.random.default_rng(3)
+    V = rng.normal(size=(60, 3)) * 1e3 + 1e-7 * rng.normal(size=(60, 3))  # float64 digits
+    if shape == "tri":
+        F = rng.integers(0, 60, (80, 3))
+    elif shape == "quad":
+        F = rng.integers(0, 60, (80, 4))
+    else:
+        F = rng.integers(0, 60, (80, 4))
+        F[::3, 3] = -1
+        F[1::6, 1] = -1      # a padding index not at the end (rows 1 mod 3)
+    fast, slow = geo.mesh(V, F), _one_by_one(V, F)
+    (Vf, Ff, Nf), (Vs, Fs, Ns) = _arrays(fast), _arrays(slow)
+    assert np.array_equal(Vf, Vs) and np.array_equal(Ff, Fs) and np.array_equal(Nf, Ns)
+    # double precision kept: every vertex left after Compact() is one of V, bit for bit
+    assert (Vf[:, None, :] == V[None, :, :]).all(axis=2).any(axis=1).all()
+    assert fast.Faces.Count == len(F) and fast.Faces.QuadCount == slow.Faces.QuadCount
+
+
+def test_bulk_mesh_rejects_faces_that_are_not_triangles_or_quads():
+    V = np.zeros((5, 3))
+    with pytest.raises(InputError, match="2 corners"):
+        geo.mesh(V, np.array([[0, 1, -1, -1]]))
+    with pytest.raises(InputError, match="5 corners"):
+        geo.mesh(V, np.array([[0, 1, 2, 3, 4]]))
+
+
+def test_unwelded_sides_equal_the_row_wise_unique():
+    """The integer-key unique gives what np.unique over (side, vertex) rows gives."""
+    from gridshell.export.rhino import unwelded_sides
+    from gridshell.strips3d import strip_solid
+
+    t = np.linspace(0, 1, 17)
+    P = np.column_stack([t, np.sin(2 * t), 0.1 * t])
+    V, F = strip_solid(P, np.tile([0.0, 0.3, 1.0], (17, 1)), 0.2, 0.01, False)
+    n_side = (len(F) - 4) // 4
+    side = np.concatenate([np.repeat(np.arange(4), n_side), [4, 4, 5, 5]])
+    key = np.stack([np.repeat(side, 3), np.asarray(F, np.int64).reshape(-1)], axis=1)
+    uniq, inverse = np.unique(key, axis=0, return_inverse=True)
+    V2, F2 = unwelded_sides(V, F)
+    assert np.array_equal(V2, np.asarray(V, float)[uniq[:, 1]])
+    assert np.array_equal(F2, inverse.reshape(-1, 3))
+    assert np.array_equal(V2[F2], np.asarray(V, float)[F])     # the same triangles
