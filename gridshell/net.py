@@ -116,23 +116,36 @@ def move_joints(net: Net, joints: np.ndarray) -> Net:
     joints are inserted as axis vertices, so the moved axis passes exactly through the moved
     joints; ``joint_s`` is remeasured along it. Loops and topology are unchanged.
     """
-    J = np.asarray(joints, dtype=float).reshape(-1, 3)
-    if J.shape != net.joints.shape:
-        raise InputError(f"move_joints: {len(J)} joint positions for a net of "
-                         f"{len(net.joints)} joints")
-    if not np.all(np.isfinite(J)):
-        raise InputError("move_joints: joint positions must be finite")
-    out = [_carry_axis(lam, J) for lam in net.lamellae]
-    return Net(joints=J, loops=net.loops.copy(), lamellae=out)
+    return move_joints_states(net, [joints])[0]
 
 
-def _carry_axis(lam: Lamella, J: np.ndarray) -> Lamella:
+def move_joints_states(net: Net, states: list[np.ndarray] | np.ndarray) -> list[Net]:
+    """:func:`move_joints` for every joint state of ``states`` (each ``(n,3)``, metres): the
+    state-independent part of each axis (its joints inserted, the smooth curve through it) is
+    built once, and one displacement spline carries all states' columns at once."""
+    Js = [np.asarray(J, dtype=float).reshape(-1, 3) for J in states]
+    for J in Js:
+        if J.shape != net.joints.shape:
+            raise InputError(f"move_joints: {len(J)} joint positions for a net of "
+                             f"{len(net.joints)} joints")
+        if not np.all(np.isfinite(J)):
+            raise InputError("move_joints: joint positions must be finite")
+    if not Js:
+        return []
+    per_lam = [_carry_axis(lam, np.stack(Js)) for lam in net.lamellae]
+    return [Net(joints=J, loops=net.loops.copy(), lamellae=[lams[k] for lams in per_lam])
+            for k, J in enumerate(Js)]
+
+
+def _carry_axis(lam: Lamella, Js: np.ndarray) -> list[Lamella]:
+    """``lam`` carried to each joint state ``Js (m, n, 3)``: one lamella per state."""
     from scipy.interpolate import CubicSpline
 
     X, js = lam.axis, lam.joint_s
     if len(X) < 2 or len(js) == 0:
-        return Lamella(id=lam.id, family=lam.family, joints=lam.joints.copy(),
-                       joint_s=js.copy(), axis=X + (J[lam.joints[0]] - X[0] if len(js) else 0))
+        return [Lamella(id=lam.id, family=lam.family, joints=lam.joints.copy(),
+                        joint_s=js.copy(), axis=X + (J[lam.joints[0]] - X[0] if len(js) else 0))
+                for J in Js]
     X = X[np.concatenate([[True], np.linalg.norm(np.diff(X, axis=0), axis=1) > 0])]
     s = polyline_arclength(X)
     js = np.clip(js, 0.0, s[-1])
@@ -147,15 +160,21 @@ def _carry_axis(lam: Lamella, J: np.ndarray) -> Lamella:
     order = np.argsort(np.concatenate([s[keep], js]), kind="stable")
     s_all = np.concatenate([s[keep], js])[order]
     X = np.concatenate([X[keep], at])[order]
-    D = J[lam.joints] - at
+    D = Js[:, lam.joints] - at[None]                       # (m, k, 3)
+    m = len(Js)
     if len(js) == 1 or js[-1] - js[0] <= 1e-12 * s[-1]:
-        disp = np.broadcast_to(D.mean(axis=0), X.shape)
+        disp = np.broadcast_to(D.mean(axis=1)[:, None, :], (m,) + X.shape)
     else:
-        cs = CubicSpline(js, D, axis=0, bc_type="natural" if len(js) > 2 else "not-a-knot")
+        Dc = np.moveaxis(D, 0, 1).reshape(len(js), 3 * m)  # every state's columns at once
+        cs = CubicSpline(js, Dc, axis=0, bc_type="natural" if len(js) > 2 else "not-a-knot")
         t = np.clip(s_all, js[0], js[-1])
-        disp = cs(t) + (s_all - t)[:, None] * np.where((s_all < js[0])[:, None], cs(js[0], 1),
-                                                        cs(js[-1], 1))
-    X = X + disp
-    s_new = polyline_arclength(X)
-    return Lamella(id=lam.id, family=lam.family, joints=lam.joints.copy(),
-                   joint_s=np.interp(js, s_all, s_new), axis=X)
+        d = cs(t) + (s_all - t)[:, None] * np.where((s_all < js[0])[:, None], cs(js[0], 1),
+                                                     cs(js[-1], 1))
+        disp = np.moveaxis(d.reshape(len(s_all), m, 3), 1, 0)
+    out = []
+    for k in range(m):
+        Xk = X + disp[k]
+        s_new = polyline_arclength(Xk)
+        out.append(Lamella(id=lam.id, family=lam.family, joints=lam.joints.copy(),
+                           joint_s=np.interp(js, s_all, s_new), axis=Xk))
+    return out

@@ -71,3 +71,21 @@ def test_move_joints_rejects_wrong_shapes():
         move_joints(net, net.joints[:2])
     with pytest.raises(InputError, match="finite"):
         move_joints(net, np.full_like(net.joints, np.nan))
+
+
+def test_states_moved_at_once_equal_each_moved_alone():
+    """move_joints_states carries several joint states through one spline with all states'
+    columns; each state's net equals that state moved alone (the columns do not mix)."""
+    from gridshell.net import move_joints_states
+
+    net = _arc_net()
+    rng = np.random.default_rng(7)
+    states = [net.joints + 0.05 * rng.normal(size=net.joints.shape) for _ in range(4)]
+    together = move_joints_states(net, states)
+    for J, got in zip(states, together):
+        alone = move_joints(net, J)
+        assert np.array_equal(got.joints, J)
+        for a, b in zip(alone.lamellae, got.lamellae):
+            assert np.allclose(a.axis, b.axis, rtol=0, atol=1e-13)
+            assert np.allclose(a.joint_s, b.joint_s, rtol=0, atol=1e-13)
+    assert move_joints_states(net, []) == []

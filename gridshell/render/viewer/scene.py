@@ -166,7 +166,7 @@ def build_scene(bundle_dir: str | os.PathLike) -> dict[str, Any]:
     in their key's ``*_dtype`` companion or as documented: vertices ``f4``, faces ``u4``).
     """
     from ...bundle import read_bundle
-    from ...net import move_joints
+    from ...net import move_joints_states
 
     d = Path(bundle_dir)
     b = read_bundle(d)
@@ -193,8 +193,9 @@ def build_scene(bundle_dir: str | os.PathLike) -> dict[str, Any]:
     normals = joint_normals(states, net.loops, n0)
 
     strip_V, strip_F, offsets = [], None, []
+    carried = [net] + move_joints_states(net, list(states[1:]))
     for k, J in enumerate(states):
-        moved = net if k == 0 else move_joints(net, J)
+        moved = carried[k]
         by_id = {lam.id: lam for lam in moved.lamellae}
         Vk, Fk, nv = [], [], 0
         for lam, frac, jf in zip(lams, fracs, joint_fracs):
