@@ -86,6 +86,11 @@ class _Shape:
     ox: tuple[float, float]
     low: np.ndarray
     up: np.ndarray
+    runs_low: list = field(init=False)     # _runs of low and up (Sheet._profiles)
+    runs_up: list = field(init=False)
+
+    def __post_init__(self) -> None:
+        self.runs_low, self.runs_up = _runs(self.low, np.inf), _runs(self.up, -np.inf)
 
 
 @dataclass
@@ -177,6 +182,8 @@ class _Sheet:
         n = int(np.ceil(Lx / COLUMN)) + 1
         self.top = np.zeros((0, n))
         self.bot = np.zeros((0, n))
+        self._tmax: list[np.ndarray] = []    # sparse tables of top / bot (_window_extreme)
+        self._bmin: list[np.ndarray] = []
 
     def places(self, s: _Shape) -> tuple[np.ndarray, np.ndarray]:
         """Free places ``(x, y)`` (arrays) of the shape inside the sheet's margins: at every
@@ -197,9 +204,7 @@ class _Sheet:
         x, off = x[inside], off[inside]
         y = np.full((1, len(off)), self.g)
         if len(self.placed):       # (no inf - inf: tops and lows are never +inf, -inf)
-            view = np.lib.stride_tricks.sliding_window_view
-            hi = (view(self.top, nb, axis=1)[:, off] - s.low).max(axis=2)
-            lo = (view(self.bot, nb, axis=1)[:, off] - s.up).min(axis=2)
+            hi, lo = self._profiles(s, off)
             y = np.vstack([y, hi])                                  # (parts + 1, offsets)
             blocked = ((y[:, None, :] > lo[None] + 1e-9) &
                        (y[:, None, :] < hi[None] - 1e-9)).any(axis=1)
@@ -229,7 +234,63 @@ class _Sheet:
         n = self.top.shape[1]
         self.top = np.vstack([self.top, _columns(grown, 0.0, n, True)])
         self.bot = np.vstack([self.bot, _columns(grown, 0.0, n, False)])
+        self._tmax, self._bmin = _sparse_table(self.top, True), _sparse_table(self.bot, False)
         return q
+
+    def _profiles(self, s: _Shape, off: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Per placed part and column offset ``off``: the height ``hi`` at which the shape
+        rests on the part (``max_j top[off + j] - low[j]``) and the height ``lo`` at which it
+        touches it from below (``min_j bot[off + j] - up[j]``), ``(parts, offsets)``.
+
+        Runs of equal ``low`` / ``up`` (a straight strip's profile is a few runs) take the
+        extreme of the sheet's profile over the run from sparse tables (two look-ups per run
+        instead of one per column); rounding is monotone, so ``max(top) - v`` equals
+        ``max(top - v)`` bit for bit. Profiles of many runs use the sliding windows."""
+        nb = len(s.low)
+        if len(s.runs_low) + len(s.runs_up) > nb // 4:
+            view = np.lib.stride_tricks.sliding_window_view
+            hi = (view(self.top, nb, axis=1)[:, off] - s.low).max(axis=2)
+            lo = (view(self.bot, nb, axis=1)[:, off] - s.up).min(axis=2)
+            return hi, lo
+        hi = np.full((len(self.top), len(off)), -np.inf)
+        for a, L, v in s.runs_low:
+            hi = np.maximum(hi, _window_extreme(self._tmax, off + a, L, True) - v)
+        lo = np.full((len(self.bot), len(off)), np.inf)
+        for a, L, v in s.runs_up:
+            lo = np.minimum(lo, _window_extreme(self._bmin, off + a, L, False) - v)
+        return hi, lo
+
+
+def _sparse_table(a: np.ndarray, top: bool) -> list[np.ndarray]:
+    """Level ``k``: the max (``top``) or min of ``a`` ``(p, n)`` over the columns
+    ``[i, i + 2^k)``, ``(p, n - 2^k + 1)``."""
+    f = np.maximum if top else np.minimum
+    out = [a]
+    k = 1
+    while 2 * k <= a.shape[1]:
+        prev = out[-1]
+        out.append(f(prev[:, :-k], prev[:, k:]))
+        k *= 2
+    return out
+
+
+def _window_extreme(table: list[np.ndarray], start: np.ndarray, L: int, top: bool) -> np.ndarray:
+    """Max (``top``) or min over the columns ``[start, start + L)`` of the array whose
+    :func:`_sparse_table` is ``table``, ``(p, len(start))``."""
+    k = L.bit_length() - 1
+    T = table[k]
+    f = np.maximum if top else np.minimum
+    return f(T[:, start], T[:, start + L - (1 << k)])
+
+
+def _runs(prof: np.ndarray, skip: float) -> list[tuple[int, int, float]]:
+    """Runs ``(start, length, value)`` of equal values of ``prof``, except ``skip`` (the
+    columns without points, which block nothing)."""
+    cut = np.flatnonzero(prof[1:] != prof[:-1]) + 1
+    starts = np.concatenate([[0], cut])
+    ends = np.concatenate([cut, [len(prof)]])
+    return [(int(a), int(b - a), float(prof[a])) for a, b in zip(starts, ends)
+            if prof[a] != skip]
 
 
 def _frame_to_sheet(W: float, H: float) -> Motion:
