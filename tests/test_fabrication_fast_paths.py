@@ -73,3 +73,41 @@ def test_stroke_joining_matches_allclose():
         joins = sum(np.allclose(a, b) for a, b in zip(segs[1:, 0], segs[:-1, 1]))
         assert len(lines) == len(segs) - joins
         assert sum(len(L) for L in lines) == len(segs) + len(lines)
+
+
+def _entities_text(doc) -> str:
+    import io
+    buf = io.StringIO()
+    doc.write(buf)
+    text = buf.getvalue()
+    return text[text.index("ENTITIES"):text.index("OBJECTS")]
+
+
+@pytest.mark.parametrize("kind", ["GG", "CNC"])
+def test_dxf_entities_equal_point_by_point_polylines(kind):
+    """The sheet document's ENTITIES section equals the one written through
+    ``add_lwpolyline(points.tolist())`` point by point, byte for byte."""
+    import ezdxf
+
+    from fabrication import dxf
+
+    parts, params = _parts(kind, 4, 5)
+    layout = nesting.nest(parts, params)
+    sp = layout.on_sheet(0)
+    assert any(len(p.engrave) for p in sp)
+    fast = dxf.sheet_document(sp, layout.sheet, params)
+
+    def slow(msp, pts, dxfattribs, closed=False):
+        pts = np.asarray(pts, float)
+        fmt = "xyb" if pts.shape[1] == 3 else "xy"
+        return msp.add_lwpolyline(pts.tolist(), format=fmt, close=closed,
+                                  dxfattribs=dxfattribs)
+
+    orig = dxf.add_polyline
+    try:
+        dxf.add_polyline = slow
+        ref = dxf.sheet_document(sp, layout.sheet, params)
+    finally:
+        dxf.add_polyline = orig
+    assert _entities_text(fast) == _entities_text(ref)
+    assert ezdxf.__version__    # (the comparison holds for the installed ezdxf)
