@@ -111,3 +111,19 @@ def test_dxf_entities_equal_point_by_point_polylines(kind):
         dxf.add_polyline = orig
     assert _entities_text(fast) == _entities_text(ref)
     assert ezdxf.__version__    # (the comparison holds for the installed ezdxf)
+
+
+def test_svg_polylines_equal_numpy_formatting():
+    """Engraved polylines formatted from Python floats equal those formatted from the
+    numpy rows (the straightforward loop), character for character."""
+    from fabrication import svg
+
+    parts, params = _parts("GG", 4, 5)
+    layout = nesting.nest(parts, params)
+    sp = layout.on_sheet(0)
+    text = svg.sheet_svg(sp, layout.sheet, params)
+    H = layout.sheet[1]
+    for p in sp:
+        for L in p.engrave:
+            pts = " ".join(f"{svg._f(x)},{svg._f(H - y)}" for x, y in L)
+            assert f'points="{pts}"' in text
