@@ -226,15 +226,18 @@ class _Sheet:
                     return False
         return True
 
-    def add(self, s: _Shape, x: float, y: float) -> Part:
-        q = s.part.moved(Motion(0.0, x, y))
+    def add(self, s: _Shape, x: float, y: float) -> tuple[Part, Motion]:
+        """Place ``s`` at ``(x, y)``; the part and its move (made by :func:`_moved` for
+        the winning layout only: moving every label stroke of every pass costs)."""
+        q = (s.part, Motion(0.0, x, y))
         poly = shapely.affinity.translate(s.poly, x, y)
         grown = _outer_ring(poly, self.g)
         self.placed.append(_Placed(poly, grown))
         n = self.top.shape[1]
         self.top = np.vstack([self.top, _columns(grown, 0.0, n, True)])
         self.bot = np.vstack([self.bot, _columns(grown, 0.0, n, False)])
-        self._tmax, self._bmin = _sparse_table(self.top, True), _sparse_table(self.bot, False)
+        self._tmax = _sparse_table(self.top[-1:], True, self._tmax)
+        self._bmin = _sparse_table(self.bot[-1:], False, self._bmin)
         return q
 
     def _profiles(self, s: _Shape, off: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -261,9 +264,9 @@ class _Sheet:
         return hi, lo
 
 
-def _sparse_table(a: np.ndarray, top: bool) -> list[np.ndarray]:
+def _sparse_table(a: np.ndarray, top: bool, below: list | None = None) -> list[np.ndarray]:
     """Level ``k``: the max (``top``) or min of ``a`` ``(p, n)`` over the columns
-    ``[i, i + 2^k)``, ``(p, n - 2^k + 1)``."""
+    ``[i, i + 2^k)``, ``(p, n - 2^k + 1)``; under the rows of the table ``below`` if given."""
     f = np.maximum if top else np.minimum
     out = [a]
     k = 1
@@ -271,7 +274,7 @@ def _sparse_table(a: np.ndarray, top: bool) -> list[np.ndarray]:
         prev = out[-1]
         out.append(f(prev[:, :-k], prev[:, k:]))
         k *= 2
-    return out
+    return [np.vstack([b, t]) for b, t in zip(below, out)] if below else out
 
 
 def _window_extreme(table: list[np.ndarray], start: np.ndarray, L: int, top: bool) -> np.ndarray:
@@ -482,8 +485,13 @@ def nest(parts: list[Part], params: FabParams) -> Layout:
         sheets, placed = _place_plan(shapes, placed, Lx, Ly, g)
     n = sheets if isinstance(sheets, int) else len(sheets)
     idx = sorted(placed)
-    return Layout([placed[i][1].moved(to_sheet) for i in idx], [placed[i][0] for i in idx],
+    return Layout([_moved(placed[i][1]).moved(to_sheet) for i in idx], [placed[i][0] for i in idx],
                   n, (W, H))
+
+
+def _moved(q: Part | tuple[Part, Motion]) -> Part:
+    """A placed part: the part, or the part moved as :meth:`_Sheet.add` left it."""
+    return q[0].moved(q[1]) if isinstance(q, tuple) else q
 
 
 def check_layout(layout: Layout, gap: float, tol: float = 1e-3) -> None:
