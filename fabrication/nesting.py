@@ -332,11 +332,17 @@ def _order(shapes: list[list[_Shape]], order: str, first: list[int]) -> list[int
 
 
 def _nest_once(shapes: list[list[_Shape]], Lx: float, Ly: float, g: float, key: str,
-               turn: bool, seq: list[int]) -> tuple[list[_Sheet], dict[int, tuple[int, Part]]]:
-    """One first-fit pass under one strategy, parts in the order ``seq``."""
+               turn: bool, seq: list[int], beat: tuple | None = None
+               ) -> tuple[list[_Sheet], dict[int, tuple[int, Part]]] | None:
+    """One first-fit pass under one strategy, parts in the order ``seq``. None as soon as
+    the pass cannot end with a score ``(sheets, area on the last sheet)`` below ``beat``
+    (the score only grows as parts are added: more sheets, or more area on the last)."""
     sheets: list[_Sheet] = []
     placed: dict[int, tuple[int, Part]] = {}
     for i in seq:
+        if beat is not None and sheets and len(sheets) >= beat[0] and not \
+                (len(sheets), sum(q.poly.area for q in sheets[-1].placed)) < beat:
+            return None
         options = shapes[i] if turn else shapes[i][:1]
         for k in range(len(sheets) + 1):
             if k == len(sheets):
@@ -418,9 +424,12 @@ def _drop_best(shapes: list[list[_Shape]], Lx: float, Ly: float, g: float, strat
         if turn and not curved:
             continue
         first: list[int] = []
-        for _ in range(RETRIES + 1):      # the parts left on the last sheet go first next time
-            sheets, placed = _nest_once(shapes, Lx, Ly, g, key, turn,
-                                        _order(shapes, order, first))
+        for r in range(RETRIES + 1):      # the parts left on the last sheet go first next time
+            got = _nest_once(shapes, Lx, Ly, g, key, turn, _order(shapes, order, first),
+                             best[0] if best is not None and r == RETRIES else None)
+            if got is None:               # the last pass of the strategy cannot win
+                break
+            sheets, placed = got
             last = sum(q.poly.area for q in sheets[-1].placed) if sheets else 0.0
             score = (len(sheets), last)
             if best is None or score < best[0]:

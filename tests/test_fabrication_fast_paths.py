@@ -127,3 +127,28 @@ def test_svg_polylines_equal_numpy_formatting():
         for L in p.engrave:
             pts = " ".join(f"{svg._f(x)},{svg._f(H - y)}" for x, y in L)
             assert f'points="{pts}"' in text
+
+
+@pytest.mark.parametrize("kind", ["GG", "CNC"])
+def test_drop_passes_stopped_early_give_the_same_layout(kind, monkeypatch):
+    """The last pass of each drop strategy stops once it cannot win: same layout as running
+    every pass to its end."""
+    parts, params = _parts(kind, 6, 6)
+    monkeypatch.setattr(nesting, "_rows_best", lambda *a, **k: None)   # drop passes only
+    monkeypatch.setattr(nesting, "RASTER", [])
+    a = nesting.nest(parts, params)
+    full = nesting._nest_once
+    stopped = []
+
+    def never_stop(*args, beat=None, **kw):
+        stopped.append(beat is not None and full(*args, beat=beat, **kw) is None)
+        return full(*args, **kw)
+
+    monkeypatch.setattr(nesting, "_nest_once",
+                        lambda *args: never_stop(*args[:7], beat=args[7] if len(args) > 7
+                                                 else None))
+    b = nesting.nest(parts, params)
+    assert a.n_sheets == b.n_sheets and a.sheet_of == b.sheet_of
+    for p, q in zip(a.parts, b.parts):
+        np.testing.assert_array_equal(p.outline.V, q.outline.V)
+    assert any(stopped) == (kind == "CNC")   # (the GG case: one pass reaches the floor)
