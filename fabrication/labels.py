@@ -9,6 +9,7 @@ from __future__ import annotations
 from functools import lru_cache
 
 import numpy as np
+import shapely
 from shapely.geometry import MultiLineString, Polygon
 
 from .joints import feature_halfwidth, slot_edge
@@ -40,9 +41,11 @@ def _unit_strokes(text: str) -> tuple[tuple[np.ndarray, ...], float]:
     segs /= cap
     x0, x1 = segs[..., 0].min(), segs[..., 0].max()
     segs[..., 0] -= x0
-    lines, cur = [], [segs[0, 0], segs[0, 1]]
-    for a, b in segs[1:]:
-        if np.allclose(a, cur[-1]):
+    lines, cur = [], segs[0].tolist()
+    for a, b in segs[1:].tolist():
+        b0 = cur[-1]                # np.allclose(a, b0), without its overhead per segment
+        if (abs(a[0] - b0[0]) <= 1e-8 + 1e-5 * abs(b0[0])
+                and abs(a[1] - b0[1]) <= 1e-8 + 1e-5 * abs(b0[1])):
             cur.append(b)
         else:
             lines.append(np.array(cur))
@@ -89,6 +92,7 @@ def strip_labels(strip: Strip, params: FabParams,
     if h0 < MIN_HEIGHT:
         return [], len(strip.joint_s) + 1
     safe = material.buffer(-0.5)
+    shapely.prepare(safe)        # many containment tests against one polygon; same answers
     pad = feature_halfwidth(params) + 1.0
     strokes: list[np.ndarray] = []
     dropped = 0

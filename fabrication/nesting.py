@@ -86,6 +86,11 @@ class _Shape:
     ox: tuple[float, float]
     low: np.ndarray
     up: np.ndarray
+    runs_low: list = field(init=False)     # _runs of low and up (Sheet._profiles)
+    runs_up: list = field(init=False)
+
+    def __post_init__(self) -> None:
+        self.runs_low, self.runs_up = _runs(self.low, np.inf), _runs(self.up, -np.inf)
 
 
 @dataclass
@@ -177,6 +182,8 @@ class _Sheet:
         n = int(np.ceil(Lx / COLUMN)) + 1
         self.top = np.zeros((0, n))
         self.bot = np.zeros((0, n))
+        self._tmax: list[np.ndarray] = []    # sparse tables of top / bot (_window_extreme)
+        self._bmin: list[np.ndarray] = []
 
     def places(self, s: _Shape) -> tuple[np.ndarray, np.ndarray]:
         """Free places ``(x, y)`` (arrays) of the shape inside the sheet's margins: at every
@@ -197,9 +204,7 @@ class _Sheet:
         x, off = x[inside], off[inside]
         y = np.full((1, len(off)), self.g)
         if len(self.placed):       # (no inf - inf: tops and lows are never +inf, -inf)
-            view = np.lib.stride_tricks.sliding_window_view
-            hi = (view(self.top, nb, axis=1)[:, off] - s.low).max(axis=2)
-            lo = (view(self.bot, nb, axis=1)[:, off] - s.up).min(axis=2)
+            hi, lo = self._profiles(s, off)
             y = np.vstack([y, hi])                                  # (parts + 1, offsets)
             blocked = ((y[:, None, :] > lo[None] + 1e-9) &
                        (y[:, None, :] < hi[None] - 1e-9)).any(axis=1)
@@ -221,15 +226,74 @@ class _Sheet:
                     return False
         return True
 
-    def add(self, s: _Shape, x: float, y: float) -> Part:
-        q = s.part.moved(Motion(0.0, x, y))
+    def add(self, s: _Shape, x: float, y: float) -> tuple[Part, Motion]:
+        """Place ``s`` at ``(x, y)``; the part and its move (made by :func:`_moved` for
+        the winning layout only: moving every label stroke of every pass costs)."""
+        q = (s.part, Motion(0.0, x, y))
         poly = shapely.affinity.translate(s.poly, x, y)
         grown = _outer_ring(poly, self.g)
         self.placed.append(_Placed(poly, grown))
         n = self.top.shape[1]
         self.top = np.vstack([self.top, _columns(grown, 0.0, n, True)])
         self.bot = np.vstack([self.bot, _columns(grown, 0.0, n, False)])
+        self._tmax = _sparse_table(self.top[-1:], True, self._tmax)
+        self._bmin = _sparse_table(self.bot[-1:], False, self._bmin)
         return q
+
+    def _profiles(self, s: _Shape, off: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Per placed part and column offset ``off``: the height ``hi`` at which the shape
+        rests on the part (``max_j top[off + j] - low[j]``) and the height ``lo`` at which it
+        touches it from below (``min_j bot[off + j] - up[j]``), ``(parts, offsets)``.
+
+        Runs of equal ``low`` / ``up`` (a straight strip's profile is a few runs) take the
+        extreme of the sheet's profile over the run from sparse tables (two look-ups per run
+        instead of one per column); rounding is monotone, so ``max(top) - v`` equals
+        ``max(top - v)`` bit for bit. Profiles of many runs use the sliding windows."""
+        nb = len(s.low)
+        if len(s.runs_low) + len(s.runs_up) > nb // 4:
+            view = np.lib.stride_tricks.sliding_window_view
+            hi = (view(self.top, nb, axis=1)[:, off] - s.low).max(axis=2)
+            lo = (view(self.bot, nb, axis=1)[:, off] - s.up).min(axis=2)
+            return hi, lo
+        hi = np.full((len(self.top), len(off)), -np.inf)
+        for a, L, v in s.runs_low:
+            hi = np.maximum(hi, _window_extreme(self._tmax, off + a, L, True) - v)
+        lo = np.full((len(self.bot), len(off)), np.inf)
+        for a, L, v in s.runs_up:
+            lo = np.minimum(lo, _window_extreme(self._bmin, off + a, L, False) - v)
+        return hi, lo
+
+
+def _sparse_table(a: np.ndarray, top: bool, below: list | None = None) -> list[np.ndarray]:
+    """Level ``k``: the max (``top``) or min of ``a`` ``(p, n)`` over the columns
+    ``[i, i + 2^k)``, ``(p, n - 2^k + 1)``; under the rows of the table ``below`` if given."""
+    f = np.maximum if top else np.minimum
+    out = [a]
+    k = 1
+    while 2 * k <= a.shape[1]:
+        prev = out[-1]
+        out.append(f(prev[:, :-k], prev[:, k:]))
+        k *= 2
+    return [np.vstack([b, t]) for b, t in zip(below, out)] if below else out
+
+
+def _window_extreme(table: list[np.ndarray], start: np.ndarray, L: int, top: bool) -> np.ndarray:
+    """Max (``top``) or min over the columns ``[start, start + L)`` of the array whose
+    :func:`_sparse_table` is ``table``, ``(p, len(start))``."""
+    k = L.bit_length() - 1
+    T = table[k]
+    f = np.maximum if top else np.minimum
+    return f(T[:, start], T[:, start + L - (1 << k)])
+
+
+def _runs(prof: np.ndarray, skip: float) -> list[tuple[int, int, float]]:
+    """Runs ``(start, length, value)`` of equal values of ``prof``, except ``skip`` (the
+    columns without points, which block nothing)."""
+    cut = np.flatnonzero(prof[1:] != prof[:-1]) + 1
+    starts = np.concatenate([[0], cut])
+    ends = np.concatenate([cut, [len(prof)]])
+    return [(int(a), int(b - a), float(prof[a])) for a, b in zip(starts, ends)
+            if prof[a] != skip]
 
 
 def _frame_to_sheet(W: float, H: float) -> Motion:
@@ -268,11 +332,17 @@ def _order(shapes: list[list[_Shape]], order: str, first: list[int]) -> list[int
 
 
 def _nest_once(shapes: list[list[_Shape]], Lx: float, Ly: float, g: float, key: str,
-               turn: bool, seq: list[int]) -> tuple[list[_Sheet], dict[int, tuple[int, Part]]]:
-    """One first-fit pass under one strategy, parts in the order ``seq``."""
+               turn: bool, seq: list[int], beat: tuple | None = None
+               ) -> tuple[list[_Sheet], dict[int, tuple[int, Part]]] | None:
+    """One first-fit pass under one strategy, parts in the order ``seq``. None as soon as
+    the pass cannot end with a score ``(sheets, area on the last sheet)`` below ``beat``
+    (the score only grows as parts are added: more sheets, or more area on the last)."""
     sheets: list[_Sheet] = []
     placed: dict[int, tuple[int, Part]] = {}
     for i in seq:
+        if beat is not None and sheets and len(sheets) >= beat[0] and not \
+                (len(sheets), sum(q.poly.area for q in sheets[-1].placed)) < beat:
+            return None
         options = shapes[i] if turn else shapes[i][:1]
         for k in range(len(sheets) + 1):
             if k == len(sheets):
@@ -354,9 +424,12 @@ def _drop_best(shapes: list[list[_Shape]], Lx: float, Ly: float, g: float, strat
         if turn and not curved:
             continue
         first: list[int] = []
-        for _ in range(RETRIES + 1):      # the parts left on the last sheet go first next time
-            sheets, placed = _nest_once(shapes, Lx, Ly, g, key, turn,
-                                        _order(shapes, order, first))
+        for r in range(RETRIES + 1):      # the parts left on the last sheet go first next time
+            got = _nest_once(shapes, Lx, Ly, g, key, turn, _order(shapes, order, first),
+                             best[0] if best is not None and r == RETRIES else None)
+            if got is None:               # the last pass of the strategy cannot win
+                break
+            sheets, placed = got
             last = sum(q.poly.area for q in sheets[-1].placed) if sheets else 0.0
             score = (len(sheets), last)
             if best is None or score < best[0]:
@@ -421,8 +494,13 @@ def nest(parts: list[Part], params: FabParams) -> Layout:
         sheets, placed = _place_plan(shapes, placed, Lx, Ly, g)
     n = sheets if isinstance(sheets, int) else len(sheets)
     idx = sorted(placed)
-    return Layout([placed[i][1].moved(to_sheet) for i in idx], [placed[i][0] for i in idx],
+    return Layout([_moved(placed[i][1]).moved(to_sheet) for i in idx], [placed[i][0] for i in idx],
                   n, (W, H))
+
+
+def _moved(q: Part | tuple[Part, Motion]) -> Part:
+    """A placed part: the part, or the part moved as :meth:`_Sheet.add` left it."""
+    return q[0].moved(q[1]) if isinstance(q, tuple) else q
 
 
 def check_layout(layout: Layout, gap: float, tol: float = 1e-3) -> None:

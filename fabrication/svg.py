@@ -66,7 +66,7 @@ def sheet_svg(parts: list[Part], sheet: tuple[float, float], params: FabParams,
     out.append(f'<g id="ENGRAVE" {style("ENGRAVE")}>')
     for p in parts:
         for L in p.engrave:
-            pts = " ".join(f"{_f(x)},{_f(H - y)}" for x, y in L)
+            pts = " ".join(f"{_f(x)},{_f(H - y)}" for x, y in L.tolist())
             out.append(f'<polyline points="{pts}" {style("ENGRAVE")}/>')
     out.append("</g>")
     out.append(f'<g id="SCORE" {style("SCORE")}>')

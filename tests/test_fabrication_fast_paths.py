@@ -1,0 +1,154 @@
+"""The fast paths of the fabrication stage (issue 17) against the straightforward ones they
+replace: the nesting's per-run profile look-ups against the sliding windows over every
+column (bit for bit, on the drop passes of straight and curved parts), the layout of a whole
+nesting with the fast look-ups switched off, and the Hershey stroke joining against
+np.allclose."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from fab_cases import make_bundle
+
+from fabrication import FabParams
+from fabrication import nesting
+from fabrication.labels import _font
+from fabrication.part import build_part
+from fabrication.strips import strips_from_bundle
+
+
+def _parts(kind, nr, nc, **kw):
+    params = FabParams(**kw)
+    return [build_part(s, params) for s in strips_from_bundle(make_bundle(kind, nr=nr, nc=nc), params)
+            ], params
+
+
+def _slow(sheet, s, off):
+    view = np.lib.stride_tricks.sliding_window_view
+    nb = len(s.low)
+    hi = (view(sheet.top, nb, axis=1)[:, off] - s.low).max(axis=2)
+    lo = (view(sheet.bot, nb, axis=1)[:, off] - s.up).min(axis=2)
+    return hi, lo
+
+
+@pytest.mark.parametrize("kind", ["GG", "CNC"])
+def test_profile_lookups_equal_the_sliding_windows(kind, monkeypatch):
+    parts, params = _parts(kind, 5, 5)
+    calls = []
+    fast = nesting._Sheet._profiles
+
+    def both(self, s, off):
+        got = fast(self, s, off)
+        want = _slow(self, s, off)
+        calls.append(len(s.runs_low) + len(s.runs_up) <= len(s.low) // 4)
+        for g, w in zip(got, want):
+            np.testing.assert_array_equal(g, w)
+        return got
+
+    monkeypatch.setattr(nesting._Sheet, "_profiles", both)
+    monkeypatch.setattr(nesting, "_rows_best", lambda *a, **k: None)   # drop passes only
+    monkeypatch.setattr(nesting, "RASTER", [])
+    nesting.nest(parts, params)
+    assert calls and any(calls) == (kind == "GG")   # straight strips: the run look-ups
+
+
+def test_layout_unchanged_without_the_fast_lookups(monkeypatch):
+    parts, params = _parts("GG", 6, 6)
+    monkeypatch.setattr(nesting, "_rows_best", lambda *a, **k: None)   # drop passes only
+    a = nesting.nest(parts, params)
+    monkeypatch.setattr(nesting._Sheet, "_profiles",
+                        lambda self, s, off: _slow(self, s, off))
+    b = nesting.nest(parts, params)
+    assert a.n_sheets == b.n_sheets and a.sheet_of == b.sheet_of
+    for p, q in zip(a.parts, b.parts):
+        np.testing.assert_array_equal(p.outline.V, q.outline.V)
+
+
+def test_stroke_joining_matches_allclose():
+    f, _, _ = _font()
+    from fabrication.labels import _unit_strokes
+    for text in ["L12", "3,17", "L40-S2", "0123456789"]:
+        lines, _ = _unit_strokes(text)
+        segs = np.array(list(f.lines_for_text(text)), float).reshape(-1, 2, 2)
+        # consecutive segments joined exactly where np.allclose says their ends meet
+        joins = sum(np.allclose(a, b) for a, b in zip(segs[1:, 0], segs[:-1, 1]))
+        assert len(lines) == len(segs) - joins
+        assert sum(len(L) for L in lines) == len(segs) + len(lines)
+
+
+def _entities_text(doc) -> str:
+    import io
+    buf = io.StringIO()
+    doc.write(buf)
+    text = buf.getvalue()
+    return text[text.index("ENTITIES"):text.index("OBJECTS")]
+
+
+@pytest.mark.parametrize("kind", ["GG", "CNC"])
+def test_dxf_entities_equal_point_by_point_polylines(kind):
+    """The sheet document's ENTITIES section equals the one written through
+    ``add_lwpolyline(points.tolist())`` point by point, byte for byte."""
+    import ezdxf
+
+    from fabrication import dxf
+
+    parts, params = _parts(kind, 4, 5)
+    layout = nesting.nest(parts, params)
+    sp = layout.on_sheet(0)
+    assert any(len(p.engrave) for p in sp)
+    fast = dxf.sheet_document(sp, layout.sheet, params)
+
+    def slow(msp, pts, dxfattribs, closed=False):
+        pts = np.asarray(pts, float)
+        fmt = "xyb" if pts.shape[1] == 3 else "xy"
+        return msp.add_lwpolyline(pts.tolist(), format=fmt, close=closed,
+                                  dxfattribs=dxfattribs)
+
+    orig = dxf.add_polyline
+    try:
+        dxf.add_polyline = slow
+        ref = dxf.sheet_document(sp, layout.sheet, params)
+    finally:
+        dxf.add_polyline = orig
+    assert _entities_text(fast) == _entities_text(ref)
+    assert ezdxf.__version__    # (the comparison holds for the installed ezdxf)
+
+
+def test_svg_polylines_equal_numpy_formatting():
+    """Engraved polylines formatted from Python floats equal those formatted from the
+    numpy rows (the straightforward loop), character for character."""
+    from fabrication import svg
+
+    parts, params = _parts("GG", 4, 5)
+    layout = nesting.nest(parts, params)
+    sp = layout.on_sheet(0)
+    text = svg.sheet_svg(sp, layout.sheet, params)
+    H = layout.sheet[1]
+    for p in sp:
+        for L in p.engrave:
+            pts = " ".join(f"{svg._f(x)},{svg._f(H - y)}" for x, y in L)
+            assert f'points="{pts}"' in text
+
+
+@pytest.mark.parametrize("kind", ["GG", "CNC"])
+def test_drop_passes_stopped_early_give_the_same_layout(kind, monkeypatch):
+    """The last pass of each drop strategy stops once it cannot win: same layout as running
+    every pass to its end."""
+    parts, params = _parts(kind, 6, 6)
+    monkeypatch.setattr(nesting, "_rows_best", lambda *a, **k: None)   # drop passes only
+    monkeypatch.setattr(nesting, "RASTER", [])
+    a = nesting.nest(parts, params)
+    full = nesting._nest_once
+    stopped = []
+
+    def never_stop(*args, beat=None, **kw):
+        stopped.append(beat is not None and full(*args, beat=beat, **kw) is None)
+        return full(*args, **kw)
+
+    monkeypatch.setattr(nesting, "_nest_once",
+                        lambda *args: never_stop(*args[:7], beat=args[7] if len(args) > 7
+                                                 else None))
+    b = nesting.nest(parts, params)
+    assert a.n_sheets == b.n_sheets and a.sheet_of == b.sheet_of
+    for p, q in zip(a.parts, b.parts):
+        np.testing.assert_array_equal(p.outline.V, q.outline.V)
+    assert any(stopped) == (kind == "CNC")   # (the GG case: one pass reaches the floor)
