@@ -200,7 +200,8 @@ def test_lamellae_joint_splices_cannot_cut_are_spliced_between_joints(tmp_path):
         for part in read_dxf_sheet(tmp_path / "fab" / f"sheet_{k + 1:02d}.dxf")[1]:
             scores += len(part["scores"])
             x0, y0, x1, y1 = part["poly"].bounds
-            assert max(x1 - x0, y1 - y0) <= 390 + 1e-6 and min(x1 - x0, y1 - y0) <= 190 + 1e-6
+            W, H = params.sheet[0] - 2 * params.gap, params.sheet[1] - 2 * params.gap
+            assert max(x1 - x0, y1 - y0) <= W + 1e-6 and min(x1 - x0, y1 - y0) <= H + 1e-6
     assert scores == 2 * 2 * n_span         # two marks per splice, on both of its pieces
 
 
