@@ -4,10 +4,8 @@ the one a figure of its own would show, whatever was drawn before it."""
 from __future__ import annotations
 
 import numpy as np
-import pytest
 from test_render import _states_case
 
-pytest.importorskip("matplotlib")
 
 
 def test_a_state_picture_does_not_depend_on_the_states_drawn_before_it():

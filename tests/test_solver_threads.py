@@ -8,7 +8,6 @@ import textwrap
 
 import pytest
 
-pytest.importorskip("threadpoolctl")
 
 SCRIPT = textwrap.dedent("""
     import numpy as np
