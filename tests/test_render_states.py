@@ -7,7 +7,6 @@ import numpy as np
 from test_render import _states_case
 
 
-
 def test_a_state_picture_does_not_depend_on_the_states_drawn_before_it():
     from gridshell.render.states import state_images
 
