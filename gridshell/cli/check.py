@@ -24,10 +24,9 @@ OVERSTRESSED = 4
 
 def add_args(p: argparse.ArgumentParser) -> None:
     from ..structure import MATERIALS
+    from .common import add_bundle_arg
 
-    p.add_argument("bundle", metavar="DIR",
-                   help="design bundle (output of 'gridshell gg' or 'ncp'); structure.json "
-                        "goes into it")
+    add_bundle_arg(p, "; structure.json goes into it")
     g = p.add_argument_group("material")
     g.add_argument("--material", default=None, metavar="NAME",
                    help="preset: " + "; ".join(f"{k}: {m.label}" for k, m in MATERIALS.items())

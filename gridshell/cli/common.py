@@ -39,6 +39,13 @@ def choice_help(descriptions: Mapping[str, str], choices: Iterable[str], default
     return "; ".join(parts) + f" (default {default})"
 
 
+def add_bundle_arg(p: Any, note: str = "") -> None:
+    """The positional design bundle ``DIR`` of a command that reads one (``note``: what the
+    command puts into it)."""
+    p.add_argument("bundle", metavar="DIR",
+                   help="design bundle (output of 'gridshell gg' or 'ncp')" + note)
+
+
 def add_input_args(p: Any) -> None:
     """``--units``, ``--no-clean`` and ``--object``: how a command reads the user's geometry
     (:func:`gridshell.io.read.read_input`)."""

@@ -11,8 +11,9 @@ HELP = ("export a design bundle to Rhino .3dm: lamellae as strips of their real 
 
 
 def add_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("bundle", metavar="DIR",
-                   help="design bundle (output of 'gridshell gg' or 'ncp')")
+    from .common import add_bundle_arg
+
+    add_bundle_arg(p)
     p.add_argument("-o", "--output", metavar="PATH",
                    help="the .3dm file (default DIR/<kind>.3dm, e.g. DIR/gg.3dm)")
     g = p.add_argument_group(

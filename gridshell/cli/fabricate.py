@@ -5,7 +5,7 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-from .common import choice_help
+from .common import add_bundle_arg, choice_help
 
 HELP = ("cut files of a design bundle: flat lamellae with joint holes, slots or marks and "
         "engraved ids, nested on sheets as DXF and SVG with PNG previews, with a cut list and an "
@@ -25,8 +25,7 @@ DXF_HELP = {"R2010": "AutoCAD 2010", "R12": "through ezdxf's R12 export"}
 def add_args(p: argparse.ArgumentParser) -> None:
     from fabrication.params import AXIS_PLACES, DXF_VERSIONS, JOINT_STYLES, ROTATIONS, FabParams
 
-    p.add_argument("bundle", metavar="DIR",
-                   help="design bundle (output of 'gridshell gg' or 'ncp')")
+    add_bundle_arg(p)
     p.add_argument("-o", "--out", metavar="OUT",
                    help="output directory, replaced atomically (default DIR/fabrication)")
     g = p.add_argument_group("strips (mm of the model)")

@@ -11,8 +11,9 @@ HELP = ("render a design bundle: render.png (lamellae as strips of their real wi
 
 
 def add_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("bundle", metavar="DIR",
-                   help="design bundle (output of 'gridshell gg' or 'ncp'); files go into it")
+    from .common import add_bundle_arg
+
+    add_bundle_arg(p, "; files go into it")
     p.add_argument("--report", action="store_true",
                    help="also write DIR/report.html: one self-contained page of the design")
     p.add_argument("--3dm", dest="rhino", metavar="PATH",

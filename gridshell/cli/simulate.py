@@ -14,9 +14,9 @@ HELP = ("elastic equilibrium of the deployed gridshell: every lamella a discrete
 
 def add_args(p: argparse.ArgumentParser) -> None:
     from ..structure.materials import material_names
+    from .common import add_bundle_arg
 
-    p.add_argument("bundle", metavar="DIR",
-                   help="design bundle (output of 'gridshell gg' or 'ncp')")
+    add_bundle_arg(p)
     p.add_argument("-o", "--out", metavar="OUT",
                    help="output directory, replaced atomically (default DIR/equilibrium)")
     g = p.add_argument_group("strip (as 'gridshell fabricate': mm of the model)")
