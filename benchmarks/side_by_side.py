@@ -8,6 +8,10 @@ and CPU time (all threads of the process; on a loaded machine wall time grows wi
 CPU time much less) and the ratio, base / this.
 
     .venv/bin/python benchmarks/side_by_side.py --base ../base phlw:0 phlw:1 ncp_e2e:0
+
+``--own-runner`` runs the base with its own ``run_all.py`` (the row as that checkout defined and
+measured it, e.g. the code of an older figures table whose library lacks today's names);
+``--repeat N`` alternates N times and prints the medians.
 """
 from __future__ import annotations
 
@@ -18,16 +22,21 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
+
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 
 
-def run(root: Path, stage: str, index: int, timeout: float) -> dict:
+def run(root: Path, stage: str, index: int, timeout: float, runner: Path | None = None) -> dict:
+    """One (stage, size) of ``runner`` (this checkout's ``run_all.py`` by default) importing the
+    ``gridshell`` of ``root``, in its own process: the worker's JSON figures."""
     env = dict(os.environ, PYTHONPATH=str(root), MPLBACKEND="Agg")
+    runner = runner or HERE / "run_all.py"
     try:
-        p = subprocess.run([sys.executable, str(HERE / "run_all.py"), "--worker", stage,
-                            str(index)], capture_output=True, text=True, env=env,
-                           timeout=timeout)
+        p = subprocess.run([sys.executable, str(runner), "--worker", stage, str(index)],
+                           capture_output=True, text=True, env=env, timeout=timeout,
+                           cwd=runner.parent.parent)
     except subprocess.TimeoutExpired:
         return {"error": f"stopped after {timeout:g} s"}
     lines = [ln for ln in p.stdout.splitlines() if ln.startswith("{")]
@@ -36,26 +45,45 @@ def run(root: Path, stage: str, index: int, timeout: float) -> dict:
     return json.loads(lines[-1])
 
 
+def median(runs: list[dict]) -> dict:
+    """The median of each figure over the runs without an error (the first error otherwise)."""
+    ok = [r for r in runs if "error" not in r]
+    if not ok:
+        return runs[0]
+    keys = set.intersection(*(set(r) for r in ok))
+    return {k: float(np.median([r[k] for r in ok])) for k in keys
+            if all(isinstance(r[k], (int, float)) for r in ok)}
+
+
 def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("runs", nargs="+", metavar="STAGE:SIZE", help="e.g. phlw:1 (size index)")
     ap.add_argument("--base", required=True, help="the other checkout's root directory")
     ap.add_argument("--timeout", type=float, default=1800.0)
     ap.add_argument("--json", help="write the figures to this file")
+    ap.add_argument("--own-runner", action="store_true",
+                    help="run the base with its own benchmarks/run_all.py (its row definitions)")
+    ap.add_argument("--repeat", type=int, default=1, help="alternate this many times; medians")
     a = ap.parse_args(argv)
+    base = Path(a.base).resolve()
+    base_runner = base / "benchmarks" / "run_all.py" if a.own_runner else None
     out = []
     print(f"{'stage':<16} {'size':>4} {'base wall':>10} {'base cpu':>9} {'this wall':>10} "
-          f"{'this cpu':>9} {'cpu ratio':>9}")
+          f"{'this cpu':>9} {'ratio':>9}")
     for spec in a.runs:
         stage, _, idx = spec.partition(":")
-        b = run(Path(a.base).resolve(), stage, int(idx or 0), a.timeout)
-        t = run(ROOT, stage, int(idx or 0), a.timeout)
+        bs, ts = [], []
+        for _ in range(max(1, a.repeat)):
+            bs.append(run(base, stage, int(idx or 0), a.timeout, base_runner))
+            ts.append(run(ROOT, stage, int(idx or 0), a.timeout))
+        b, t = median(bs), median(ts)
         out.append({"stage": stage, "size": int(idx or 0), "base": b, "this": t})
 
         def f(d: dict, k: str) -> str:
             return f"{d[k]:.2f}" if k in d else "-"
-        ratio = (f"{b['cpu_seconds'] / t['cpu_seconds']:.1f}x" if "cpu_seconds" in b and
-                 "cpu_seconds" in t and t["cpu_seconds"] > 0 else b.get("error", t.get("error", "-")))
+        key = "cpu_seconds" if "cpu_seconds" in b and "cpu_seconds" in t else "seconds"
+        ratio = (f"{b[key] / t[key]:.2f}x" + ("" if key == "cpu_seconds" else " wall")
+                 if key in b and key in t and t[key] > 0 else b.get("error", t.get("error", "-")))
         print(f"{stage:<16} {idx or 0:>4} {f(b, 'seconds'):>10} {f(b, 'cpu_seconds'):>9} "
               f"{f(t, 'seconds'):>10} {f(t, 'cpu_seconds'):>9} {ratio:>9}", flush=True)
     if a.json:
