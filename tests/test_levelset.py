@@ -74,3 +74,26 @@ def test_pseudosphere_asymptotic_net_before_post_optimization():
     tn = LS.trace(surf, d, curves=10)
     da = alignability_error(tn.net.joints, tn.net.loops)
     assert np.mean(da) < 0.01 and np.max(da) < 0.03
+
+
+def test_xi_evaluation_matches_the_operator():
+    """evaluate_xi and the gradient used by the tracing sum over the non-zero basis products
+    only; they equal the sparse operator's products (eq. 4.1), ends of the domain included."""
+    surf = torus()
+    rng = np.random.default_rng(3)
+    F = LS.level_function(surf, rng.normal(size=99), (9, 11), (3, 2))
+    (u0, u1), (v0, v1) = F.domain
+    u = np.concatenate([rng.uniform(u0, u1, 200), [u0, u1, u0, u1]])
+    v = np.concatenate([rng.uniform(v0, v1, 200), [v0, v1, v1, v0]])
+    xi = F.ctrl[..., 2].reshape(-1)
+    for du, dv in ((0, 0), (1, 0), (0, 1), (1, 1), (2, 0), (0, 3)):
+        ref = F.operator(u, v, du, dv) @ xi
+        assert np.allclose(LS.evaluate_xi(F, u, v, du, dv), ref, rtol=1e-13, atol=1e-12)
+    z, g = LS._grad_xi(F, np.stack([u, v], axis=1))
+    assert np.allclose(z, F.operator(u, v) @ xi, rtol=1e-13, atol=1e-12)
+    assert np.allclose(g[:, 0], F.operator(u, v, 1, 0) @ xi, rtol=1e-13, atol=1e-12)
+    assert np.allclose(g[:, 1], F.operator(u, v, 0, 1) @ xi, rtol=1e-13, atol=1e-12)
+    with pytest.raises(InputError):
+        LS.evaluate_xi(F, u, v[:-1])
+    with pytest.raises(InputError):
+        LS.evaluate_xi(F, np.array([u1 + 1.0]), np.array([v0]))

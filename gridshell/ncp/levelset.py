@@ -20,7 +20,7 @@ from typing import Callable, NamedTuple
 import numpy as np
 import scipy.sparse as sp
 
-from ..bspline import BSplineSurface, open_uniform_knots
+from ..bspline import BSplineSurface, _local_basis, _params, open_uniform_knots
 from ..errors import InputError, NoNetError
 from ..net import Lamella, Net
 from ..solver import Layout, Problem, TermResult, result, solve, term
@@ -59,11 +59,36 @@ def level_function(surf: BSplineSurface, xi_ctrl: np.ndarray, n_ctrl: tuple[int,
     return BSplineSurface(du, dv, ku, kv, ctrl)
 
 
+def _patches(F: BSplineSurface, u: np.ndarray, v: np.ndarray, du: int, dv: int
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Local data of ``xi`` at paired parameters ``(k,)``: the ``xi`` control values of each
+    parameter's span ``(k, d_u + 1, d_v + 1)``, the non-zero ``u`` basis values (or ``du``-th
+    derivatives) ``(k, d_u + 1)``, those in ``v``, and the checked, clipped ``u, v``."""
+    u = np.atleast_1d(np.asarray(u, dtype=float))
+    v = np.atleast_1d(np.asarray(v, dtype=float))
+    if u.shape != v.shape or u.ndim != 1:
+        raise InputError(f"xi needs paired 1-D u and v of equal length, got shapes {u.shape} "
+                         f"and {v.shape}")
+    for name, d in (("du", du), ("dv", dv)):
+        if int(d) != d or d < 0:
+            raise InputError(f"{name} must be a non-negative integer, got {d!r}")
+    u = _params(u, F.knots_u, F.degree_u, "u")
+    v = _params(v, F.knots_v, F.degree_v, "v")
+    fu, bu = _local_basis(F.knots_u, F.degree_u, u, int(du))
+    fv, bv = _local_basis(F.knots_v, F.degree_v, v, int(dv))
+    iu = fu[:, None, None] + np.arange(bu.shape[1])[None, :, None]
+    iv = fv[:, None, None] + np.arange(bv.shape[1])[None, None, :]
+    return F.ctrl[..., 2][iu, iv], bu, bv, u, v
+
+
 def evaluate_xi(F: BSplineSurface, u: np.ndarray, v: np.ndarray, du: int = 0,
                 dv: int = 0) -> np.ndarray:
-    """``xi`` (or a derivative) at paired parameters ``(k,)``."""
-    A = F.operator(u, v, du, dv)
-    return np.asarray(A @ F.ctrl[..., 2].reshape(-1))
+    """``xi`` (or a derivative, per parameter^(du+dv)) at paired parameters ``(k,)``.
+
+    The same sums as ``F.operator(u, v, du, dv) @ xi`` (eq. 4.1), over each parameter's
+    ``(d_u + 1) x (d_v + 1)`` non-zero basis products only, without building the operator."""
+    C, bu, bv, _, _ = _patches(F, u, v, du, dv)
+    return np.einsum("ka,ka->k", bu, np.einsum("kab,kb->ka", C, bv))
 
 
 # ============================================================================ terms (4.12, 4.13)
@@ -186,9 +211,15 @@ def _check_count(count: int, max_count: int | None, spacing: float | None = None
 
 
 def _grad_xi(F: BSplineSurface, uv: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    z = evaluate_xi(F, uv[:, 0], uv[:, 1])
-    g = np.stack([evaluate_xi(F, uv[:, 0], uv[:, 1], 1, 0),
-                  evaluate_xi(F, uv[:, 0], uv[:, 1], 0, 1)], axis=1)
+    """``xi (k,)`` and its gradient ``(xi_u, xi_v) (k, 2)`` at ``uv (k, 2)``: one basis
+    evaluation per direction and order, shared by the value and the two derivatives."""
+    C, bu, bv, u, v = _patches(F, uv[:, 0], uv[:, 1], 0, 0)
+    _, du = _local_basis(F.knots_u, F.degree_u, u, 1)
+    _, dv = _local_basis(F.knots_v, F.degree_v, v, 1)
+    Cv = np.einsum("kab,kb->ka", C, bv)
+    z = np.einsum("ka,ka->k", bu, Cv)
+    g = np.stack([np.einsum("ka,ka->k", du, Cv),
+                  np.einsum("kb,kb->k", dv, np.einsum("ka,kab->kb", bu, C))], axis=1)
     return z, g
 
 
