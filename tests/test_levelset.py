@@ -97,3 +97,54 @@ def test_xi_evaluation_matches_the_operator():
         LS.evaluate_xi(F, u, v[:-1])
     with pytest.raises(InputError):
         LS.evaluate_xi(F, np.array([u1 + 1.0]), np.array([v0]))
+
+
+def _fit_with_solve(surf, d, family, n_ctrl, omega_f, max_iter=20):
+    """The level-set fit as the terms given to gridshell.solver.solve (the reference)."""
+    from gridshell.solver import Layout, Problem, solve
+
+    ops = LS.level_operators(surf, d, n_ctrl)
+    a1, b1, a2, b2 = (c.reshape(-1)[ops.ok] for c in d.coefficients(family))
+    k, (nu, nv) = ops.Du.shape[0], n_ctrl
+    prob = Problem(Layout({"xi": nu * nv}))
+    prob.add("alignment (4.12)", 1.0, LS.directional_derivative,
+             LS.DirectionalDerivative(ops.Du, ops.Dv, a1, b1, np.zeros(k)))
+    prob.add("density (4.13)", omega_f, LS.directional_derivative,
+             LS.DirectionalDerivative(ops.Du, ops.Dv, a2, b2, np.ones(k)))
+    fixed = np.zeros(nu * nv, bool)
+    fixed[(nu // 2) * nv + nv // 2] = True
+    return solve(prob, np.zeros(nu * nv), fixed=fixed, method="lm", max_iter=max_iter,
+                 damping=1e-9, tol_rel=1e-12)
+
+
+@pytest.mark.parametrize("case", [("pseudo", "aa", 48, (12, 12), 0.01),
+                                  ("torus", "cnc", 24, (16, 12), 1.0),
+                                  ("torus", "cnc", 6, (12, 12), 0.01)])
+def test_level_fit_is_the_solvers_minimum(case):
+    """fit_level_function (Jacobian and normal matrix formed once) ends where
+    gridshell.solver.solve ends on the same terms: same energy to 1e-9, same control values,
+    the same verdict and iterations; one iteration cannot converge; dropped samples are left
+    out alike (6 x 6 samples: fewer than the 12 x 12 control values, damping holds them)."""
+    name, mode, m, n_ctrl, omega_f = case
+    surf = pseudosphere() if name == "pseudo" else torus()
+    d = net_directions(surf, *uniform_params(surf, (m, m)), mode=mode)
+    if m == 6:
+        d.valid[0, :3] = False
+    for f in (1, 3):
+        fit = LS.fit_level_function(surf, d, f, n_ctrl=n_ctrl, omega_f=omega_f)
+        ref = _fit_with_solve(surf, d, f, n_ctrl, omega_f)
+        assert fit.converged and ref.converged and fit.iterations == ref.iterations
+        E = sum(t["energy"] for t in fit.report.values())
+        assert abs(E - ref.energy) <= 1e-9 * ref.energy + 1e-24
+        for t, want in ref.report.items():
+            assert np.allclose([fit.report[t][k] for k in want], list(want.values()),
+                               rtol=1e-6, atol=1e-12)
+        xi = fit.F.ctrl[..., 2].reshape(-1)
+        assert np.max(np.abs(xi - ref.x)) <= 1e-6 * np.max(np.abs(ref.x))
+        one = LS.fit_level_function(surf, d, f, n_ctrl=n_ctrl, omega_f=omega_f, max_iter=1)
+        assert not one.converged and one.iterations == 1
+    with pytest.raises(InputError):
+        LS.fit_level_function(surf, d, 1, n_ctrl=n_ctrl, omega_f=-1.0)
+    with pytest.raises(InputError):
+        LS.fit_level_function(surf, d, 1, n_ctrl=(8, 8),
+                              operators=LS.level_operators(surf, d, n_ctrl))

@@ -23,12 +23,15 @@ import scipy.sparse as sp
 from ..bspline import BSplineSurface, _local_basis, _params, open_uniform_knots
 from ..errors import InputError, NoNetError
 from ..net import Lamella, Net
-from ..solver import Layout, Problem, TermResult, result, solve, term
+from ..solver import Layout, TermResult, result, term
+from ..solver.linear import NotPositiveDefinite, shared_solver
+from ..solver.threads import one_blas_thread
 from .directions import NetDirections
 
 __all__ = ["LEVELSET_DEFAULTS", "DirectionalDerivative", "directional_derivative", "LevelFit",
-           "level_function", "fit_level_function", "level_values", "project_to_level",
-           "trace_levels", "TracedNet", "trace_net", "trace", "evaluate_xi"]
+           "LevelOperators", "level_function", "level_operators", "fit_level_function",
+           "level_values", "project_to_level", "trace_levels", "TracedNet", "trace_net", "trace",
+           "evaluate_xi"]
 
 #: paper 4.2.2: bi-degree 3, 12 x 12 control points, 48 x 48 samples. omega_f: the paper sets
 #: 0.1; measured on the pseudosphere patch (10 curves) 0.1 leaves the level sets 0.44 degrees
@@ -134,46 +137,176 @@ class LevelFit:
     density: float
 
 
-def fit_level_function(surf: BSplineSurface, dirs: NetDirections, family: int, *,
-                       n_ctrl: tuple[int, int] = (12, 12), degree: tuple[int, int] = (3, 3),
-                       omega_f: float = 0.01, max_iter: int = 20) -> LevelFit:
-    """Fit ``xi_f`` minimizing ``E_a + omega_f E_f`` at the samples of ``dirs`` (paper 4.2.2).
+class LevelOperators(NamedTuple):
+    """The sample operators of a level-function fit, shared by both families: ``F0`` (the
+    level function with ``xi = 0``), ``Du, Dv (k, nu * nv)`` mapping its control values to
+    ``xi_u, xi_v`` at the ``k`` samples ``ok`` of ``dirs`` (``valid`` flattened), for
+    ``n_ctrl`` control values of ``degree``."""
 
-    The problem is linear in the control values; one control value (the centre one) is fixed
-    to remove the free constant. Levenberg-Marquardt of :mod:`gridshell.solver`.
-    """
-    if family not in (1, 3):
-        raise InputError(f"family must be 1 or 3, got {family}")
+    F0: BSplineSurface
+    Du: sp.csr_matrix
+    Dv: sp.csr_matrix
+    ok: np.ndarray
+    n_ctrl: tuple[int, int]
+    degree: tuple[int, int]
+
+
+def level_operators(surf: BSplineSurface, dirs: NetDirections, n_ctrl: tuple[int, int] = (12, 12),
+                    degree: tuple[int, int] = (3, 3)) -> LevelOperators:
+    """:class:`LevelOperators` of the samples of ``dirs`` (one evaluation for both families)."""
     nu, nv = (int(k) for k in n_ctrl)
-    for k, d in zip((nu, nv), degree):
-        open_uniform_knots(k, int(d))  # checks the counts before anything is allocated
-    F0 = level_function(surf, np.zeros(nu * nv), (nu, nv), tuple(int(d) for d in degree))
+    deg = tuple(int(d) for d in degree)
+    for k, d in zip((nu, nv), deg):
+        open_uniform_knots(k, d)  # checks the counts before anything is allocated
+    F0 = level_function(surf, np.zeros(nu * nv), (nu, nv), deg)
     uu, vv = np.meshgrid(dirs.u, dirs.v, indexing="ij")
     ok = dirs.valid.reshape(-1)
     uu, vv = uu.reshape(-1)[ok], vv.reshape(-1)[ok]
-    Du = F0.operator(uu, vv, 1, 0)
-    Dv = F0.operator(uu, vv, 0, 1)
-    a1, b1, a2, b2 = (c.reshape(-1)[ok] for c in dirs.coefficients(family))
-    k = len(uu)
-    lay = Layout({"xi": nu * nv})
-    prob = Problem(lay)
-    prob.add("alignment (4.12)", 1.0, directional_derivative,
-             DirectionalDerivative(Du, Dv, a1, b1, np.zeros(k)))
-    prob.add("density (4.13)", omega_f, directional_derivative,
-             DirectionalDerivative(Du, Dv, a2, b2, np.ones(k)))
-    fixed = np.zeros(lay.size, bool)
+    return LevelOperators(F0, F0.operator(uu, vv, 1, 0), F0.operator(uu, vv, 0, 1), ok,
+                          (nu, nv), deg)
+
+
+def _combine(Du: sp.csr_matrix, Dv: sp.csr_matrix, a: np.ndarray, b: np.ndarray
+             ) -> sp.csr_matrix:
+    """``diag(a) Du + diag(b) Dv`` (explicit zeros kept); one pass over the values when
+    ``Du`` and ``Dv`` share their pattern (as the operators of one set of samples do)."""
+    if np.array_equal(Du.indptr, Dv.indptr) and np.array_equal(Du.indices, Dv.indices):
+        rows = np.repeat(np.arange(Du.shape[0]), np.diff(Du.indptr))
+        return sp.csr_matrix((a[rows] * Du.data + b[rows] * Dv.data, Du.indices, Du.indptr),
+                             shape=Du.shape)
+    return (sp.diags(a) @ Du + sp.diags(b) @ Dv).tocsr()
+
+
+@one_blas_thread
+def _linear_least_squares(J: sp.csr_matrix, t: np.ndarray, free: np.ndarray, *, max_iter: int,
+                          damping: float, tol_rel: float, tol_energy: float = 1e-20,
+                          tol_step: float = 1e-12, tol_grad: float = 1e-14
+                          ) -> tuple[np.ndarray, bool, int]:
+    """Minimize ``|J x - t|^2`` over ``x[free]`` from ``x = 0`` (the other entries stay 0):
+    ``(x, converged, iterations)``.
+
+    The Levenberg-Marquardt iteration of :func:`gridshell.solver.solve` (method ``"lm"``,
+    the same steps, gain ratio, damping updates, rejections and stopping rules, ``damping``
+    relative to the mean diagonal of ``J^T J``) for a linear residual: its Jacobian ``J`` and
+    normal matrix ``J^T J`` do not change, so they are formed once here, where ``solve``
+    assembles both again at every iteration and trial step; each trial damping is factored
+    (:func:`~gridshell.solver.linear.shared_solver`, the analysis shared)."""
+    n = J.shape[1]
+    JT = J.T.tocsr()
+    N = (JT @ J).tocsr()[free][:, free].tocsc()
+    N.sort_indices()
+    diag = N.diagonal()
+    scale = float(np.mean(diag)) if diag.size and np.mean(diag) > 0 else 1.0
+    lin = shared_solver()
+    x = np.zeros(n)
+    r = -np.asarray(t, float)           # J x - t
+    E = float(r @ r)
+    lam, nu = damping, 2.0
+    converged, it = False, 0
+    for it in range(1, max_iter + 1):
+        if E <= tol_energy:
+            converged, it = True, it - 1
+            break
+        g = (JT @ r)[free]
+        if np.max(np.abs(g), initial=0.0) <= tol_grad:
+            converged, it = True, it - 1
+            break
+        accepted = False
+        while True:
+            try:
+                dx = -lin.factor(N + sp.diags(np.full(len(free), lam * scale), format="csc"))(g)
+            except NotPositiveDefinite:  # singular: raise the damping
+                lam *= 10.0
+                if lam > 1e16:
+                    break
+                continue
+            x_new = x.copy()
+            x_new[free] += dx
+            r_new = J @ x_new - t
+            E_new = float(r_new @ r_new)
+            pred = -(2 * g @ dx + dx @ (N @ dx))
+            rho = (E - E_new) / pred if pred > 0 else -1.0
+            if np.isfinite(E_new) and E_new < E:
+                accepted = True
+                lam *= max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0) ** 3) if rho > 0 else 1.0
+                nu = 2.0
+                break
+            lam *= nu
+            nu *= 2.0
+            if lam > 1e16:
+                break
+        if not accepted:  # no step lowers the energy: a minimum if the gradient is round-off
+            converged = bool(np.max(np.abs(g)) <= max(tol_grad, 1e-8 * max(E, 1e-300) ** 0.5))
+            break
+        rel = (E - E_new) / max(E, 1e-300)
+        x, r, E = x_new, r_new, E_new
+        if 0 <= rel < tol_rel or \
+                np.linalg.norm(dx) <= tol_step * (np.linalg.norm(x) + tol_step):
+            converged = True
+            break
+    else:
+        it = max_iter
+    return x, converged or E <= tol_energy, it
+
+
+def fit_level_function(surf: BSplineSurface, dirs: NetDirections, family: int, *,
+                       n_ctrl: tuple[int, int] = (12, 12), degree: tuple[int, int] = (3, 3),
+                       omega_f: float = 0.01, max_iter: int = 20,
+                       operators: LevelOperators | None = None) -> LevelFit:
+    """Fit ``xi_f`` minimizing ``E_a + omega_f E_f`` at the samples of ``dirs`` (paper 4.2.2).
+
+    The problem is linear in the control values; one control value (the centre one) is fixed
+    to remove the free constant. Levenberg-Marquardt of :func:`gridshell.solver.solve` on the
+    terms :func:`directional_derivative`, their Jacobian and normal matrix formed once
+    (:func:`_linear_least_squares`). ``operators``:
+    :func:`level_operators` of these ``dirs``, ``n_ctrl`` and ``degree``, to share them
+    between the two families (default: computed here).
+    """
+    if family not in (1, 3):
+        raise InputError(f"family must be 1 or 3, got {family}")
+    if not (np.isfinite(omega_f) and omega_f >= 0):
+        raise InputError(f"term 'density (4.13)': weight must be finite and >= 0, got {omega_f}")
+    nu, nv = (int(k) for k in n_ctrl)
+    deg = tuple(int(d) for d in degree)
+    ops = operators
+    if ops is None:
+        ops = level_operators(surf, dirs, (nu, nv), deg)
+    elif ops.n_ctrl != (nu, nv) or ops.degree != deg or len(ops.ok) != dirs.valid.size:
+        raise InputError(f"the level operators are for {ops.n_ctrl} control values of degree "
+                         f"{ops.degree} at {len(ops.ok)} samples, not {(nu, nv)}, {deg}, "
+                         f"{dirs.valid.size}")
+    Du, Dv = ops.Du, ops.Dv
+    a1, b1, a2, b2 = (c.reshape(-1)[ops.ok] for c in dirs.coefficients(family))
+    k = Du.shape[0]
+    blocks, targets = [_combine(Du, Dv, a1, b1)], [np.zeros(k)]
+    if omega_f > 0:
+        w = float(np.sqrt(omega_f))
+        blocks.append(_combine(Du, Dv, w * a2, w * b2))
+        targets.append(np.full(k, w))
+    J = sp.vstack(blocks, format="csr")
+    fixed = np.zeros(nu * nv, bool)
     fixed[(nu // 2) * nv + nv // 2] = True
-    sol = solve(prob, np.zeros(lay.size), fixed=fixed, method="lm", max_iter=max_iter,
-                damping=1e-9, tol_rel=1e-12)
-    xi = sol.x
-    F = level_function(surf, xi, (nu, nv), tuple(int(d) for d in degree))
+    xi, converged, iterations = _linear_least_squares(
+        J, np.concatenate(targets), np.flatnonzero(~fixed), max_iter=max_iter, damping=1e-9,
+        tol_rel=1e-12)
+    F = level_function(surf, xi, (nu, nv), deg)
     gu, gv = np.asarray(Du @ xi), np.asarray(Dv @ xi)
     d1 = a1 * gu + b1 * gv
     d2 = a2 * gu + b2 * gv
+    report = {"alignment (4.12)": _term_report(1.0, d1)}
+    if omega_f > 0:
+        report["density (4.13)"] = _term_report(float(omega_f), d2 - 1.0)
     with np.errstate(divide="ignore", invalid="ignore"):
         sin_err = d1 / np.hypot(d1, d2)
-    return LevelFit(family, F, bool(sol.converged), sol.iterations, sol.report,
+    return LevelFit(family, F, bool(converged), iterations, report,
                     float(np.sqrt(np.nanmean(sin_err ** 2))), float(np.mean(d2)))
+
+
+def _term_report(weight: float, r: np.ndarray) -> dict[str, float]:
+    """A term's line of the fit's report, as :meth:`gridshell.solver.Problem.report`."""
+    return {"weight": weight, "energy": weight * float(r @ r),
+            "rms": float(np.sqrt(np.mean(r ** 2))) if r.size else 0.0,
+            "max": float(np.max(np.abs(r))) if r.size else 0.0}
 
 
 # ============================================================================ tracing
@@ -492,8 +625,10 @@ def trace(surf: BSplineSurface, dirs: NetDirections, *, curves: int | tuple[int,
           progress: Callable[[str], None] | None = None) -> TracedNet:
     """Fit both level functions on the samples of ``dirs`` and trace the net (paper 4.2.2)."""
     fits = {}
+    ops = level_operators(surf, dirs, n_ctrl, degree)
     for f in (1, 3):
-        fits[f] = fit_level_function(surf, dirs, f, n_ctrl=n_ctrl, degree=degree, omega_f=omega_f)
+        fits[f] = fit_level_function(surf, dirs, f, n_ctrl=n_ctrl, degree=degree,
+                                     omega_f=omega_f, operators=ops)
         if progress is not None:
             progress(f"level function xi_{f}: alignment RMS sin {fits[f].align_rms:.2e}, "
                      f"density {fits[f].density:.3f}")
