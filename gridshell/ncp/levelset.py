@@ -361,6 +361,11 @@ def _clip_uv(uv: np.ndarray, dom: tuple[tuple[float, float], tuple[float, float]
     return np.stack([np.clip(uv[:, 0], u0, u1), np.clip(uv[:, 1], v0, v1)], axis=1)
 
 
+def _split(values: np.ndarray, lengths: list[int]) -> list[np.ndarray]:
+    """``values`` cut into consecutive pieces of ``lengths`` (rows)."""
+    return np.split(values, np.cumsum(lengths)[:-1]) if lengths else []
+
+
 def project_to_level(F: BSplineSurface, uv: np.ndarray, level: np.ndarray,
                      steps: int = 3) -> np.ndarray:
     """Move ``uv (k, 2)`` onto ``xi = level`` along the gradient (Newton, ``steps`` times)."""
@@ -387,14 +392,25 @@ def trace_levels(F: BSplineSurface, levels: np.ndarray, grid: tuple[int, int] = 
     v = np.linspace(v0, v1, int(grid[1]))
     Z = F.evaluate_grid(u, v)[..., 2]
     gen = contourpy.contour_generator(x=v, y=u, z=Z, line_type="Separate")
-    out: list[np.ndarray | None] = []
+    longest: list[np.ndarray | None] = []
     for lev in levels:
         pieces = [p for p in gen.lines(float(lev)) if len(p) >= 2]
-        if not pieces:
+        longest.append(max(pieces, key=lambda p: np.linalg.norm(np.diff(p, axis=0), axis=1).sum())
+                       if pieces else None)
+    # every level's polyline projected in one call (each vertex independently)
+    found = [k for k, P in enumerate(longest) if P is not None]
+    projected: dict[int, np.ndarray] = {}
+    if found:
+        P = np.concatenate([longest[k][:, ::-1] for k in found])
+        lev = np.concatenate([np.full(len(longest[k]), float(levels[k])) for k in found])
+        uvs = _split(project_to_level(F, P, lev), [len(longest[k]) for k in found])
+        projected = dict(zip(found, uvs))
+    out: list[np.ndarray | None] = []
+    for k in range(len(levels)):
+        if k not in projected:
             out.append(None)
             continue
-        P = max(pieces, key=lambda p: np.linalg.norm(np.diff(p, axis=0), axis=1).sum())
-        uv = project_to_level(F, P[:, ::-1], lev)
+        uv = projected[k]
         keep = np.concatenate([[True], np.linalg.norm(np.diff(uv, axis=0), axis=1) > 1e-12])
         uv = uv[keep]
         if len(uv) < 2:
@@ -468,14 +484,14 @@ class TracedNet:
     dropped: list[str] = field(default_factory=list)
 
 
-def _resample_axis(surf: BSplineSurface, F: BSplineSurface, level: float, uv: np.ndarray,
-                   joints_uv: np.ndarray, seg: np.ndarray, frac: np.ndarray,
-                   spacing: float) -> tuple[np.ndarray, np.ndarray]:
-    """Axis ``uv`` with the joints inserted as vertices and every piece between consecutive
-    joints (and the two end pieces) resampled uniformly in 3D arc length ~``spacing``."""
+def _axis_vertices(uv: np.ndarray, P: np.ndarray, joints_uv: np.ndarray, seg: np.ndarray,
+                   frac: np.ndarray, spacing: float) -> tuple[np.ndarray, np.ndarray]:
+    """Axis vertices ``uv (q, 2)`` with the joints inserted and every piece between
+    consecutive joints (and the two end pieces) resampled uniformly in 3D arc length
+    ~``spacing``, before the projection of the non-joint vertices onto the level; and the
+    joints' indices among them. ``P`` are the 3D points of the traced polyline ``uv``."""
     order = np.lexsort((frac, seg))
     seg, frac, joints_uv = seg[order], frac[order], joints_uv[order]
-    P = surf.evaluate(uv[:, 0], uv[:, 1])
     s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(P, axis=0), axis=1))])
     sj = s[seg] + frac * (s[seg + 1] - s[seg])
     # knots: start, joints, end; each piece resampled with uv interpolated in arc length
@@ -492,11 +508,12 @@ def _resample_axis(surf: BSplineSurface, F: BSplineSurface, level: float, uv: np
             jidx.append(count)
         pieces.append(q)
         count += len(q)
-    Q = np.concatenate(pieces)
-    jidx = np.asarray(jidx, np.int64)
-    free = np.ones(len(Q), bool)
-    free[jidx] = False
-    Q[free] = project_to_level(F, Q[free], level)
+    return np.concatenate(pieces), np.asarray(jidx, np.int64)
+
+
+def _axis_kept(Q: np.ndarray, jidx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The projected axis vertices without repeats (the joints kept), and the joints'
+    indices among them."""
     keep = np.concatenate([[True], np.linalg.norm(np.diff(Q, axis=0), axis=1) > 1e-13])
     keep[jidx] = True
     new_index = np.cumsum(keep) - 1
@@ -536,27 +553,41 @@ def trace_net(surf: BSplineSurface, fits: dict[int, LevelFit], *, curves: int | 
                                  max_count=min(grid) // 2)
         polys[f] = trace_levels(fits[f].F, levels[f], grid)
     F1, F3 = fits[1].F, fits[3].F
+    Ffam = {1: F1, 3: F3}
     rng = max(float(np.ptp(levels[1])), float(np.ptp(levels[3])), 1.0)
-    # joints: crossings of xi_3 levels along the traced curves of family 1
+    # the traced curves of each family: xi of the other family along them and their 3D points,
+    # each evaluated in one call for all curves (every vertex independently)
+    live = {f: [a for a, uv in enumerate(polys[f]) if uv is not None] for f in (1, 3)}
+    cross: dict[int, dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]]] = {1: {}, 3: {}}
+    pts: dict[int, dict[int, np.ndarray]] = {1: {}, 3: {}}
+    for f, other in ((1, 3), (3, 1)):
+        if not live[f]:
+            continue
+        lens = [len(polys[f][a]) for a in live[f]]
+        UV = np.concatenate([polys[f][a] for a in live[f]])
+        xi_o = _split(evaluate_xi(Ffam[other], UV[:, 0], UV[:, 1]), lens)
+        cross[f] = {a: _crossings(z, levels[other]) for a, z in zip(live[f], xi_o)}
+        pts[f] = dict(zip(live[f], _split(surf.evaluate(UV[:, 0], UV[:, 1]), lens)))
+    # joints: crossings of xi_3 levels along the traced curves of family 1, refined together
     found: dict[tuple[int, int], np.ndarray] = {}
-    for i, uv in enumerate(polys[1]):
-        if uv is None:
-            continue
-        lev, seg, t = _crossings(evaluate_xi(F3, uv[:, 0], uv[:, 1]), levels[3])
-        if len(lev) == 0:
-            continue
-        guess = uv[seg] + t[:, None] * (uv[seg + 1] - uv[seg])
-        sol, res = _newton_joints(F1, F3, guess, np.full(len(lev), levels[1][i]), levels[3][lev])
-        for j, p, r in zip(lev.tolist(), sol, res.tolist()):
+    gi, gj, guess = [], [], []
+    for i in live[1]:
+        lev, seg, t = cross[1][i]
+        uv = polys[1][i]
+        gi.append(np.full(len(lev), i))
+        gj.append(lev)
+        guess.append(uv[seg] + t[:, None] * (uv[seg + 1] - uv[seg]))
+    if gi and sum(len(g) for g in gi):
+        ii, jj = np.concatenate(gi), np.concatenate(gj)
+        sol, res = _newton_joints(F1, F3, np.concatenate(guess), levels[1][ii], levels[3][jj])
+        for i, j, p, r in zip(ii.tolist(), jj.tolist(), sol, res.tolist()):
             if r <= tol * rng:
                 found[(i, j)] = p
     # positions along the traced curves of both families (segment, fraction) per joint
     where: dict[int, dict[tuple[int, int], tuple[int, float]]] = {1: {}, 3: {}}
-    for f, other, Fo in ((1, 3, F3), (3, 1, F1)):
-        for a, uv in enumerate(polys[f]):
-            if uv is None:
-                continue
-            lev, seg, t = _crossings(evaluate_xi(Fo, uv[:, 0], uv[:, 1]), levels[other])
+    for f in (1, 3):
+        for a in live[f]:
+            lev, seg, t = cross[f][a]
             for b, sg, tt in zip(lev.tolist(), seg.tolist(), t.tolist()):
                 key = (a, b) if f == 1 else (b, a)
                 if key in found:
@@ -572,17 +603,13 @@ def trace_net(surf: BSplineSurface, fits: dict[int, LevelFit], *, curves: int | 
     # lamellae
     longest = 0.0
     for f in (1, 3):
-        for uv in polys[f]:
-            if uv is not None:
-                Q = surf.evaluate(uv[:, 0], uv[:, 1])
-                longest = max(longest, float(np.linalg.norm(np.diff(Q, axis=0), axis=1).sum()))
+        for Q in pts[f].values():
+            longest = max(longest, float(np.linalg.norm(np.diff(Q, axis=0), axis=1).sum()))
     h = longest / max(int(axis_points), 10)
     lamellae, axis_uv, axis_jidx, dropped = [], [], [], []
-    Ffam = {1: F1, 3: F3}
     for f in (1, 3):
-        for a, uv in enumerate(polys[f]):
-            if uv is None:
-                continue
+        todo = []
+        for a in live[f]:
             mine = [k for k in keys if (k[0] if f == 1 else k[1]) == a]
             if len(mine) < 2:
                 dropped.append(f"family {f} curve {a} (xi = {levels[f][a]:.4g}) has "
@@ -593,8 +620,24 @@ def trace_net(surf: BSplineSurface, fits: dict[int, LevelFit], *, curves: int | 
             juv = np.array([found[k] for k in mine])
             order = np.lexsort((frac, seg))
             mine = [mine[o] for o in order]
-            Q, jidx = _resample_axis(surf, Ffam[f], levels[f][a], uv, juv, seg, frac, h)
-            X = surf.evaluate(Q[:, 0], Q[:, 1])
+            Q, jidx = _axis_vertices(polys[f][a], pts[f][a], juv, seg, frac, h)
+            free = np.ones(len(Q), bool)
+            free[jidx] = False
+            todo.append((a, mine, Q, jidx, free))
+        if not todo:
+            continue
+        # the axes' vertices between the joints projected onto their levels in one call
+        lev = np.concatenate([np.full(int(fr.sum()), levels[f][a]) for a, _, _, _, fr in todo])
+        moved = project_to_level(Ffam[f], np.concatenate([Q[fr] for _, _, Q, _, fr in todo]),
+                                 lev)
+        axes = []
+        for (a, mine, Q, jidx, fr), q in zip(todo, _split(moved, [int(t[4].sum())
+                                                                   for t in todo])):
+            Q[fr] = q
+            axes.append((mine, *_axis_kept(Q, jidx)))
+        QQ = np.concatenate([Q for _, Q, _ in axes])
+        Xs = _split(surf.evaluate(QQ[:, 0], QQ[:, 1]), [len(Q) for _, Q, _ in axes])
+        for (mine, Q, jidx), X in zip(axes, Xs):
             s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(X, axis=0), axis=1))])
             lamellae.append(Lamella(id=len(lamellae), family=f,
                                     joints=[index[k] for k in mine], joint_s=s[jidx], axis=X))
