@@ -258,9 +258,10 @@ def fit_level_function(surf: BSplineSurface, dirs: NetDirections, family: int, *
     The problem is linear in the control values; one control value (the centre one) is fixed
     to remove the free constant. Levenberg-Marquardt of :func:`gridshell.solver.solve` on the
     terms :func:`directional_derivative`, their Jacobian and normal matrix formed once
-    (:func:`_linear_least_squares`). ``operators``:
-    :func:`level_operators` of these ``dirs``, ``n_ctrl`` and ``degree``, to share them
-    between the two families (default: computed here).
+    (:func:`_linear_least_squares`). ``operators``: :func:`level_operators` of these
+    ``dirs``, ``n_ctrl`` and ``degree``, to share them between the two families (default:
+    computed here). Raises :class:`InputError` for a family other than 1 or 3, a negative or
+    non-finite ``omega_f``, or ``operators`` of other samples or control values.
     """
     if family not in (1, 3):
         raise InputError(f"family must be 1 or 3, got {family}")
