@@ -20,15 +20,18 @@ from typing import Callable, NamedTuple
 import numpy as np
 import scipy.sparse as sp
 
-from ..bspline import BSplineSurface, open_uniform_knots
+from ..bspline import BSplineSurface, _local_basis, _params, open_uniform_knots
 from ..errors import InputError, NoNetError
 from ..net import Lamella, Net
-from ..solver import Layout, Problem, TermResult, result, solve, term
+from ..solver import Layout, TermResult, result, term
+from ..solver.linear import NotPositiveDefinite, shared_solver
+from ..solver.threads import one_blas_thread
 from .directions import NetDirections
 
 __all__ = ["LEVELSET_DEFAULTS", "DirectionalDerivative", "directional_derivative", "LevelFit",
-           "level_function", "fit_level_function", "level_values", "project_to_level",
-           "trace_levels", "TracedNet", "trace_net", "trace", "evaluate_xi"]
+           "LevelOperators", "level_function", "level_operators", "fit_level_function",
+           "level_values", "project_to_level", "trace_levels", "TracedNet", "trace_net", "trace",
+           "evaluate_xi"]
 
 #: paper 4.2.2: bi-degree 3, 12 x 12 control points, 48 x 48 samples. omega_f: the paper sets
 #: 0.1; measured on the pseudosphere patch (10 curves) 0.1 leaves the level sets 0.44 degrees
@@ -59,11 +62,36 @@ def level_function(surf: BSplineSurface, xi_ctrl: np.ndarray, n_ctrl: tuple[int,
     return BSplineSurface(du, dv, ku, kv, ctrl)
 
 
+def _patches(F: BSplineSurface, u: np.ndarray, v: np.ndarray, du: int, dv: int
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Local data of ``xi`` at paired parameters ``(k,)``: the ``xi`` control values of each
+    parameter's span ``(k, d_u + 1, d_v + 1)``, the non-zero ``u`` basis values (or ``du``-th
+    derivatives) ``(k, d_u + 1)``, those in ``v``, and the checked, clipped ``u, v``."""
+    u = np.atleast_1d(np.asarray(u, dtype=float))
+    v = np.atleast_1d(np.asarray(v, dtype=float))
+    if u.shape != v.shape or u.ndim != 1:
+        raise InputError(f"xi needs paired 1-D u and v of equal length, got shapes {u.shape} "
+                         f"and {v.shape}")
+    for name, d in (("du", du), ("dv", dv)):
+        if int(d) != d or d < 0:
+            raise InputError(f"{name} must be a non-negative integer, got {d!r}")
+    u = _params(u, F.knots_u, F.degree_u, "u")
+    v = _params(v, F.knots_v, F.degree_v, "v")
+    fu, bu = _local_basis(F.knots_u, F.degree_u, u, int(du))
+    fv, bv = _local_basis(F.knots_v, F.degree_v, v, int(dv))
+    iu = fu[:, None, None] + np.arange(bu.shape[1])[None, :, None]
+    iv = fv[:, None, None] + np.arange(bv.shape[1])[None, None, :]
+    return F.ctrl[..., 2][iu, iv], bu, bv, u, v
+
+
 def evaluate_xi(F: BSplineSurface, u: np.ndarray, v: np.ndarray, du: int = 0,
                 dv: int = 0) -> np.ndarray:
-    """``xi`` (or a derivative) at paired parameters ``(k,)``."""
-    A = F.operator(u, v, du, dv)
-    return np.asarray(A @ F.ctrl[..., 2].reshape(-1))
+    """``xi`` (or a derivative, per parameter^(du+dv)) at paired parameters ``(k,)``.
+
+    The same sums as ``F.operator(u, v, du, dv) @ xi`` (eq. 4.1), over each parameter's
+    ``(d_u + 1) x (d_v + 1)`` non-zero basis products only, without building the operator."""
+    C, bu, bv, _, _ = _patches(F, u, v, du, dv)
+    return np.einsum("ka,ka->k", bu, np.einsum("kab,kb->ka", C, bv))
 
 
 # ============================================================================ terms (4.12, 4.13)
@@ -109,46 +137,177 @@ class LevelFit:
     density: float
 
 
-def fit_level_function(surf: BSplineSurface, dirs: NetDirections, family: int, *,
-                       n_ctrl: tuple[int, int] = (12, 12), degree: tuple[int, int] = (3, 3),
-                       omega_f: float = 0.01, max_iter: int = 20) -> LevelFit:
-    """Fit ``xi_f`` minimizing ``E_a + omega_f E_f`` at the samples of ``dirs`` (paper 4.2.2).
+class LevelOperators(NamedTuple):
+    """The sample operators of a level-function fit, shared by both families: ``F0`` (the
+    level function with ``xi = 0``), ``Du, Dv (k, nu * nv)`` mapping its control values to
+    ``xi_u, xi_v`` at the ``k`` samples ``ok`` of ``dirs`` (``valid`` flattened), for
+    ``n_ctrl`` control values of ``degree``."""
 
-    The problem is linear in the control values; one control value (the centre one) is fixed
-    to remove the free constant. Levenberg-Marquardt of :mod:`gridshell.solver`.
-    """
-    if family not in (1, 3):
-        raise InputError(f"family must be 1 or 3, got {family}")
+    F0: BSplineSurface
+    Du: sp.csr_matrix
+    Dv: sp.csr_matrix
+    ok: np.ndarray
+    n_ctrl: tuple[int, int]
+    degree: tuple[int, int]
+
+
+def level_operators(surf: BSplineSurface, dirs: NetDirections, n_ctrl: tuple[int, int] = (12, 12),
+                    degree: tuple[int, int] = (3, 3)) -> LevelOperators:
+    """:class:`LevelOperators` of the samples of ``dirs`` (one evaluation for both families)."""
     nu, nv = (int(k) for k in n_ctrl)
-    for k, d in zip((nu, nv), degree):
-        open_uniform_knots(k, int(d))  # checks the counts before anything is allocated
-    F0 = level_function(surf, np.zeros(nu * nv), (nu, nv), tuple(int(d) for d in degree))
+    deg = tuple(int(d) for d in degree)
+    for k, d in zip((nu, nv), deg):
+        open_uniform_knots(k, d)  # checks the counts before anything is allocated
+    F0 = level_function(surf, np.zeros(nu * nv), (nu, nv), deg)
     uu, vv = np.meshgrid(dirs.u, dirs.v, indexing="ij")
     ok = dirs.valid.reshape(-1)
     uu, vv = uu.reshape(-1)[ok], vv.reshape(-1)[ok]
-    Du = F0.operator(uu, vv, 1, 0)
-    Dv = F0.operator(uu, vv, 0, 1)
-    a1, b1, a2, b2 = (c.reshape(-1)[ok] for c in dirs.coefficients(family))
-    k = len(uu)
-    lay = Layout({"xi": nu * nv})
-    prob = Problem(lay)
-    prob.add("alignment (4.12)", 1.0, directional_derivative,
-             DirectionalDerivative(Du, Dv, a1, b1, np.zeros(k)))
-    prob.add("density (4.13)", omega_f, directional_derivative,
-             DirectionalDerivative(Du, Dv, a2, b2, np.ones(k)))
-    fixed = np.zeros(lay.size, bool)
+    return LevelOperators(F0, F0.operator(uu, vv, 1, 0), F0.operator(uu, vv, 0, 1), ok,
+                          (nu, nv), deg)
+
+
+def _combine(Du: sp.csr_matrix, Dv: sp.csr_matrix, a: np.ndarray, b: np.ndarray
+             ) -> sp.csr_matrix:
+    """``diag(a) Du + diag(b) Dv`` (explicit zeros kept); one pass over the values when
+    ``Du`` and ``Dv`` share their pattern (as the operators of one set of samples do)."""
+    if np.array_equal(Du.indptr, Dv.indptr) and np.array_equal(Du.indices, Dv.indices):
+        rows = np.repeat(np.arange(Du.shape[0]), np.diff(Du.indptr))
+        return sp.csr_matrix((a[rows] * Du.data + b[rows] * Dv.data, Du.indices, Du.indptr),
+                             shape=Du.shape)
+    return (sp.diags(a) @ Du + sp.diags(b) @ Dv).tocsr()
+
+
+@one_blas_thread
+def _linear_least_squares(J: sp.csr_matrix, t: np.ndarray, free: np.ndarray, *, max_iter: int,
+                          damping: float, tol_rel: float, tol_energy: float = 1e-20,
+                          tol_step: float = 1e-12, tol_grad: float = 1e-14
+                          ) -> tuple[np.ndarray, bool, int]:
+    """Minimize ``|J x - t|^2`` over ``x[free]`` from ``x = 0`` (the other entries stay 0):
+    ``(x, converged, iterations)``.
+
+    The Levenberg-Marquardt iteration of :func:`gridshell.solver.solve` (method ``"lm"``,
+    the same steps, gain ratio, damping updates, rejections and stopping rules, ``damping``
+    relative to the mean diagonal of ``J^T J``) for a linear residual: its Jacobian ``J`` and
+    normal matrix ``J^T J`` do not change, so they are formed once here, where ``solve``
+    assembles both again at every iteration and trial step; each trial damping is factored
+    (:func:`~gridshell.solver.linear.shared_solver`, the analysis shared)."""
+    n = J.shape[1]
+    JT = J.T.tocsr()
+    N = (JT @ J).tocsr()[free][:, free].tocsc()
+    N.sort_indices()
+    diag = N.diagonal()
+    scale = float(np.mean(diag)) if diag.size and np.mean(diag) > 0 else 1.0
+    lin = shared_solver()
+    x = np.zeros(n)
+    r = -np.asarray(t, float)           # J x - t
+    E = float(r @ r)
+    lam, nu = damping, 2.0
+    converged, it = False, 0
+    for it in range(1, max_iter + 1):
+        if E <= tol_energy:
+            converged, it = True, it - 1
+            break
+        g = (JT @ r)[free]
+        if np.max(np.abs(g), initial=0.0) <= tol_grad:
+            converged, it = True, it - 1
+            break
+        accepted = False
+        while True:
+            try:
+                dx = -lin.factor(N + sp.diags(np.full(len(free), lam * scale), format="csc"))(g)
+            except NotPositiveDefinite:  # singular: raise the damping
+                lam *= 10.0
+                if lam > 1e16:
+                    break
+                continue
+            x_new = x.copy()
+            x_new[free] += dx
+            r_new = J @ x_new - t
+            E_new = float(r_new @ r_new)
+            pred = -(2 * g @ dx + dx @ (N @ dx))
+            rho = (E - E_new) / pred if pred > 0 else -1.0
+            if np.isfinite(E_new) and E_new < E:
+                accepted = True
+                lam *= max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0) ** 3) if rho > 0 else 1.0
+                nu = 2.0
+                break
+            lam *= nu
+            nu *= 2.0
+            if lam > 1e16:
+                break
+        if not accepted:  # no step lowers the energy: a minimum if the gradient is round-off
+            converged = bool(np.max(np.abs(g)) <= max(tol_grad, 1e-8 * max(E, 1e-300) ** 0.5))
+            break
+        rel = (E - E_new) / max(E, 1e-300)
+        x, r, E = x_new, r_new, E_new
+        if 0 <= rel < tol_rel or \
+                np.linalg.norm(dx) <= tol_step * (np.linalg.norm(x) + tol_step):
+            converged = True
+            break
+    else:
+        it = max_iter
+    return x, converged or E <= tol_energy, it
+
+
+def fit_level_function(surf: BSplineSurface, dirs: NetDirections, family: int, *,
+                       n_ctrl: tuple[int, int] = (12, 12), degree: tuple[int, int] = (3, 3),
+                       omega_f: float = 0.01, max_iter: int = 20,
+                       operators: LevelOperators | None = None) -> LevelFit:
+    """Fit ``xi_f`` minimizing ``E_a + omega_f E_f`` at the samples of ``dirs`` (paper 4.2.2).
+
+    The problem is linear in the control values; one control value (the centre one) is fixed
+    to remove the free constant. Levenberg-Marquardt of :func:`gridshell.solver.solve` on the
+    terms :func:`directional_derivative`, their Jacobian and normal matrix formed once
+    (:func:`_linear_least_squares`). ``operators``: :func:`level_operators` of these
+    ``dirs``, ``n_ctrl`` and ``degree``, to share them between the two families (default:
+    computed here). Raises :class:`InputError` for a family other than 1 or 3, a negative or
+    non-finite ``omega_f``, or ``operators`` of other samples or control values.
+    """
+    if family not in (1, 3):
+        raise InputError(f"family must be 1 or 3, got {family}")
+    if not (np.isfinite(omega_f) and omega_f >= 0):
+        raise InputError(f"term 'density (4.13)': weight must be finite and >= 0, got {omega_f}")
+    nu, nv = (int(k) for k in n_ctrl)
+    deg = tuple(int(d) for d in degree)
+    ops = operators
+    if ops is None:
+        ops = level_operators(surf, dirs, (nu, nv), deg)
+    elif ops.n_ctrl != (nu, nv) or ops.degree != deg or len(ops.ok) != dirs.valid.size:
+        raise InputError(f"the level operators are for {ops.n_ctrl} control values of degree "
+                         f"{ops.degree} at {len(ops.ok)} samples, not {(nu, nv)}, {deg}, "
+                         f"{dirs.valid.size}")
+    Du, Dv = ops.Du, ops.Dv
+    a1, b1, a2, b2 = (c.reshape(-1)[ops.ok] for c in dirs.coefficients(family))
+    k = Du.shape[0]
+    blocks, targets = [_combine(Du, Dv, a1, b1)], [np.zeros(k)]
+    if omega_f > 0:
+        w = float(np.sqrt(omega_f))
+        blocks.append(_combine(Du, Dv, w * a2, w * b2))
+        targets.append(np.full(k, w))
+    J = sp.vstack(blocks, format="csr")
+    fixed = np.zeros(nu * nv, bool)
     fixed[(nu // 2) * nv + nv // 2] = True
-    sol = solve(prob, np.zeros(lay.size), fixed=fixed, method="lm", max_iter=max_iter,
-                damping=1e-9, tol_rel=1e-12)
-    xi = sol.x
-    F = level_function(surf, xi, (nu, nv), tuple(int(d) for d in degree))
+    xi, converged, iterations = _linear_least_squares(
+        J, np.concatenate(targets), np.flatnonzero(~fixed), max_iter=max_iter, damping=1e-9,
+        tol_rel=1e-12)
+    F = level_function(surf, xi, (nu, nv), deg)
     gu, gv = np.asarray(Du @ xi), np.asarray(Dv @ xi)
     d1 = a1 * gu + b1 * gv
     d2 = a2 * gu + b2 * gv
+    report = {"alignment (4.12)": _term_report(1.0, d1)}
+    if omega_f > 0:
+        report["density (4.13)"] = _term_report(float(omega_f), d2 - 1.0)
     with np.errstate(divide="ignore", invalid="ignore"):
         sin_err = d1 / np.hypot(d1, d2)
-    return LevelFit(family, F, bool(sol.converged), sol.iterations, sol.report,
+    return LevelFit(family, F, bool(converged), iterations, report,
                     float(np.sqrt(np.nanmean(sin_err ** 2))), float(np.mean(d2)))
+
+
+def _term_report(weight: float, r: np.ndarray) -> dict[str, float]:
+    """A term's line of the fit's report, as :meth:`gridshell.solver.Problem.report`."""
+    return {"weight": weight, "energy": weight * float(r @ r),
+            "rms": float(np.sqrt(np.mean(r ** 2))) if r.size else 0.0,
+            "max": float(np.max(np.abs(r))) if r.size else 0.0}
 
 
 # ============================================================================ tracing
@@ -186,15 +345,26 @@ def _check_count(count: int, max_count: int | None, spacing: float | None = None
 
 
 def _grad_xi(F: BSplineSurface, uv: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    z = evaluate_xi(F, uv[:, 0], uv[:, 1])
-    g = np.stack([evaluate_xi(F, uv[:, 0], uv[:, 1], 1, 0),
-                  evaluate_xi(F, uv[:, 0], uv[:, 1], 0, 1)], axis=1)
+    """``xi (k,)`` and its gradient ``(xi_u, xi_v) (k, 2)`` at ``uv (k, 2)``: one basis
+    evaluation per direction and order, shared by the value and the two derivatives."""
+    C, bu, bv, u, v = _patches(F, uv[:, 0], uv[:, 1], 0, 0)
+    _, du = _local_basis(F.knots_u, F.degree_u, u, 1)
+    _, dv = _local_basis(F.knots_v, F.degree_v, v, 1)
+    Cv = np.einsum("kab,kb->ka", C, bv)
+    z = np.einsum("ka,ka->k", bu, Cv)
+    g = np.stack([np.einsum("ka,ka->k", du, Cv),
+                  np.einsum("kb,kb->k", dv, np.einsum("ka,kab->kb", bu, C))], axis=1)
     return z, g
 
 
 def _clip_uv(uv: np.ndarray, dom: tuple[tuple[float, float], tuple[float, float]]) -> np.ndarray:
     (u0, u1), (v0, v1) = dom
     return np.stack([np.clip(uv[:, 0], u0, u1), np.clip(uv[:, 1], v0, v1)], axis=1)
+
+
+def _split(values: np.ndarray, lengths: list[int]) -> list[np.ndarray]:
+    """``values`` cut into consecutive pieces of ``lengths`` (rows)."""
+    return np.split(values, np.cumsum(lengths)[:-1]) if lengths else []
 
 
 def project_to_level(F: BSplineSurface, uv: np.ndarray, level: np.ndarray,
@@ -223,14 +393,25 @@ def trace_levels(F: BSplineSurface, levels: np.ndarray, grid: tuple[int, int] = 
     v = np.linspace(v0, v1, int(grid[1]))
     Z = F.evaluate_grid(u, v)[..., 2]
     gen = contourpy.contour_generator(x=v, y=u, z=Z, line_type="Separate")
-    out: list[np.ndarray | None] = []
+    longest: list[np.ndarray | None] = []
     for lev in levels:
         pieces = [p for p in gen.lines(float(lev)) if len(p) >= 2]
-        if not pieces:
+        longest.append(max(pieces, key=lambda p: np.linalg.norm(np.diff(p, axis=0), axis=1).sum())
+                       if pieces else None)
+    # every level's polyline projected in one call (each vertex independently)
+    found = [k for k, P in enumerate(longest) if P is not None]
+    projected: dict[int, np.ndarray] = {}
+    if found:
+        P = np.concatenate([longest[k][:, ::-1] for k in found])
+        lev = np.concatenate([np.full(len(longest[k]), float(levels[k])) for k in found])
+        uvs = _split(project_to_level(F, P, lev), [len(longest[k]) for k in found])
+        projected = dict(zip(found, uvs))
+    out: list[np.ndarray | None] = []
+    for k in range(len(levels)):
+        if k not in projected:
             out.append(None)
             continue
-        P = max(pieces, key=lambda p: np.linalg.norm(np.diff(p, axis=0), axis=1).sum())
-        uv = project_to_level(F, P[:, ::-1], lev)
+        uv = projected[k]
         keep = np.concatenate([[True], np.linalg.norm(np.diff(uv, axis=0), axis=1) > 1e-12])
         uv = uv[keep]
         if len(uv) < 2:
@@ -304,14 +485,14 @@ class TracedNet:
     dropped: list[str] = field(default_factory=list)
 
 
-def _resample_axis(surf: BSplineSurface, F: BSplineSurface, level: float, uv: np.ndarray,
-                   joints_uv: np.ndarray, seg: np.ndarray, frac: np.ndarray,
-                   spacing: float) -> tuple[np.ndarray, np.ndarray]:
-    """Axis ``uv`` with the joints inserted as vertices and every piece between consecutive
-    joints (and the two end pieces) resampled uniformly in 3D arc length ~``spacing``."""
+def _axis_vertices(uv: np.ndarray, P: np.ndarray, joints_uv: np.ndarray, seg: np.ndarray,
+                   frac: np.ndarray, spacing: float) -> tuple[np.ndarray, np.ndarray]:
+    """Axis vertices ``uv (q, 2)`` with the joints inserted and every piece between
+    consecutive joints (and the two end pieces) resampled uniformly in 3D arc length
+    ~``spacing``, before the projection of the non-joint vertices onto the level; and the
+    joints' indices among them. ``P`` are the 3D points of the traced polyline ``uv``."""
     order = np.lexsort((frac, seg))
     seg, frac, joints_uv = seg[order], frac[order], joints_uv[order]
-    P = surf.evaluate(uv[:, 0], uv[:, 1])
     s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(P, axis=0), axis=1))])
     sj = s[seg] + frac * (s[seg + 1] - s[seg])
     # knots: start, joints, end; each piece resampled with uv interpolated in arc length
@@ -328,11 +509,12 @@ def _resample_axis(surf: BSplineSurface, F: BSplineSurface, level: float, uv: np
             jidx.append(count)
         pieces.append(q)
         count += len(q)
-    Q = np.concatenate(pieces)
-    jidx = np.asarray(jidx, np.int64)
-    free = np.ones(len(Q), bool)
-    free[jidx] = False
-    Q[free] = project_to_level(F, Q[free], level)
+    return np.concatenate(pieces), np.asarray(jidx, np.int64)
+
+
+def _axis_kept(Q: np.ndarray, jidx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The projected axis vertices without repeats (the joints kept), and the joints'
+    indices among them."""
     keep = np.concatenate([[True], np.linalg.norm(np.diff(Q, axis=0), axis=1) > 1e-13])
     keep[jidx] = True
     new_index = np.cumsum(keep) - 1
@@ -372,27 +554,41 @@ def trace_net(surf: BSplineSurface, fits: dict[int, LevelFit], *, curves: int | 
                                  max_count=min(grid) // 2)
         polys[f] = trace_levels(fits[f].F, levels[f], grid)
     F1, F3 = fits[1].F, fits[3].F
+    Ffam = {1: F1, 3: F3}
     rng = max(float(np.ptp(levels[1])), float(np.ptp(levels[3])), 1.0)
-    # joints: crossings of xi_3 levels along the traced curves of family 1
+    # the traced curves of each family: xi of the other family along them and their 3D points,
+    # each evaluated in one call for all curves (every vertex independently)
+    live = {f: [a for a, uv in enumerate(polys[f]) if uv is not None] for f in (1, 3)}
+    cross: dict[int, dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]]] = {1: {}, 3: {}}
+    pts: dict[int, dict[int, np.ndarray]] = {1: {}, 3: {}}
+    for f, other in ((1, 3), (3, 1)):
+        if not live[f]:
+            continue
+        lens = [len(polys[f][a]) for a in live[f]]
+        UV = np.concatenate([polys[f][a] for a in live[f]])
+        xi_o = _split(evaluate_xi(Ffam[other], UV[:, 0], UV[:, 1]), lens)
+        cross[f] = {a: _crossings(z, levels[other]) for a, z in zip(live[f], xi_o)}
+        pts[f] = dict(zip(live[f], _split(surf.evaluate(UV[:, 0], UV[:, 1]), lens)))
+    # joints: crossings of xi_3 levels along the traced curves of family 1, refined together
     found: dict[tuple[int, int], np.ndarray] = {}
-    for i, uv in enumerate(polys[1]):
-        if uv is None:
-            continue
-        lev, seg, t = _crossings(evaluate_xi(F3, uv[:, 0], uv[:, 1]), levels[3])
-        if len(lev) == 0:
-            continue
-        guess = uv[seg] + t[:, None] * (uv[seg + 1] - uv[seg])
-        sol, res = _newton_joints(F1, F3, guess, np.full(len(lev), levels[1][i]), levels[3][lev])
-        for j, p, r in zip(lev.tolist(), sol, res.tolist()):
+    gi, gj, guess = [], [], []
+    for i in live[1]:
+        lev, seg, t = cross[1][i]
+        uv = polys[1][i]
+        gi.append(np.full(len(lev), i))
+        gj.append(lev)
+        guess.append(uv[seg] + t[:, None] * (uv[seg + 1] - uv[seg]))
+    if gi and sum(len(g) for g in gi):
+        ii, jj = np.concatenate(gi), np.concatenate(gj)
+        sol, res = _newton_joints(F1, F3, np.concatenate(guess), levels[1][ii], levels[3][jj])
+        for i, j, p, r in zip(ii.tolist(), jj.tolist(), sol, res.tolist()):
             if r <= tol * rng:
                 found[(i, j)] = p
     # positions along the traced curves of both families (segment, fraction) per joint
     where: dict[int, dict[tuple[int, int], tuple[int, float]]] = {1: {}, 3: {}}
-    for f, other, Fo in ((1, 3, F3), (3, 1, F1)):
-        for a, uv in enumerate(polys[f]):
-            if uv is None:
-                continue
-            lev, seg, t = _crossings(evaluate_xi(Fo, uv[:, 0], uv[:, 1]), levels[other])
+    for f in (1, 3):
+        for a in live[f]:
+            lev, seg, t = cross[f][a]
             for b, sg, tt in zip(lev.tolist(), seg.tolist(), t.tolist()):
                 key = (a, b) if f == 1 else (b, a)
                 if key in found:
@@ -408,17 +604,13 @@ def trace_net(surf: BSplineSurface, fits: dict[int, LevelFit], *, curves: int | 
     # lamellae
     longest = 0.0
     for f in (1, 3):
-        for uv in polys[f]:
-            if uv is not None:
-                Q = surf.evaluate(uv[:, 0], uv[:, 1])
-                longest = max(longest, float(np.linalg.norm(np.diff(Q, axis=0), axis=1).sum()))
+        for Q in pts[f].values():
+            longest = max(longest, float(np.linalg.norm(np.diff(Q, axis=0), axis=1).sum()))
     h = longest / max(int(axis_points), 10)
     lamellae, axis_uv, axis_jidx, dropped = [], [], [], []
-    Ffam = {1: F1, 3: F3}
     for f in (1, 3):
-        for a, uv in enumerate(polys[f]):
-            if uv is None:
-                continue
+        todo = []
+        for a in live[f]:
             mine = [k for k in keys if (k[0] if f == 1 else k[1]) == a]
             if len(mine) < 2:
                 dropped.append(f"family {f} curve {a} (xi = {levels[f][a]:.4g}) has "
@@ -429,8 +621,24 @@ def trace_net(surf: BSplineSurface, fits: dict[int, LevelFit], *, curves: int | 
             juv = np.array([found[k] for k in mine])
             order = np.lexsort((frac, seg))
             mine = [mine[o] for o in order]
-            Q, jidx = _resample_axis(surf, Ffam[f], levels[f][a], uv, juv, seg, frac, h)
-            X = surf.evaluate(Q[:, 0], Q[:, 1])
+            Q, jidx = _axis_vertices(polys[f][a], pts[f][a], juv, seg, frac, h)
+            free = np.ones(len(Q), bool)
+            free[jidx] = False
+            todo.append((a, mine, Q, jidx, free))
+        if not todo:
+            continue
+        # the axes' vertices between the joints projected onto their levels in one call
+        lev = np.concatenate([np.full(int(fr.sum()), levels[f][a]) for a, _, _, _, fr in todo])
+        moved = project_to_level(Ffam[f], np.concatenate([Q[fr] for _, _, Q, _, fr in todo]),
+                                 lev)
+        axes = []
+        for (a, mine, Q, jidx, fr), q in zip(todo, _split(moved, [int(t[4].sum())
+                                                                   for t in todo])):
+            Q[fr] = q
+            axes.append((mine, *_axis_kept(Q, jidx)))
+        QQ = np.concatenate([Q for _, Q, _ in axes])
+        Xs = _split(surf.evaluate(QQ[:, 0], QQ[:, 1]), [len(Q) for _, Q, _ in axes])
+        for (mine, Q, jidx), X in zip(axes, Xs):
             s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(X, axis=0), axis=1))])
             lamellae.append(Lamella(id=len(lamellae), family=f,
                                     joints=[index[k] for k in mine], joint_s=s[jidx], axis=X))
@@ -461,8 +669,10 @@ def trace(surf: BSplineSurface, dirs: NetDirections, *, curves: int | tuple[int,
           progress: Callable[[str], None] | None = None) -> TracedNet:
     """Fit both level functions on the samples of ``dirs`` and trace the net (paper 4.2.2)."""
     fits = {}
+    ops = level_operators(surf, dirs, n_ctrl, degree)
     for f in (1, 3):
-        fits[f] = fit_level_function(surf, dirs, f, n_ctrl=n_ctrl, degree=degree, omega_f=omega_f)
+        fits[f] = fit_level_function(surf, dirs, f, n_ctrl=n_ctrl, degree=degree,
+                                     omega_f=omega_f, operators=ops)
         if progress is not None:
             progress(f"level function xi_{f}: alignment RMS sin {fits[f].align_rms:.2e}, "
                      f"density {fits[f].density:.3f}")
