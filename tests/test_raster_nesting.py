@@ -94,3 +94,50 @@ def test_rotation_option_is_checked():
     assert FabParams(rotation="grain").rotation == "grain"
     with pytest.raises(InputError, match="--rotation"):
         FabParams(rotation="diagonal")
+
+
+def test_depth_of_a_mask_inside_another_is_not_larger():
+    """depth: a disc of radius r is about r deep; a mask translated inside another is at most as
+    deep (the rule that lets a sheet skip rotations without an FFT)."""
+    from fabrication.raster import depth
+
+    yy, xx = np.mgrid[0:120, 0:160]
+    disc = (xx - 60) ** 2 + (yy - 50) ** 2 <= 20 ** 2
+    assert abs(depth(disc) - 21) <= 1.0 and depth(np.zeros((5, 5), bool)) == 0.0
+    rng = np.random.default_rng(7)
+    for _ in range(20):
+        big = fill(np.asarray(_parts(rng, 1)[0].exterior.coords)
+                   - np.asarray(_parts(rng, 1)[0].centroid.coords) + (80, 60), 160, 120, 1.0)
+        big |= rng.random(big.shape) < 0.3
+        small = big & (rng.random(big.shape) < 0.7)         # a subset, then translated
+        small = np.roll(small, (3, -5), axis=(0, 1))
+        assert depth(small) <= depth(np.roll(big, (3, -5), axis=(0, 1))) + 1e-12
+
+
+def test_depth_pruning_keeps_the_layout_and_skips_products(monkeypatch):
+    """The same sheets and motions with and without the depth rule; with it, a full sheet whose
+    free band is thinner than a bar costs the bar no FFT product."""
+    import scipy.fft
+
+    import fabrication.raster as raster
+
+    rng = np.random.default_rng(11)
+    bars = [shapely.affinity.rotate(shapely.box(0, 0, rng.uniform(200, 280), 40),
+                                    rng.uniform(0, 360)) for _ in range(8)]
+    polys = [shapely.box(0, 0, 290, 170)] + bars + _parts(rng, 6)
+    order = sorted(range(len(polys)), key=lambda i: -polys[i].area)
+    calls = {"n": 0}
+    irfft2 = scipy.fft.irfft2
+
+    def counted(*a, **k):
+        calls["n"] += 1
+        return irfft2(*a, **k)
+    monkeypatch.setattr(raster.scipy.fft, "irfft2", counted)
+    with_rule = raster_nest(polys, 300.0, 200.0, 2.0, order, step=30.0)
+    n_with = calls["n"]
+    monkeypatch.setattr(raster, "depth", lambda mask: 0.0)   # every rotation fits: no pruning
+    calls["n"] = 0
+    without = raster_nest(polys, 300.0, 200.0, 2.0, order, step=30.0)
+    assert with_rule[0] == without[0] and with_rule[2] == without[2] >= 3
+    assert with_rule[1] == without[1]
+    assert n_with <= calls["n"] - 8            # each bar skips at least the first sheet
