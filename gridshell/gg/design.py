@@ -503,14 +503,21 @@ def design_gg_surface(target_V: Any, target_F: Any, P0: Any, *,
     sides = _boundary_sides(R, C)
     D = fairness_matrix((R, C))
 
+    def refreshed(X: np.ndarray) -> dict[str, Any]:
+        """The data of the terms that follow the mesh, at vertices ``X``."""
+        return {"closeness": _surface_gliding(X, V, Ft),
+                "boundary": _boundary_gliding(X, P0flat, sides),
+                "elastic": T.Linear("P", D, D @ X), "proximity": T.Closeness("P", X.copy())}
+
     def build(X: np.ndarray) -> Problem:
         """The problem with base weights and data refreshed at vertices ``X``."""
+        d = refreshed(X)
         return (_constraints_only(lay, (R, C), w, par, mer, s2)
-                .add("closeness", w.closeness * s2, T.gliding, _surface_gliding(X, V, Ft))
-                .add("boundary", w.boundary * s2, T.gliding, _boundary_gliding(X, P0flat, sides))
+                .add("closeness", w.closeness * s2, T.gliding, d["closeness"])
+                .add("boundary", w.boundary * s2, T.gliding, d["boundary"])
                 .add("fairness", w.fairness * s2, T.linear, T.Linear("P", D))
-                .add("elastic", w.elastic * s2, T.linear, T.Linear("P", D, D @ X))
-                .add("proximity", w.proximity * s2, T.closeness, T.Closeness("P", X.copy())))
+                .add("elastic", w.elastic * s2, T.linear, d["elastic"])
+                .add("proximity", w.proximity * s2, T.closeness, d["proximity"]))
 
     prob = build(P0flat)
     before = prob.report(x)
@@ -532,7 +539,10 @@ def design_gg_surface(target_V: Any, target_F: Any, P0: Any, *,
     for k in range(k0, int(outer)):
         X = lay.view(x, "P")
         if k > 0:  # (after a coarse start: refreshed at the interpolated coarse design)
-            prob = build(X)
+            # the same problem with new data (every weight is set below): it keeps its
+            # Jacobian's structure, whose triplets do not move from round to round
+            for name, data in refreshed(X).items():
+                prob.set_data(name, data)
         wf = w.fairness * w.fairness_decay ** k
         soft = w.soften ** k
         prob.set_weight("fairness", wf * s2)
