@@ -47,7 +47,8 @@ Optimization (Tang et al. 2014 style, one :class:`~gridshell.solver.Layout` with
   :data:`POLISH_SLOW` with the regularisation below :data:`POLISH_GN`: the floor of slightly
   inconsistent constraints on a freeform target),
   or is far inside the thresholds (:data:`SCORE_DONE`); the score is computed every
-  ``check_every`` steps, after :data:`SCORE_EARLY` steps and when the polish slows down. With a score the best-scoring
+  ``check_every`` steps, when the polish slows down, and once after :data:`SCORE_EARLY` steps
+  (which ends the polish only on :data:`SCORE_DONE`). With a score the best-scoring
   checkpoint is returned, so a longer polish never returns a worse design (the end of the
   rounds is a candidate too, scored only when no polish checkpoint is far inside the
   thresholds, or as the reference of the first check's stagnation test).
@@ -86,6 +87,7 @@ from ..solver import terms as T
 from .constraints import (EdgeGroups, GridShape, diagonal_residual_rel, edge_groups,
                           equal_diagonals, equal_lengths, geodesic_meridians, geodesic_residual,
                           init_group_lengths, length_residual_rel)
+from .soft_terms import boundary_gliding, boundary_sides, fairness_matrix, surface_gliding
 
 __all__ = ["GGDesign", "GGWeights", "design_gg_surface", "edge_groups", "equal_lengths",
            "fairness_matrix", "geodesic_meridians", "geodesic_residual", "GridShape",
@@ -93,25 +95,6 @@ __all__ = ["GGDesign", "GGWeights", "design_gg_surface", "edge_groups", "equal_l
            "diagonal_residual_rel"]
 
 Progress = Callable[[str], None] | None
-
-
-# ============================================================================ fairness
-
-def fairness_matrix(shape: tuple[int, int]) -> sp.csr_matrix:
-    """Second differences ``X[k-1] - 2 X[k] + X[k+1]`` along meridians and along parallels of
-    an ``R x C`` grid (row-major), ``((R-2) C + R (C-2), R C)``."""
-    R, C = shape
-    idx = np.arange(R * C).reshape(R, C)
-    trip = []
-    for a, b, c in ((idx[:-2, :], idx[1:-1, :], idx[2:, :]), (idx[:, :-2], idx[:, 1:-1], idx[:, 2:])):
-        trip.append((a.ravel(), b.ravel(), c.ravel()))
-    a = np.concatenate([t[0] for t in trip])
-    b = np.concatenate([t[1] for t in trip])
-    c = np.concatenate([t[2] for t in trip])
-    m = len(a)
-    rows = np.tile(np.arange(m), 3)
-    return sp.csr_matrix((np.concatenate([np.ones(m), -2 * np.ones(m), np.ones(m)]),
-                          (rows, np.concatenate([a, b, c]))), shape=(m, R * C))
 
 
 # ============================================================================ weights, result
@@ -297,49 +280,6 @@ def _check_P0(P0: Any) -> np.ndarray:
     return P0
 
 
-def _closest_on_polyline(X: np.ndarray, Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Closest points ``(k,3)`` of ``X (k,3)`` on polyline ``Q (n,3)`` and the unit tangent of
-    the segment holding each."""
-    A, B = Q[:-1], Q[1:]
-    d = B - A
-    dd = np.maximum(np.einsum("ij,ij->i", d, d), 1e-300)
-    t = np.clip(np.einsum("kij,ij->ki", X[:, None, :] - A[None], d) / dd[None], 0.0, 1.0)
-    F = A[None] + t[..., None] * d[None]
-    s = np.argmin(np.einsum("kij,kij->ki", X[:, None] - F, X[:, None] - F), axis=1)
-    k = np.arange(len(X))
-    return F[k, s], d[s] / np.sqrt(dd[s])[:, None]
-
-
-def _boundary_sides(R: int, C: int) -> list[np.ndarray]:
-    idx = np.arange(R * C).reshape(R, C)
-    return [idx[0, :], idx[-1, :], idx[:, 0], idx[:, -1]]
-
-
-def _boundary_gliding(X: np.ndarray, P0flat: np.ndarray, sides: list[np.ndarray]) -> T.Gliding:
-    """Gliding data keeping each boundary vertex on the tangent line of its side of ``P0``."""
-    index, foot, normal = [], [], []
-    for side in sides:
-        F, t = _closest_on_polyline(X[side], P0flat[side])
-        # two unit normals of the tangent line
-        helper = np.where(np.abs(t[:, [0]]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]])
-        n1 = np.cross(t, helper)
-        n1 /= np.linalg.norm(n1, axis=1)[:, None]
-        n2 = np.cross(t, n1)
-        index += [side, side]
-        foot += [F, F]
-        normal += [n1, n2]
-    return T.Gliding("P", np.concatenate(foot), np.concatenate(normal), np.concatenate(index))
-
-
-def _surface_gliding(X: np.ndarray, V: np.ndarray, F: np.ndarray) -> T.Gliding:
-    from ..igl_adapter import closest_points_with_normals
-
-    C, N = closest_points_with_normals(X, V, F)
-    bad = ~np.all(np.isfinite(N), axis=1)
-    N[bad] = 0.0
-    return T.Gliding("P", C, N)
-
-
 def _figures(P: np.ndarray) -> tuple[float, float]:
     g = geodesic_residual(P)
     lr = length_residual_rel(P)
@@ -500,13 +440,13 @@ def design_gg_surface(target_V: Any, target_F: Any, P0: Any, *,
     par, mer = edge_groups((R, C), "parallel"), edge_groups((R, C), "meridian")
     x = lay.pack({"P": P0flat, "l": init_group_lengths(P0flat, par),
                   "h": init_group_lengths(P0flat, mer)})
-    sides = _boundary_sides(R, C)
+    sides = boundary_sides(R, C)
     D = fairness_matrix((R, C))
 
     def refreshed(X: np.ndarray) -> dict[str, Any]:
         """The data of the terms that follow the mesh, at vertices ``X``."""
-        return {"closeness": _surface_gliding(X, V, Ft),
-                "boundary": _boundary_gliding(X, P0flat, sides),
+        return {"closeness": surface_gliding(X, V, Ft),
+                "boundary": boundary_gliding(X, P0flat, sides),
                 "elastic": T.Linear("P", D, D @ X), "proximity": T.Closeness("P", X.copy())}
 
     def build(X: np.ndarray) -> Problem:
