@@ -385,7 +385,8 @@ def design_gg_surface(target_V: Any, target_F: Any, P0: Any, *,
     outer : int
         Rounds of (closest points -> ``max_iter`` Levenberg-Marquardt iterations).
     max_iter : int
-        Solver iterations per round.
+        Most solver iterations per round (a round ends sooner once a step gains less than
+        :data:`ROUND_TOL_REL` of its energy).
     polish_iter : int
         Most iterations of the final projection onto the constraints (0: no polish); it
         stops earlier on stagnation (see the module docstring).
