@@ -25,7 +25,6 @@ from gridshell.errors import InputError, OutputError
 from gridshell.manifest import MANIFEST, refusal
 
 from .cutlist import cutlist_rows, write_cutlist
-from .dxf import write_sheet_dxf
 from .nesting import Layout, check_layout, nest
 from .params import FabParams, scale_text
 from .part import Part, build_part, joint_clearance
@@ -126,6 +125,8 @@ def fabricate(bundle: str | Path | DesignBundle, out_dir: str | Path,
         placement (the rigid motion from strip coordinates, see :mod:`fabrication.axis`, to
         the sheet; mm and degrees).
     """
+    from .dxf import write_sheet_dxf  # ezdxf: only for writing (plan_parts does without)
+
     say = progress or (lambda msg: None)
     if params is None:
         params = FabParams()
