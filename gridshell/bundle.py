@@ -384,6 +384,25 @@ def content_key(path: str | Path, names: Sequence[str] = BUNDLE_FILES) -> tuple 
     return (where, tuple(names), tuple(digests))
 
 
+def cached_bundle(path: str | Path) -> DesignBundle | None:
+    """A copy of what :func:`read_bundle` read at ``path`` in this process if its files are
+    byte for byte unchanged since (:func:`content_key`), else None (the files are hashed,
+    not parsed)."""
+    return _cached(content_key(path))
+
+
+def _cached(key: tuple | None) -> DesignBundle | None:
+    """A copy of the bundle read under ``key``, or None."""
+    if key is None:
+        return None
+    with _READ_LOCK:
+        hit = _READ.get(key)
+        if hit is None:
+            return None
+        _READ.move_to_end(key)
+        return copy.deepcopy(hit)
+
+
 def read_bundle(path: str | Path) -> DesignBundle:
     """Read a design bundle directory written by :func:`write_bundle`.
 
@@ -393,12 +412,9 @@ def read_bundle(path: str | Path) -> DesignBundle:
     returns its own copy, so the caller may change it."""
     path = Path(path)
     key = content_key(path)
-    if key is not None:
-        with _READ_LOCK:
-            hit = _READ.get(key)
-            if hit is not None:
-                _READ.move_to_end(key)
-                return copy.deepcopy(hit)
+    hit = _cached(key)
+    if hit is not None:
+        return hit
     bundle = _read_bundle(path)
     # stored only if the files did not change while they were read
     if key is not None and content_key(path) == key:

@@ -84,3 +84,55 @@ def test_an_added_revolution_file_is_read(tmp_path):
     b = read_bundle(d)
     meshfile.write_mesh(d / "revolution.obj", b.surface_V + 1.0, b.surface_F)
     assert np.array_equal(read_bundle(d).revolution_V, b.surface_V + 1.0)
+
+
+def test_closest_point_queries_asked_with_reuse_are_answered_once(monkeypatch):
+    import gridshell.igl_adapter as ia
+
+    rng = np.random.default_rng(5)
+    t = np.linspace(-1, 1, 12)
+    X, Y = np.meshgrid(t, t, indexing="ij")
+    V = np.stack([X, Y, 0.2 * X * Y], -1).reshape(-1, 3)
+    from gridshell.grid import grid_quads
+
+    F = grid_quads(12, 12)
+    P = rng.uniform(-1, 1, (50, 3))
+    plain = ia.closest_points(P, V, F)
+    plain_n = ia.closest_points_with_normals(P, V, F)
+    first = ia.closest_points(P, V, F, reuse=True)
+    first_n = ia.closest_points_with_normals(P + 0.0, V, F, reuse=True)
+    monkeypatch.setattr(ia.igl, "point_mesh_squared_distance",
+                        lambda *a: (_ for _ in ()).throw(AssertionError("asked igl again")))
+    again = ia.closest_points(P.copy(), V.copy(), F.copy(), reuse=True)
+    again_n = ia.closest_points_with_normals(P, V, F, reuse=True)
+    for a, b, c in zip(plain + plain_n, first + first_n, again + again_n):
+        assert np.array_equal(a, b) and np.array_equal(a, c)
+    again[2][:] = 0.0                        # the caller's own copy
+    assert np.array_equal(ia.closest_points(P, V, F, reuse=True)[2], plain[2])
+    with pytest.raises(AssertionError, match="asked igl again"):
+        ia.closest_points(P + 1e-9, V, F, reuse=True)       # other points: a new query
+    with pytest.raises(AssertionError, match="asked igl again"):
+        ia.closest_points(P, V, F)                           # without reuse: always asked
+
+
+def test_verification_after_a_read_gives_what_it_gives_alone(tmp_path):
+    """verify_bundle on the arrays read_bundle parsed (and on reused closest points) gives
+    the result it gives from the files alone, in a new process, pass and fail alike."""
+    import json
+    import subprocess
+    import sys
+
+    from gridshell.verification import verify_bundle
+
+    d = write_case(tmp_path / "b", kind="NCP")
+    code = ("import json, sys; sys.path.insert(0, 'tests')\n"
+            "from gridshell.verification import verify_bundle\n"
+            f"print(json.dumps(verify_bundle({str(d)!r})))")
+    alone = json.loads(subprocess.run([sys.executable, "-c", code], capture_output=True,
+                                      text=True, check=True, timeout=120).stdout)
+    read_bundle(d)
+    from gridshell.bundle import cached_bundle
+
+    assert cached_bundle(d) is not None
+    assert json.loads(json.dumps(verify_bundle(d))) == alone
+    assert json.loads(json.dumps(verify_bundle(d))) == alone
