@@ -36,6 +36,7 @@ __all__ = [
     "parameterize_disk",
     "per_vertex_normals",
     "principal_curvature",
+    "principal_curvature_at",
     "triangulate",
 ]
 
@@ -263,7 +264,51 @@ def principal_curvature(V: Any, F: np.ndarray | None = None,
     V, T, _ = triangulate(V, F)
     if int(radius) < 1:
         raise InputError(f"radius must be an integer >= 1, got {radius!r}")
-    out = igl.principal_curvature(V, T, int(radius))
+    return _principal_curvature(V, T, int(radius))
+
+
+def principal_curvature_at(V: Any, F: np.ndarray | None, vertices: np.ndarray,
+                           radius: int = 5) -> tuple[np.ndarray, np.ndarray, np.ndarray,
+                                                     np.ndarray]:
+    """:func:`principal_curvature` of the vertices ``vertices (k,)`` only: ``d1, d2 (k,3)``,
+    ``k1, k2 (k,)``, the same numbers (bit for bit), computed on the part of the mesh they
+    depend on.
+
+    igl fits each vertex's quadric to its ``radius``-ring (the vertices joined to it by at
+    most ``radius`` edges) with the average of their normals, each normal from the faces
+    round its vertex: the triangles with a corner within the ``radius``-ring of ``vertices``
+    hold all of that. They are handed to igl in their order, their vertices renumbered in
+    theirs, so that igl meets every neighbour in the same order and adds in the same order
+    (tests/test_bundle_cache.py compares with the whole mesh's figures)."""
+    V, T, _ = triangulate(V, F)
+    if int(radius) < 1:
+        raise InputError(f"radius must be an integer >= 1, got {radius!r}")
+    vertices = np.asarray(vertices, dtype=np.int64).reshape(-1)
+    if vertices.size and (vertices.min() < 0 or vertices.max() >= len(V)):
+        raise InputError(f"vertex indices must lie in [0, {len(V) - 1}]")
+    near = np.zeros(len(V), dtype=bool)
+    near[vertices] = True
+    for _ in range(max(int(radius), 2)):   # igl takes a radius below 2 as 2
+        near[T[near[T].any(axis=1)]] = True
+    faces = near[T].any(axis=1)
+    keep = np.zeros(len(V), dtype=bool)
+    keep[T[faces]] = True
+    if not keep[vertices].all() or 2 * keep.sum() > len(V):
+        # a vertex on no triangle, or most of the mesh anyway: the whole mesh
+        return tuple(a[vertices] for a in _principal_curvature(V, T, int(radius)))
+    old = np.flatnonzero(keep)
+    new = np.full(len(V), -1, dtype=np.int64)
+    new[old] = np.arange(len(old))
+    d1, d2, k1, k2 = _principal_curvature(np.ascontiguousarray(V[old]),
+                                          np.ascontiguousarray(new[T[faces]]), int(radius))
+    at = new[vertices]
+    return d1[at], d2[at], k1[at], k2[at]
+
+
+def _principal_curvature(V: np.ndarray, T: np.ndarray,
+                         radius: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`principal_curvature` of a checked triangle mesh."""
+    out = igl.principal_curvature(V, T, radius)
     # libigl < 2.6 returns (PD1, PD2, PV1, PV2); 2.6 appends the list of bad vertices.
     if len(out) == 5:
         pd1, pd2, pv1, pv2, bad = out

@@ -513,7 +513,7 @@ def crossing_normal_curvature_on_mesh(net: Net, V: np.ndarray, F: np.ndarray,
     ``axes.obj``; joints are located on their axes by arc length (``joint_s``). ``reuse``: the
     closest-point queries may answer from earlier ones
     (:func:`gridshell.igl_adapter.closest_points`)."""
-    from .igl_adapter import closest_points, closest_points_with_normals, principal_curvature
+    from .igl_adapter import closest_points, closest_points_with_normals, principal_curvature_at
     from .net import polyline_arclength
 
     axes = [np.asarray(lam.axis, float) for lam in net.lamellae]
@@ -523,11 +523,12 @@ def crossing_normal_curvature_on_mesh(net: Net, V: np.ndarray, F: np.ndarray,
     for lam, a in zip(net.lamellae, axes):
         s = polyline_arclength(a)
         jidx.append(np.abs(s[None, :] - np.asarray(lam.joint_s, float)[:, None]).argmin(axis=1))
-    _, _, k1, k2 = principal_curvature(V, F, radius=2)
     _, face, C = closest_points(net.joints, V, F, reuse)
     tri = np.asarray(F, np.int64)[face]
     nearest = tri[np.arange(len(tri)), np.linalg.norm(V[tri] - C[:, None], axis=2).argmin(1)]
-    scale = np.abs(k2[nearest] - k1[nearest]) / 2
+    # the curvatures of the nearest vertices only (those of the whole mesh, bit for bit)
+    _, _, k1, k2 = principal_curvature_at(V, F, nearest, radius=2)
+    scale = np.abs(k2 - k1) / 2
     return crossing_normal_curvature(net, normals, jidx, scale)
 
 

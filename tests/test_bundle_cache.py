@@ -136,3 +136,53 @@ def test_verification_after_a_read_gives_what_it_gives_alone(tmp_path):
     assert cached_bundle(d) is not None
     assert json.loads(json.dumps(verify_bundle(d))) == alone
     assert json.loads(json.dumps(verify_bundle(d))) == alone
+
+
+def _irregular_mesh(rng, n=5000):
+    """A Delaunay triangulation of random points on a wavy height field (irregular
+    valences, a ragged boundary)."""
+    from scipy.spatial import Delaunay
+
+    xy = rng.uniform(-1, 1, (n, 2))
+    T = Delaunay(xy).simplices.astype(np.int64)
+    V = np.column_stack([xy, 0.3 * np.sin(2 * xy[:, 0]) * np.cos(3 * xy[:, 1])])
+    return V, T
+
+
+@pytest.mark.parametrize("case", ["grid", "irregular"])
+@pytest.mark.parametrize("radius", [1, 2, 3])
+def test_principal_curvature_at_some_vertices_is_that_of_the_whole_mesh(case, radius):
+    from gridshell.grid import grid_quads
+    from gridshell.igl_adapter import principal_curvature, principal_curvature_at
+
+    rng = np.random.default_rng(11 + radius)
+    if case == "grid":
+        m = 120
+        t = np.linspace(-1, 1, m)
+        X, Y = np.meshgrid(t, t, indexing="ij")
+        V = np.stack([X, Y, 0.3 * np.sin(2 * X) * np.cos(3 * Y)], -1).reshape(-1, 3)
+        V = V + rng.normal(0, 0.003, V.shape)
+        F = grid_quads(m, m)
+        corners = [0, m - 1, m * m - 1, m * (m - 1), m, 2 * m + 1]
+    else:
+        V, F = _irregular_mesh(rng)
+        corners = []
+    whole = principal_curvature(V, F, radius=radius)
+    picks = np.concatenate([rng.choice(len(V), 30, replace=False),
+                            np.array(corners + [5, 5], dtype=np.int64)])
+    part = principal_curvature_at(V, F, picks, radius=radius)
+    for w, p in zip(whole, part):
+        assert np.array_equal(w[picks], p, equal_nan=True)
+
+
+def test_principal_curvature_at_asks_igl_about_a_part_of_the_mesh(monkeypatch):
+    """(The test above compares on meshes where only a part is handed to igl.)"""
+    import gridshell.igl_adapter as ia
+
+    V, F = _irregular_mesh(np.random.default_rng(3))
+    sizes = []
+    real = ia.igl.principal_curvature
+    monkeypatch.setattr(ia.igl, "principal_curvature",
+                        lambda V, T, r: sizes.append(len(V)) or real(V, T, r))
+    ia.principal_curvature_at(V, F, np.arange(0, 5000, 170), radius=3)
+    assert sizes and sizes[0] < len(V) // 2
