@@ -124,11 +124,11 @@ def per_vertex_normals(V: Any, F: np.ndarray | None = None) -> np.ndarray:
 #: results of the closest-point queries asked with ``reuse=True`` in this process, by the
 #: content of their arrays (:func:`_content`): the same query again (a design verified, then
 #: exported: the joints' and the axes' closest points on surface.obj) is answered without igl.
-#: A few, newest last, of at most _QUERIES_BYTES each. Opt-in: a loop that queries new points
-#: on one large mesh would only pay for the hashing.
+#: A few, newest last, of at most _QUERIES_BYTES together. Opt-in: a loop that queries new
+#: points on one large mesh would only pay for the hashing.
 _QUERIES: OrderedDict[tuple, tuple[np.ndarray, ...]] = OrderedDict()
 _QUERIES_SIZE = 8
-_QUERIES_BYTES = 32 << 20
+_QUERIES_BYTES = 16 << 20
 _QUERIES_LOCK = threading.Lock()
 
 
@@ -159,7 +159,8 @@ def _once(what: str, arrays: tuple[np.ndarray, ...],
         return out
     with _QUERIES_LOCK:
         _QUERIES[key] = tuple(a.copy() for a in out)
-        while len(_QUERIES) > _QUERIES_SIZE:
+        while len(_QUERIES) > _QUERIES_SIZE or sum(
+                a.nbytes for v in _QUERIES.values() for a in v) > _QUERIES_BYTES:
             _QUERIES.popitem(last=False)
     return out
 
@@ -293,8 +294,8 @@ def principal_curvature_at(V: Any, F: np.ndarray | None, vertices: np.ndarray,
     faces = near[T].any(axis=1)
     keep = np.zeros(len(V), dtype=bool)
     keep[T[faces]] = True
-    if not keep[vertices].all() or 2 * keep.sum() > len(V):
-        # a vertex on no triangle, or most of the mesh anyway: the whole mesh
+    if not keep[vertices].all() or 10 * keep.sum() > 9 * len(V):
+        # a vertex on no triangle, or nearly all of the mesh anyway: the whole mesh
         return tuple(a[vertices] for a in _principal_curvature(V, T, int(radius)))
     old = np.flatnonzero(keep)
     new = np.full(len(V), -1, dtype=np.int64)
