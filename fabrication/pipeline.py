@@ -25,15 +25,11 @@ from gridshell.errors import InputError, OutputError
 from gridshell.manifest import MANIFEST, refusal
 
 from .cutlist import cutlist_rows, write_cutlist
-from .dxf import write_sheet_dxf
 from .nesting import Layout, check_layout, nest
 from .params import FabParams, scale_text
 from .part import Part, build_part, joint_clearance
-from .plan import write_plan
-from .preview import write_sheet_png
 from .splice import split_strip
 from .strips import strips_from_bundle
-from .svg import write_sheet_svg
 
 REPORT = "fabrication.json"
 #: the command whose outputs :func:`fabricate` writes and may replace (gridshell.manifest)
@@ -126,6 +122,12 @@ def fabricate(bundle: str | Path | DesignBundle, out_dir: str | Path,
         placement (the rigid motion from strip coordinates, see :mod:`fabrication.axis`, to
         the sheet; mm and degrees).
     """
+    # the writers (ezdxf, the previews): only for writing, plan_parts does without them
+    from .dxf import write_sheet_dxf
+    from .plan import write_plan
+    from .preview import write_sheet_png
+    from .svg import write_sheet_svg
+
     say = progress or (lambda msg: None)
     if params is None:
         params = FabParams()

@@ -17,10 +17,14 @@ Layout (all geometry in metres)::
 """
 from __future__ import annotations
 
+import copy
+import hashlib
 import json
+import threading
+from collections import OrderedDict
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable, NamedTuple
+from typing import Any, Callable, NamedTuple, Sequence
 
 import numpy as np
 
@@ -351,11 +355,80 @@ def _finite_field(value: Any, what: str) -> None:
                          "or Inf); re-run the design command")
 
 
+#: the files :func:`read_bundle` reads (revolution.obj when there is one)
+BUNDLE_FILES = ("design.json", "net.obj", "aligned.obj", "axes.obj", "surface.obj",
+                "revolution.obj")
+#: bundles read in this process, by content (:func:`content_key`); a few, most recent last
+_READ: OrderedDict[tuple, DesignBundle] = OrderedDict()
+_READ_SIZE = 4
+_READ_LOCK = threading.Lock()
+
+
+def content_key(path: str | Path, names: Sequence[str] = BUNDLE_FILES) -> tuple | None:
+    """What identifies the content of the files ``names`` of directory ``path``: the resolved
+    directory and each file's BLAKE2b digest (None for a file that is not there), or None when
+    one of them cannot be read. Equal keys mean byte-identical files, whatever their times."""
+    path = Path(path)
+    digests = []
+    for name in names:
+        f = path / name
+        try:
+            data = f.read_bytes() if f.is_file() else None
+        except OSError:
+            return None
+        digests.append(None if data is None else hashlib.blake2b(data, digest_size=20).digest())
+    try:
+        where = str(path.resolve())
+    except OSError:
+        return None
+    return (where, tuple(names), tuple(digests))
+
+
+def cached_bundle(path: str | Path) -> DesignBundle | None:
+    """A copy of what :func:`read_bundle` read at ``path`` in this process if its files are
+    byte for byte unchanged since (:func:`content_key`), else None (the files are hashed,
+    not parsed)."""
+    return _cached(content_key(path))
+
+
+def _cached(key: tuple | None) -> DesignBundle | None:
+    """A copy of the bundle read under ``key``, or None."""
+    if key is None:
+        return None
+    with _READ_LOCK:
+        hit = _READ.get(key)
+        if hit is None:
+            return None
+        _READ.move_to_end(key)
+        return copy.deepcopy(hit)
+
+
 def read_bundle(path: str | Path) -> DesignBundle:
-    """Read a design bundle directory written by :func:`write_bundle`."""
+    """Read a design bundle directory written by :func:`write_bundle`.
+
+    A bundle whose files (:data:`BUNDLE_FILES`) are byte for byte those of a bundle this
+    process has read before is not parsed and checked again: a copy of that reading is
+    returned (:func:`content_key`; a changed, added or removed file reads it anew). Each call
+    returns its own copy, so the caller may change it."""
+    path = Path(path)
+    key = content_key(path)
+    hit = _cached(key)
+    if hit is not None:
+        return hit
+    bundle = _read_bundle(path)
+    # stored only if the files did not change while they were read
+    if key is not None and content_key(path) == key:
+        with _READ_LOCK:
+            _READ[key] = copy.deepcopy(bundle)
+            while len(_READ) > _READ_SIZE:
+                _READ.popitem(last=False)
+    return bundle
+
+
+def _read_bundle(path: Path) -> DesignBundle:
+    """:func:`read_bundle` without the cache: parse and check the files."""
     from .meshfile import read_configuration, read_mesh, read_polylines
 
-    path = Path(path)
     d = read_design_json(path)
     for name in ("net.obj", "aligned.obj", "axes.obj", "surface.obj"):
         if not (path / name).is_file():

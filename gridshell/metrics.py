@@ -183,7 +183,8 @@ def delta_n(V_star: np.ndarray, r_star: np.ndarray, V_a: np.ndarray, r_a: np.nda
     return np.where((m > 0) & (den > 0), out, np.nan)
 
 
-def deviation(P: np.ndarray, V: np.ndarray, F: np.ndarray) -> dict[str, float]:
+def deviation(P: np.ndarray, V: np.ndarray, F: np.ndarray,
+              reuse: bool = False) -> dict[str, float]:
     """Distance of points from a surface mesh in percent of its bounding-box diagonal (Fig. 17).
 
     Parameters
@@ -199,12 +200,14 @@ def deviation(P: np.ndarray, V: np.ndarray, F: np.ndarray) -> dict[str, float]:
         ``max``, ``mean``: distances in % of the bounding-box diagonal of the referenced
         vertices of ``(V, F)``; ``diagonal`` in metres.
     """
-    return deviations([P], V, F)[0]
+    return deviations([P], V, F, reuse)[0]
 
 
-def deviations(Ps: Sequence[np.ndarray], V: np.ndarray, F: np.ndarray) -> list[dict[str, float]]:
+def deviations(Ps: Sequence[np.ndarray], V: np.ndarray, F: np.ndarray,
+               reuse: bool = False) -> list[dict[str, float]]:
     """:func:`deviation` of each point set of ``Ps`` from one surface, with one closest-point
-    query (igl builds its AABB tree once per query: on a 200k-triangle target ~0.15 s)."""
+    query (igl builds its AABB tree once per query: on a 200k-triangle target ~0.15 s;
+    ``reuse``: see :func:`gridshell.igl_adapter.closest_points`)."""
     from .igl_adapter import closest_points
 
     V = _V("V", V)
@@ -215,7 +218,7 @@ def deviations(Ps: Sequence[np.ndarray], V: np.ndarray, F: np.ndarray) -> list[d
     if not diag > 0:
         raise InputError("the reference surface has a zero bounding box; give a real surface")
     Ps = [_V("P", P) for P in Ps]
-    sq, _, _ = closest_points(np.concatenate(Ps) if Ps else np.zeros((0, 3)), V, F)
+    sq, _, _ = closest_points(np.concatenate(Ps) if Ps else np.zeros((0, 3)), V, F, reuse)
     d = np.sqrt(np.maximum(sq, 0.0)) / diag * 100.0
     out = []
     for part in np.split(d, np.cumsum([len(P) for P in Ps])[:-1]):
@@ -503,25 +506,29 @@ def crossing_normal_curvature(net: Net, axis_normals: Sequence[np.ndarray],
             "max": float(rel.max())}
 
 
-def crossing_normal_curvature_on_mesh(net: Net, V: np.ndarray, F: np.ndarray) -> dict[str, Any]:
+def crossing_normal_curvature_on_mesh(net: Net, V: np.ndarray, F: np.ndarray,
+                                      reuse: bool = False) -> dict[str, Any]:
     """:func:`crossing_normal_curvature` with normals and principal curvatures of a surface
     mesh ``(V, F)`` (e.g. a bundle's ``surface.obj``): what ``gridshell verify`` measures on
-    ``axes.obj``; joints are located on their axes by arc length (``joint_s``)."""
-    from .igl_adapter import closest_points, closest_points_with_normals, principal_curvature
+    ``axes.obj``; joints are located on their axes by arc length (``joint_s``). ``reuse``: the
+    closest-point queries may answer from earlier ones
+    (:func:`gridshell.igl_adapter.closest_points`)."""
+    from .igl_adapter import closest_points, closest_points_with_normals, principal_curvature_at
     from .net import polyline_arclength
 
     axes = [np.asarray(lam.axis, float) for lam in net.lamellae]
-    _, N = closest_points_with_normals(np.concatenate(axes), V, F)
+    _, N = closest_points_with_normals(np.concatenate(axes), V, F, reuse)
     normals = np.split(N, np.cumsum([len(a) for a in axes])[:-1])
     jidx = []
     for lam, a in zip(net.lamellae, axes):
         s = polyline_arclength(a)
         jidx.append(np.abs(s[None, :] - np.asarray(lam.joint_s, float)[:, None]).argmin(axis=1))
-    _, _, k1, k2 = principal_curvature(V, F, radius=2)
-    _, face, C = closest_points(net.joints, V, F)
+    _, face, C = closest_points(net.joints, V, F, reuse)
     tri = np.asarray(F, np.int64)[face]
     nearest = tri[np.arange(len(tri)), np.linalg.norm(V[tri] - C[:, None], axis=2).argmin(1)]
-    scale = np.abs(k2[nearest] - k1[nearest]) / 2
+    # the curvatures of the nearest vertices only (those of the whole mesh, bit for bit)
+    _, _, k1, k2 = principal_curvature_at(V, F, nearest, radius=2)
+    scale = np.abs(k2 - k1) / 2
     return crossing_normal_curvature(net, normals, jidx, scale)
 
 

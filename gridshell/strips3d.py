@@ -83,19 +83,21 @@ def strip_frame(axis: np.ndarray, normals: np.ndarray, tangent: bool
 
 
 def strip_solid(axis: np.ndarray, normals: np.ndarray, width: float, thickness: float,
-                tangent: bool) -> tuple[np.ndarray, np.ndarray]:
+                tangent: bool, frame: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+                ) -> tuple[np.ndarray, np.ndarray]:
     """A closed, outward-oriented triangle mesh of the strip: the axis swept by its
     ``width x thickness`` rectangle (metres), with end caps.
 
     Returns ``V (4k,3)`` (the corners of the cross-section at each axis point, in the order
     ``-W-H, +W-H, +W+H, -W+H``) and ``F (8(k-1)+4, 3)``. The faces ``+-H`` are the strip's
-    two wide faces, each of area ~ length x width.
+    two wide faces, each of area ~ length x width. ``frame``: :func:`strip_frame` of these
+    ``axis``, ``normals`` and ``tangent`` when the caller has it already (not computed again).
     """
     if not (np.isfinite(width) and np.isfinite(thickness) and width > 0 and thickness > 0):
         raise InputError(f"strip solid: width {width!r} and thickness {thickness!r} must be "
                          "positive lengths in metres")
     P = np.asarray(axis, float).reshape(-1, 3)
-    _, W, H = strip_frame(P, normals, tangent)
+    _, W, H = frame if frame is not None else strip_frame(P, normals, tangent)
     w, h = 0.5 * float(width) * W, 0.5 * float(thickness) * H
     V = np.stack([P - w - h, P + w - h, P + w + h, P - w + h], axis=1).reshape(-1, 3)
     k = len(P)

@@ -175,7 +175,8 @@ def verify_bundle(path: str | Path) -> dict[str, Any]:
     holds and there is no problem. A bundle whose net.obj, axes.obj, surface.obj or
     design.json cannot be read raises :class:`~gridshell.errors.InputError`.
     """
-    from .bundle import check_collapse, lamellae_from_design, read_design_json, read_net_mesh
+    from .bundle import (cached_bundle, check_collapse, lamellae_from_design, read_design_json,
+                         read_net_mesh)
     from .errors import InputError
     from .metrics import (alignability_error, alignability_error_arc,
                            crossing_normal_curvature_on_mesh, delta_l, delta_n,
@@ -190,11 +191,21 @@ def verify_bundle(path: str | Path) -> dict[str, Any]:
     for name in ("net.obj", "axes.obj", "surface.obj"):
         if not (path / name).is_file():
             raise InputError(f"design bundle {path} lacks {name}; re-run the design command")
-    net_mesh = read_net_mesh(path / "net.obj")
-    axes = read_polylines(path / "axes.obj")
+    # files this process has read (read_bundle) and are byte for byte unchanged give the
+    # arrays their parsing gives: they are not parsed again
+    done = cached_bundle(path)
+    if done is not None:
+        net_V, net_F = done.net.joints, done.net.loops
+        axes = [lam.axis for lam in done.net.lamellae]
+        surf_V, surf_F = done.surface_V, done.surface_F
+    else:
+        net_mesh = read_net_mesh(path / "net.obj")
+        net_V, net_F = net_mesh.V, net_mesh.F
+        axes = read_polylines(path / "axes.obj")
+        surf = read_mesh(path / "surface.obj", kind="any")
+        surf_V, surf_F = surf.V, surf.F
     lams = lamellae_from_design(d, axes, path)
-    net = Net(joints=net_mesh.V, loops=net_mesh.F, lamellae=lams)
-    surf = read_mesh(path / "surface.obj", kind="any")
+    net = Net(joints=net_V, loops=net_F, lamellae=lams)
     da = alignability_error(net.joints, net.loops)
     da_arc = alignability_error_arc(net)
     out: dict[str, Any] = {
@@ -205,14 +216,14 @@ def verify_bundle(path: str | Path) -> dict[str, Any]:
     }
     ncp = d["kind"] != "GG"
     if not ncp:
-        out["geodesic_turning"] = 100 * geodesic_turning(net, surf.V, surf.F)["ratio"]
+        out["geodesic_turning"] = 100 * geodesic_turning(net, surf_V, surf_F)["ratio"]
     else:  # orthogonal lamellae: equal normal curvature of the two axes at every joint
-        ck = crossing_normal_curvature_on_mesh(net, surf.V, surf.F)
+        ck = crossing_normal_curvature_on_mesh(net, surf_V, surf_F, reuse=True)
         out["crossing_kn"] = {"mean": 100 * ck["mean"], "max": 100 * ck["max"],
                               "joints": int(len(ck["joints"]))}
     target = (d.get("params") or {}).get("target")
     if ncp:  # the joints from the designed (PHLW) surface, as the pipeline measures them
-        dv = deviation(net.joints, surf.V, surf.F)
+        dv = deviation(net.joints, surf_V, surf_F, reuse=True)
         out["deviation"] = {"mean": dv["mean"], "max": dv["max"]}
     elif target:
         try:  # read as the design read it: the recorded unit, object and cleaning
@@ -226,7 +237,7 @@ def verify_bundle(path: str | Path) -> dict[str, Any]:
         except InputError as exc:
             out["deviation"] = {"skipped": f"target {target} unreadable: {exc}"}
         else:
-            dv, dj = deviations([surf.V, net.joints], t.V, t.F)
+            dv, dj = deviations([surf_V, net.joints], t.V, t.F)
             out["deviation"] = {"mean": dv["mean"], "max": dv["max"]}
             out["deviation_joints"] = {"mean": dj["mean"], "max": dj["max"]}
     problems = [f"{name} is missing: the figures that need it were not computed"
@@ -235,7 +246,7 @@ def verify_bundle(path: str | Path) -> dict[str, Any]:
     Va = None
     has_r = r_star.is_file() and r_a.is_file()
     if (path / "aligned.obj").is_file():
-        Va = read_configuration(path / "aligned.obj")[0]
+        Va = done.aligned if done is not None else read_configuration(path / "aligned.obj")[0]
         if Va.shape != net.joints.shape:
             raise InputError(f"{path}: aligned.obj has {len(Va)} vertices but net.obj "
                              f"{len(net.joints)}; re-run the design command")

@@ -30,3 +30,23 @@ def test_a_design_function_loads_its_own_pipeline_only():
                      "try:\n    api.design_gg('missing.obj')\nexcept Exception:\n    pass")
     assert "gridshell.gg.pipeline" in loaded
     assert not any(m.startswith("gridshell.ncp") for m in loaded), loaded
+
+
+def test_the_export_plans_its_cut_sheets_without_the_dxf_writer():
+    """``gridshell export`` reads the fabrication parameters and plans the cut sheets in
+    memory: ezdxf (the DXF writer's library) is loaded only by ``fabricate``, which writes."""
+    code = ("import sys\n"
+            "sys.path.insert(0, 'tests')\n"
+            "from render_cases import make_bundle\n"
+            "from gridshell.export.fabparams import export_params, plan_sheets\n"
+            "fab, _ = export_params(None)\n"
+            "plan_sheets(make_bundle(), fab)\n"
+            "import fabrication\n"
+            "assert 'ezdxf' not in sys.modules, 'ezdxf loaded'\n"
+            "for m in ('dxf', 'svg', 'preview', 'plan'):\n"
+            "    assert 'fabrication.' + m not in sys.modules, m\n"
+            "fabrication.fabricate\n"
+            "assert 'ezdxf' not in sys.modules, 'ezdxf loaded by fabrication.fabricate'")
+    subprocess.run([sys.executable, "-c", code], check=True, timeout=120)
+    loaded = _loaded("import fabrication\nfabrication.FabParams")
+    assert "fabrication.params" in loaded and "fabrication.pipeline" not in loaded, loaded

@@ -76,3 +76,18 @@ def test_bad_sections_are_refused():
 def test_real_section_and_kinds():
     assert real_section_m(20.0, 1.0, 0.1) == pytest.approx((0.2, 0.01))
     assert is_tangent("GG") and not is_tangent("CNC") and not is_tangent("NCP")
+
+
+def test_strip_solid_with_the_frame_given_is_the_strip_solid():
+    """The .3dm export hands strip_solid the frame it computed: the same solid, bit for bit."""
+    import numpy as np
+
+    from gridshell.strips3d import strip_frame, strip_solid
+
+    t = np.linspace(0, 2, 41)
+    P = np.column_stack([t, np.sin(t), 0.2 * t * t])
+    N = np.column_stack([np.zeros_like(t), -np.cos(t), np.ones_like(t)])
+    for tangent in (False, True):
+        plain = strip_solid(P, N, 0.2, 0.01, tangent)
+        given = strip_solid(P, N, 0.2, 0.01, tangent, frame=strip_frame(P, N, tangent))
+        assert all(np.array_equal(a, b) for a, b in zip(plain, given))

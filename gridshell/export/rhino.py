@@ -168,20 +168,23 @@ def _strips(m: _Model, bundle, params, with_holes: bool) -> dict[str, Any]:
     # the surface normal interpolated at the closest point (smooth along the axis; the nearest
     # vertex's normal jumps from vertex to vertex and crinkles the strip: +1.7 % of area on
     # the demo dome, 0.2 % with these)
+    # (reuse: the query the verification of the design asked, gridshell.verification)
     normals = closest_points_with_normals(np.concatenate([P for _, P in lams]),
-                                          bundle.surface_V, bundle.surface_F)[1]
+                                          bundle.surface_V, bundle.surface_F, reuse=True)[1]
     n_holes, at = 0, 0
     for lam, P in lams:
         N = normals[at:at + len(P)]
         at += len(P)
-        _, W, H = strip_frame(P, N, tangent)
+        frame = strip_frame(P, N, tangent)
+        _, W, H = frame
         if tangent:      # stacked: family 1 on the normals' side of the surface, 3 below
             C = P + (0.5 * t if lam.family == 1 else -0.5 * t) * H
         elif params.axis == "edge":    # the axis on the edge the strip stands on
             C = P + 0.5 * w * W
         else:
             C = P
-        V, F = strip_solid(C, N, w, t, tangent)
+        # the solid's frame along C: the one above when C is the axis itself
+        V, F = strip_solid(C, N, w, t, tangent, frame=frame if C is P else None)
         s = polyline_arclength(P)
         strings = {"lamella_id": int(lam.id), "family": int(lam.family), "kind": bundle.kind,
                    "length": m.fmt(lam.length), "length_m": f"{lam.length:.9g}",
