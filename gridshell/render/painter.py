@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["Camera", "Painter", "strip_faces"]
+__all__ = ["Camera", "Painter", "grow_polygons", "strip_faces"]
 
 
 def _unit(X: np.ndarray) -> np.ndarray:
@@ -146,12 +146,48 @@ class Painter:
 
     def draw(self, ax, linewidth: float = 0.2) -> None:
         """Paint everything, far to near, into a 2D matplotlib ``ax`` (one collection; its
-        limits are the caller's: the collection does not autoscale the axes)."""
+        limits are the caller's and must be set before: the collection does not autoscale
+        the axes).
+
+        ``linewidth`` (points) outlines each polygon in its edge colour. Where the edge colour
+        is the face colour (no seams between neighbours) the polygon is grown by half the
+        line width instead (:func:`grow_polygons`, in display pixels at the axes' limits and
+        the figure's dpi) and drawn without a line: the same covered area as a fill and a
+        stroke, at half of Agg's drawing time. Polygons with another edge colour are stroked.
+        """
         from matplotlib.collections import PolyCollection
 
         if not self.polys:
             return
         P, face, edge = self.sorted_polygons()
+        widths = np.full(len(P), float(linewidth))
+        grow = np.all(face == edge, axis=1) if linewidth > 0 else np.zeros(len(P), bool)
+        if np.any(grow):
+            M = ax.transData.get_matrix()[:2, :2]   # data -> display pixels (linear axes)
+            half_px = 0.5 * float(linewidth) * ax.figure.dpi / 72.0
+            Pg = P[grow]
+            moved = grow_polygons(Pg @ M.T, half_px) - Pg @ M.T
+            P[grow] = Pg + moved @ np.linalg.inv(M).T
+            widths[grow] = 0.0
         # an (m, k, 2) array takes matplotlib's fast path (one template path shared by all)
-        coll = PolyCollection(P, facecolors=face, edgecolors=edge, linewidths=linewidth)
+        coll = PolyCollection(P, facecolors=face, edgecolors=edge, linewidths=widths)
         ax.add_collection(coll, autolim=False)
+
+
+def grow_polygons(P: np.ndarray, d: float) -> np.ndarray:
+    """Polygons ``P (m, k, 2)`` moved outward by ``d`` (same units) along their edges' normals:
+    each corner on the miter of its two edges (at most ``2 d`` from it, so a spike does not
+    shoot out); a repeated corner (zero-length edge) takes the normal of its other edge, which
+    bevels that corner. A polygon of zero area becomes a band ``2 d`` wide, as a stroke of
+    width ``2 d`` draws it."""
+    P = np.asarray(P, float)
+    E = np.roll(P, -1, axis=1) - P                      # edge i runs from corner i to i + 1
+    L = np.hypot(E[..., 0], E[..., 1])[..., None]
+    U = np.divide(E, L, out=np.zeros_like(E), where=L > 0)
+    x, y = P[..., 0], P[..., 1]
+    area2 = np.sum(x * np.roll(y, -1, axis=1) - np.roll(x, -1, axis=1) * y, axis=1)
+    s = np.where(area2 >= 0, 1.0, -1.0)[:, None]
+    N = np.stack([s * U[..., 1], -s * U[..., 0]], axis=-1)  # outward normal of edge i
+    Nin = np.roll(N, 1, axis=1)                              # of the edge into corner i
+    cos = np.sum(N * Nin, axis=-1, keepdims=True)
+    return P + d * (N + Nin) / np.maximum(1.0 + cos, 0.5)

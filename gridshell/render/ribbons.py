@@ -246,7 +246,6 @@ def render_ribbons(path: str | os.PathLike, axes: Sequence[np.ndarray],
 
     fig = Figure(figsize=(size[0] / dpi, size[1] / dpi), dpi=dpi)
     ax = fig.add_axes((0.01, 0.01, 0.98, 0.91 if title else 0.98))
-    painter.draw(ax, linewidth=0.2)
     xy = np.concatenate([p.reshape(-1, 2) for p in painter.polys])
     lo, hi = xy.min(axis=0), xy.max(axis=0)
     box = np.array([0.98 * size[0], (0.91 if title else 0.98) * size[1]])  # axes, pixels
@@ -255,6 +254,7 @@ def render_ribbons(path: str | os.PathLike, axes: Sequence[np.ndarray],
     ax.set_xlim(mid[0] - 0.5 * scale * box[0], mid[0] + 0.5 * scale * box[0])
     ax.set_ylim(mid[1] - 0.5 * scale * box[1], mid[1] + 0.5 * scale * box[1])
     ax.set_axis_off()
+    painter.draw(ax, linewidth=0.2)  # after the limits: it grows polygons in display pixels
     if colorbar is not None:
         from matplotlib import colormaps
         from matplotlib.cm import ScalarMappable
