@@ -1,5 +1,6 @@
 """The painter's one-array drawing (polygons padded to one corner count, matplotlib's array
-fast path, no autoscaling) paints the picture that one polygon per list entry paints."""
+fast path, no autoscaling, outlines as filled polygons) paints the picture that one stroked
+polygon per list entry paints."""
 from __future__ import annotations
 
 import io
@@ -57,9 +58,9 @@ def test_painter_draw_equals_one_polygon_at_a_time():
     fast, ref = _pixels(painter.draw), _pixels(lambda ax: _reference(painter, ax))
     diff = np.abs(fast - ref).max(axis=2)
     assert fast.std() > 10                      # something was drawn
-    # pixel noise at most: seamless polygons are grown by half the line width instead of
-    # stroked, which covers the same area up to antialiasing at the corners
-    assert np.abs(fast - ref).mean() < 0.01 and (diff > 16).mean() < 1e-3 and diff.max() <= 64
+    # antialiasing noise along the lines: the outlines are filled rings (a black one round
+    # every triangle here), not strokes; drawn without them the mean difference is ~3x
+    assert np.abs(fast - ref).mean() < 1.0 and (diff > 16).mean() < 0.03
 
     P, face, _ = painter.sorted_polygons()
     assert P.shape[1:] == (8, 2) and len(P) == len(face) == sum(len(p) for p in painter.polys)
