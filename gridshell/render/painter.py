@@ -17,7 +17,9 @@ The projection is orthographic, the camera given as matplotlib's ``(elev, azim)`
 """
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -157,7 +159,6 @@ class Painter:
         between it grown and shrunk by half the line width. The covered areas are those of a
         fill and a stroke.
         """
-        from matplotlib.collections import PolyCollection
         from matplotlib.path import Path as MplPath
 
         if not self.polys:
@@ -181,16 +182,13 @@ class Painter:
                                                   P[i][-1:] - out[i][-1:]]))
                          for j, i in zip(np.flatnonzero(ring), idx[ring])]
                 P, face = P[idx], np.where(ring[:, None], edge[idx], face[idx])
-        # an (m, k, 2) array takes matplotlib's fast path (one template path shared by all)
-        coll = PolyCollection(P, facecolors=face, edgecolors="none", linewidths=0.0)
-        if rings:   # each outline: the grown polygon and, reversed, the shrunk one (a hole)
-            k = P.shape[1]
-            loop = [MplPath.MOVETO] + [MplPath.LINETO] * (k - 1) + [MplPath.CLOSEPOLY]
-            codes = np.array(loop + loop, dtype=MplPath.code_type)
-            paths = coll.get_paths()
-            for j, verts in rings:
-                paths[j] = MplPath(verts, codes)
-        ax.add_collection(coll, autolim=False)
+        k = P.shape[1]
+        loop = [MplPath.MOVETO] + [MplPath.LINETO] * (k - 1) + [MplPath.CLOSEPOLY]
+        ring_codes = np.array(loop + loop, dtype=MplPath.code_type)
+        # each outline: the grown polygon and, reversed, the shrunk one (a hole)
+        paths = _PolygonPaths(P, {j: MplPath(v, ring_codes) for j, v in rings})
+        ax.add_collection(_array_poly_collection()(paths, facecolors=face, edgecolors="none",
+                                               linewidths=0.0), autolim=False)
 
 
 def grow_polygons(P: np.ndarray, d: float) -> np.ndarray:
@@ -210,3 +208,43 @@ def grow_polygons(P: np.ndarray, d: float) -> np.ndarray:
     Nin = np.roll(N, 1, axis=1)                              # of the edge into corner i
     cos = np.sum(N * Nin, axis=-1, keepdims=True)
     return P + d * (N + Nin) / np.maximum(1.0 + cos, 0.5)
+
+
+class _PolygonPaths(Sequence):
+    """The closed paths of polygons ``P (m, k, 2)`` made one at a time when asked for (Agg
+    converts them one by one): ``m`` matplotlib ``Path`` objects built and kept at once would
+    cost as much again in the garbage collector's sweeps as in their making. ``special``
+    replaces some by their index (the outlines)."""
+
+    def __init__(self, P: np.ndarray, special: dict[int, Any]) -> None:
+        from matplotlib.path import Path as MplPath
+
+        self._verts = np.concatenate([P, P[:, :1]], axis=1)   # closed: first corner again
+        self._template = MplPath(self._verts[0], closed=True)
+        self._codes = self._template.codes
+        self._special = special
+        self._make = MplPath._fast_from_codes_and_verts  # what PolyCollection uses
+
+    def __len__(self) -> int:
+        return len(self._verts)
+
+    def __getitem__(self, i):
+        if isinstance(i, slice):
+            return [self[j] for j in range(*i.indices(len(self)))]
+        i = range(len(self))[i]
+        if i in self._special:
+            return self._special[i]
+        return self._make(self._verts[i], self._codes, internals_from=self._template)
+
+
+def _array_poly_collection():
+    from matplotlib.collections import PolyCollection
+
+    class ArrayPolyCollection(PolyCollection):
+        """A ``PolyCollection`` drawing the paths of a :class:`_PolygonPaths`."""
+
+        def __init__(self, paths: _PolygonPaths, **kwargs) -> None:
+            super().__init__([], **kwargs)
+            self._paths = paths
+
+    return ArrayPolyCollection
