@@ -6,6 +6,7 @@ from __future__ import annotations
 import io
 
 import numpy as np
+import pytest
 
 from gridshell.render.painter import Camera, Painter, grow_polygons, strip_faces
 
@@ -111,3 +112,28 @@ def test_grown_polygons_hide_seams_as_the_stroke_does():
     # antialiasing noise along the seams (the grown corners are mitred, the stroke's round)
     assert np.abs(grown - stroked).mean() < 0.5 and np.abs(grown - stroked).max() <= 32
     assert np.abs(seams - stroked).mean() > 3 * np.abs(grown - stroked).mean()
+
+
+@pytest.mark.parametrize("tangent", [True, False])
+def test_strips_faces_are_each_strips_solid_sides(tangent):
+    """All strips at once: axis by axis, the quads of each side of strip_solid's section (each
+    side in two halves), the same numbers as one strip at a time."""
+    from gridshell.render.painter import strips_faces
+    from gridshell.strips3d import strip_solid
+
+    rng = np.random.default_rng(8)
+    axes = [np.cumsum(rng.normal(size=(k, 3)), axis=0) for k in (2, 5, 17)]
+    normals = [rng.normal(size=(len(a), 3)) for a in axes]
+    Q, side, qn = strips_faces(axes, normals, 0.2, 0.01, tangent)
+    one = [strip_faces(a, n, 0.2, 0.01, tangent) for a, n in zip(axes, normals)]
+    for got, want in zip((Q, side, qn), zip(*one)):
+        assert np.array_equal(got, np.concatenate(want))
+    for (Qa, _, _), a, n in zip(one, axes, normals):
+        V = strip_solid(a, n, 0.2, 0.01, tangent)[0].reshape(len(a), 4, 3)
+        G = Qa.reshape(8, len(a) - 1, 4, 3)
+        for s in range(4):
+            A, B = V[:, s], V[:, (s + 1) % 4]
+            M = 0.5 * (A + B)
+            for g, (X, Y) in enumerate(((A, M), (M, B))):
+                want = np.stack([X[:-1], Y[:-1], Y[1:], X[1:]], axis=1)
+                assert np.allclose(G[2 * s + g], want, atol=1e-12)

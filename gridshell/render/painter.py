@@ -23,7 +23,8 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["Camera", "Painter", "grow_polygons", "strip_faces"]
+__all__ = ["Camera", "Painter", "grow_polygons", "strip_faces", "strip_frames",
+           "strips_faces"]
 
 
 def _unit(X: np.ndarray) -> np.ndarray:
@@ -61,31 +62,78 @@ class Camera:
         return np.stack([P @ r, P @ u], axis=-1), P @ c
 
 
+def strip_frames(axes: list[np.ndarray], normals: list[np.ndarray], tangent: bool
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`gridshell.strips3d.strip_frame` of every axis ``(k_i,3)`` (metres, ``k_i >= 2``)
+    with its normals, in one vectorized pass: ``P, N, T, W, H``, each ``(sum k_i, 3)``, the
+    axis points, unit normals and frames concatenated (the same numbers as one call per axis:
+    the tangent is ``np.gradient``'s at unit spacing, central inside, one-sided at the ends)."""
+    from ..errors import InputError
+
+    sizes = np.array([len(a) for a in axes], dtype=np.int64)
+    if len(sizes) and sizes.min() < 2:
+        raise InputError("strip frame: a lamella axis needs at least 2 points")
+    P = np.concatenate([np.asarray(a, float).reshape(-1, 3) for a in axes]) if len(sizes) \
+        else np.zeros((0, 3))
+    N = _unit(np.concatenate([np.asarray(n, float).reshape(-1, 3) for n in normals])) \
+        if len(sizes) else np.zeros((0, 3))
+    if len(N) != len(P):
+        raise InputError(f"strip frame: {len(P)} axis points but {len(N)} normals")
+    first = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64)
+    last = first + sizes - 1
+    D = np.empty_like(P)
+    D[1:-1] = (P[2:] - P[:-2]) / 2.0
+    D[first] = P[first + 1] - P[first]
+    D[last] = P[last] - P[last - 1]
+    T = _unit(D)
+    if tangent:
+        W = _unit(np.cross(N, T))
+    else:
+        W = _unit(N - np.sum(N * T, axis=1, keepdims=True) * T)
+    H = _unit(np.cross(T, W))
+    return P, N, T, W, H
+
+
 def strip_faces(axis: np.ndarray, normals: np.ndarray, width: float, thickness: float,
                 tangent: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The four long sides of a strip (:func:`gridshell.strips3d.strip_solid`) as quads, each
     side split in two along its width: ``Q (8(k-1), 4, 3)``; ``side (8(k-1),)``, the signed
     distance of each quad's centre from the surface along the normal (metres; 0 for a quad in
     the surface); and that unit normal under each quad ``(8(k-1), 3)``."""
-    from ..strips3d import strip_frame
+    return strips_faces([axis], [normals], width, thickness, tangent)
 
-    P = np.asarray(axis, float).reshape(-1, 3)
-    _, W, H = strip_frame(P, normals, tangent)
-    N = _unit(np.asarray(normals, float).reshape(-1, 3))
+
+def strips_faces(axes: list[np.ndarray], normals: list[np.ndarray], width: float,
+                 thickness: float, tangent: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`strip_faces` of every axis ``(k_i,3)`` with its normals, concatenated axis by
+    axis (each axis's 8 groups of one quad per segment), in one vectorized pass."""
+    P, N, _, W, H = strip_frames(axes, normals, tangent)
+    sizes = np.array([len(a) for a in axes], dtype=np.int64)
     w, h = 0.5 * float(width) * W, 0.5 * float(thickness) * H
     corners = [-w - h, +w - h, +w + h, -w + h]  # strip_solid's order around the section
-    quads, sides, normals_q = [], [], []
+    seg = np.ones(len(P), bool)                  # points that start a segment of their axis
+    seg[np.cumsum(sizes) - 1] = False
+    i0 = np.flatnonzero(seg)
+    i1 = i0 + 1
+    nm = 0.5 * (N[i0] + N[i1])
+    quads, sides = [], []
     for a in range(4):
         A, B = corners[a], corners[(a + 1) % 4]
-        M = 0.5 * (A + B)
-        for X, Y in ((A, M), (M, B)):
-            q = np.stack([P[:-1] + X[:-1], P[:-1] + Y[:-1], P[1:] + Y[1:], P[1:] + X[1:]], axis=1)
-            quads.append(q)
-            mid = 0.25 * (X[:-1] + Y[:-1] + X[1:] + Y[1:])
-            nm = 0.5 * (N[:-1] + N[1:])
+        Mid = 0.5 * (A + B)
+        for X, Y in ((A, Mid), (Mid, B)):
+            quads.append(np.stack([P[i0] + X[i0], P[i0] + Y[i0], P[i1] + Y[i1], P[i1] + X[i1]],
+                                  axis=1))
+            mid = 0.25 * (X[i0] + Y[i0] + X[i1] + Y[i1])
             sides.append(np.sum(mid * nm, axis=1))
-            normals_q.append(nm)
-    return np.concatenate(quads), np.concatenate(sides), np.concatenate(normals_q)
+    # (8, S) group-major -> axis by axis, each axis's groups in order
+    nseg = sizes - 1
+    start = np.concatenate([[0], np.cumsum(nseg)[:-1]]).astype(np.int64)
+    lam = np.repeat(np.arange(len(sizes)), 8 * nseg)
+    within = np.arange(len(lam)) - np.repeat(8 * start, 8 * nseg)
+    g, j = within // np.repeat(nseg, 8 * nseg), within % np.repeat(nseg, 8 * nseg)
+    order = g * len(i0) + start[lam] + j
+    Q = np.concatenate(quads)[order]
+    return Q, np.concatenate(sides)[order], np.tile(nm, (8, 1))[order]
 
 
 @dataclass
@@ -112,14 +160,16 @@ class Painter:
         self.edge.append(np.broadcast_to(np.asarray(edge_rgba, float), (len(Q), 4)))
 
     def add_strip(self, Q: np.ndarray, side: np.ndarray, axis_normals: np.ndarray,
-                  rgb: np.ndarray, light: np.ndarray, bias: float, layer: float = 0.0) -> None:
+                  rgb: np.ndarray, light: np.ndarray, bias: float,
+                  layer: float | np.ndarray = 0.0) -> None:
         """Strip quads of :func:`strip_faces` (``side`` from it; ``axis_normals (m,3)`` the
         surface normal under each quad): back faces dropped, faces shaded, each placed nearer
         by ``bias`` on the viewer's side of the surface, farther on the other side.
 
         ``layer`` (metres) orders strips that lie in the surface and cross each other (GG: two
         layers bolted at the joints): positive puts this strip on the side of the normal, i.e.
-        nearer by ``layer`` where the normal faces the viewer, farther where it does not."""
+        nearer by ``layer`` where the normal faces the viewer, farther where it does not (one
+        value, or one per quad)."""
         c = self.camera.dir
         n = _unit(np.cross(Q[:, 2] - Q[:, 0], Q[:, 3] - Q[:, 1]))
         keep = n @ c > 1e-9
@@ -131,6 +181,7 @@ class Painter:
         edge = face  # no seams between the segments
         viewer_side = np.sign(axis_normals[keep] @ c)
         s = np.sign(np.where(np.abs(side[keep]) < 1e-12, 0.0, side[keep]))
+        layer = np.broadcast_to(np.asarray(layer, float), (len(Q),))[keep]
         b = np.where(s * viewer_side >= 0, bias, -bias) + layer * np.where(viewer_side >= 0, 1, -1)
         self.add(Q[keep], face, edge, b)
 

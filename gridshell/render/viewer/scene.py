@@ -34,6 +34,7 @@ import numpy as np
 
 from ...errors import InputError
 from ...strips3d import is_tangent, nearest_vertex_normals, strip_solid
+from ..painter import strip_frames
 from ..section import bundle_section
 
 __all__ = ["encode", "decode", "build_scene", "scene_json", "strip_solids_vertices",
@@ -169,27 +170,9 @@ def strip_solids_vertices(axes: list[np.ndarray], normals: list[np.ndarray], wid
     if not (np.isfinite(width) and np.isfinite(thickness) and width > 0 and thickness > 0):
         raise InputError(f"strip solid: width {width!r} and thickness {thickness!r} must be "
                          "positive lengths in metres")
-    sizes = np.array([len(a) for a in axes])
-    if len(sizes) == 0:
+    if not axes:
         return np.zeros((0, 3))
-    if sizes.min() < 2:
-        raise InputError("strip frame: a lamella axis needs at least 2 points")
-    P = np.concatenate([np.asarray(a, float).reshape(-1, 3) for a in axes])
-    N = _unit(np.concatenate([np.asarray(n, float).reshape(-1, 3) for n in normals]))
-    if len(N) != len(P):
-        raise InputError(f"strip frame: {len(P)} axis points but {len(N)} normals")
-    first = np.concatenate([[0], np.cumsum(sizes)[:-1]])
-    last = first + sizes - 1
-    D = np.empty_like(P)
-    D[1:-1] = (P[2:] - P[:-2]) / 2.0
-    D[first] = P[first + 1] - P[first]
-    D[last] = P[last] - P[last - 1]
-    T = _unit(D)
-    if tangent:
-        W = _unit(np.cross(N, T))
-    else:
-        W = _unit(N - np.sum(N * T, axis=1, keepdims=True) * T)
-    H = _unit(np.cross(T, W))
+    P, _, _, W, H = strip_frames(axes, normals, tangent)
     w, h = 0.5 * float(width) * W, 0.5 * float(thickness) * H
     return np.stack([P - w - h, P + w - h, P + w + h, P - w + h], axis=1).reshape(-1, 3)
 
