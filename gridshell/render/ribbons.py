@@ -276,10 +276,27 @@ def render_ribbons(path: str | os.PathLike, axes: Sequence[np.ndarray],
                loc="lower left", fontsize=8, frameon=False)
     if title:
         fig.suptitle(title, fontsize=max(6.0, min(10.0, size[0] / 60.0)))
-    with atomic_path(path) as tmp:
-        # zlib level 3: the same pixels, half the encoding time of the default 6, ~10 % larger
-        fig.savefig(tmp, format="png", dpi=dpi, pil_kwargs={"compress_level": 3})
+    _write_png(fig, path, dpi)
     return Path(path)
+
+
+def _write_png(fig, path: str | os.PathLike, dpi: int) -> None:
+    """``fig`` drawn once by Agg and written as PNG at ``dpi``, atomically: RGB when every pixel
+    is opaque (the same picture as ``savefig``'s RGBA, a tenth smaller and faster to encode),
+    zlib level 3 (the same pixels in half the encoding time of the default 6)."""
+    from matplotlib import __version__ as mpl_version
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from PIL import Image, PngImagePlugin
+
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    rgba = np.asarray(canvas.buffer_rgba())
+    img = rgba[..., :3] if int(rgba[..., 3].min()) == 255 else rgba
+    info = PngImagePlugin.PngInfo()
+    info.add_text("Software", f"Matplotlib version{mpl_version}, https://matplotlib.org/")
+    with atomic_path(path) as tmp:
+        Image.fromarray(np.ascontiguousarray(img)).save(tmp, format="png", compress_level=3,
+                                                        dpi=(dpi, dpi), pnginfo=info)
 
 
 def render_bundle(bundle, path: str | os.PathLike | None = None, *,
