@@ -19,9 +19,12 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
+
+from ..errors import InputError
 
 __all__ = ["Camera", "Painter", "grow_polygons", "strip_faces", "strip_frames",
            "strips_faces"]
@@ -68,8 +71,6 @@ def strip_frames(axes: list[np.ndarray], normals: list[np.ndarray], tangent: boo
     with its normals, in one vectorized pass: ``P, N, T, W, H``, each ``(sum k_i, 3)``, the
     axis points, unit normals and frames concatenated (the same numbers as one call per axis:
     the tangent is ``np.gradient``'s at unit spacing, central inside, one-sided at the ends)."""
-    from ..errors import InputError
-
     sizes = np.array([len(a) for a in axes], dtype=np.int64)
     if len(sizes) and sizes.min() < 2:
         raise InputError("strip frame: a lamella axis needs at least 2 points")
@@ -288,7 +289,10 @@ class _PolygonPaths(Sequence):
         return self._make(self._verts[i], self._codes, internals_from=self._template)
 
 
-def _array_poly_collection():
+@lru_cache(maxsize=1)
+def _array_poly_collection() -> type:
+    """The ``PolyCollection`` class drawing a :class:`_PolygonPaths` (made on first use: this
+    module does not import matplotlib)."""
     from matplotlib.collections import PolyCollection
 
     class ArrayPolyCollection(PolyCollection):
