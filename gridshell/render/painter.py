@@ -246,9 +246,10 @@ class Painter:
 def grow_polygons(P: np.ndarray, d: float) -> np.ndarray:
     """Polygons ``P (m, k, 2)`` moved outward by ``d`` (same units) along their edges' normals:
     each corner on the miter of its two edges (at most ``2 d`` from it, so a spike does not
-    shoot out); a repeated corner (zero-length edge) takes the normal of its other edge, which
-    bevels that corner. A polygon of zero area becomes a band ``2 d`` wide, as a stroke of
-    width ``2 d`` draws it."""
+    shoot out). A corner repeated (the padding of :meth:`Painter.sorted_polygons`) is cut:
+    its first copy moves along the edge before it, its last along the edge after it, copies
+    between stay in place (a notch of at most ``d``). A polygon of zero area becomes a band
+    ``2 d`` wide, as a stroke of width ``2 d`` draws it."""
     P = np.asarray(P, float)
     E = np.roll(P, -1, axis=1) - P                      # edge i runs from corner i to i + 1
     L = np.hypot(E[..., 0], E[..., 1])[..., None]
