@@ -20,8 +20,8 @@ from gridshell.errors import InputError
 from gridshell.render.report import write_report
 from gridshell.render.section import DEFAULT_CUT, bundle_section
 from gridshell.render.viewer import assets
-from gridshell.render.viewer.scene import build_scene, decode
-from gridshell.strips3d import nearest_vertex_normals
+from gridshell.render.viewer.scene import build_scene, decode, strip_solids_vertices
+from gridshell.strips3d import nearest_vertex_normals, strip_solid
 
 VENDOR = Path(assets.__file__).parent / "vendor"
 
@@ -49,6 +49,18 @@ def _structure(d: Path, bundle) -> dict:
     rec = {"lamellae": lams, "max_utilisation": 1.1, "verdict": "fail"}
     (d / "structure.json").write_text(json.dumps(rec), encoding="utf-8")
     return rec
+
+
+@pytest.mark.parametrize("tangent", [True, False])
+def test_strip_solids_vertices_equal_one_solid_per_axis(tangent):
+    rng = np.random.default_rng(3)
+    axes = [np.cumsum(rng.normal(size=(k, 3)), axis=0) for k in (2, 3, 9, 40)]
+    normals = [rng.normal(size=(len(a), 3)) for a in axes]
+    one = np.concatenate([strip_solid(a, n, 0.2, 0.01, tangent)[0]
+                          for a, n in zip(axes, normals)])
+    assert np.array_equal(strip_solids_vertices(axes, normals, 0.2, 0.01, tangent), one)
+    with pytest.raises(InputError):
+        strip_solids_vertices([axes[0][:1]], [normals[0][:1]], 0.2, 0.01, tangent)
 
 
 @pytest.fixture()

@@ -17,11 +17,17 @@ The projection is orthographic, the camera given as matplotlib's ``(elev, azim)`
 """
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
+from functools import lru_cache
+from typing import Any
 
 import numpy as np
 
-__all__ = ["Camera", "Painter", "strip_faces"]
+from ..errors import InputError
+
+__all__ = ["Camera", "Painter", "grow_polygons", "strip_faces", "strip_frames",
+           "strips_faces"]
 
 
 def _unit(X: np.ndarray) -> np.ndarray:
@@ -59,31 +65,76 @@ class Camera:
         return np.stack([P @ r, P @ u], axis=-1), P @ c
 
 
+def strip_frames(axes: list[np.ndarray], normals: list[np.ndarray], tangent: bool
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`gridshell.strips3d.strip_frame` of every axis ``(k_i,3)`` (metres, ``k_i >= 2``)
+    with its normals, in one vectorized pass: ``P, N, T, W, H``, each ``(sum k_i, 3)``, the
+    axis points, unit normals and frames concatenated (the same numbers as one call per axis:
+    the tangent is ``np.gradient``'s at unit spacing, central inside, one-sided at the ends)."""
+    sizes = np.array([len(a) for a in axes], dtype=np.int64)
+    if len(sizes) and sizes.min() < 2:
+        raise InputError("strip frame: a lamella axis needs at least 2 points")
+    P = np.concatenate([np.asarray(a, float).reshape(-1, 3) for a in axes]) if len(sizes) \
+        else np.zeros((0, 3))
+    N = _unit(np.concatenate([np.asarray(n, float).reshape(-1, 3) for n in normals])) \
+        if len(sizes) else np.zeros((0, 3))
+    if len(N) != len(P):
+        raise InputError(f"strip frame: {len(P)} axis points but {len(N)} normals")
+    first = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64)
+    last = first + sizes - 1
+    D = np.empty_like(P)
+    D[1:-1] = (P[2:] - P[:-2]) / 2.0
+    D[first] = P[first + 1] - P[first]
+    D[last] = P[last] - P[last - 1]
+    T = _unit(D)
+    if tangent:
+        W = _unit(np.cross(N, T))
+    else:
+        W = _unit(N - np.sum(N * T, axis=1, keepdims=True) * T)
+    H = _unit(np.cross(T, W))
+    return P, N, T, W, H
+
+
 def strip_faces(axis: np.ndarray, normals: np.ndarray, width: float, thickness: float,
                 tangent: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The four long sides of a strip (:func:`gridshell.strips3d.strip_solid`) as quads, each
     side split in two along its width: ``Q (8(k-1), 4, 3)``; ``side (8(k-1),)``, the signed
     distance of each quad's centre from the surface along the normal (metres; 0 for a quad in
     the surface); and that unit normal under each quad ``(8(k-1), 3)``."""
-    from ..strips3d import strip_frame
+    return strips_faces([axis], [normals], width, thickness, tangent)
 
-    P = np.asarray(axis, float).reshape(-1, 3)
-    _, W, H = strip_frame(P, normals, tangent)
-    N = _unit(np.asarray(normals, float).reshape(-1, 3))
+
+def strips_faces(axes: list[np.ndarray], normals: list[np.ndarray], width: float,
+                 thickness: float, tangent: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`strip_faces` of every axis ``(k_i,3)`` with its normals, concatenated axis by
+    axis (each axis's 8 groups of one quad per segment), in one vectorized pass."""
+    P, N, _, W, H = strip_frames(axes, normals, tangent)
+    sizes = np.array([len(a) for a in axes], dtype=np.int64)
     w, h = 0.5 * float(width) * W, 0.5 * float(thickness) * H
     corners = [-w - h, +w - h, +w + h, -w + h]  # strip_solid's order around the section
-    quads, sides, normals_q = [], [], []
+    seg = np.ones(len(P), bool)                  # points that start a segment of their axis
+    seg[np.cumsum(sizes) - 1] = False
+    i0 = np.flatnonzero(seg)
+    i1 = i0 + 1
+    nm = 0.5 * (N[i0] + N[i1])
+    quads, sides = [], []
     for a in range(4):
         A, B = corners[a], corners[(a + 1) % 4]
-        M = 0.5 * (A + B)
-        for X, Y in ((A, M), (M, B)):
-            q = np.stack([P[:-1] + X[:-1], P[:-1] + Y[:-1], P[1:] + Y[1:], P[1:] + X[1:]], axis=1)
-            quads.append(q)
-            mid = 0.25 * (X[:-1] + Y[:-1] + X[1:] + Y[1:])
-            nm = 0.5 * (N[:-1] + N[1:])
+        Mid = 0.5 * (A + B)
+        for X, Y in ((A, Mid), (Mid, B)):
+            quads.append(np.stack([P[i0] + X[i0], P[i0] + Y[i0], P[i1] + Y[i1], P[i1] + X[i1]],
+                                  axis=1))
+            mid = 0.25 * (X[i0] + Y[i0] + X[i1] + Y[i1])
             sides.append(np.sum(mid * nm, axis=1))
-            normals_q.append(nm)
-    return np.concatenate(quads), np.concatenate(sides), np.concatenate(normals_q)
+    # (8, S) group-major -> axis by axis, each axis's groups in order
+    nseg = sizes - 1
+    start = np.concatenate([[0], np.cumsum(nseg)[:-1]]).astype(np.int64)
+    lam = np.repeat(np.arange(len(sizes)), 8 * nseg)
+    within = np.arange(len(lam)) - np.repeat(8 * start, 8 * nseg)
+    g, j = within // np.repeat(nseg, 8 * nseg), within % np.repeat(nseg, 8 * nseg)
+    order = g * len(i0) + start[lam] + j
+    Q = np.concatenate(quads)[order]
+    return Q, np.concatenate(sides)[order], np.tile(nm, (8, 1))[order]
 
 
 @dataclass
@@ -110,14 +161,16 @@ class Painter:
         self.edge.append(np.broadcast_to(np.asarray(edge_rgba, float), (len(Q), 4)))
 
     def add_strip(self, Q: np.ndarray, side: np.ndarray, axis_normals: np.ndarray,
-                  rgb: np.ndarray, light: np.ndarray, bias: float, layer: float = 0.0) -> None:
+                  rgb: np.ndarray, light: np.ndarray, bias: float,
+                  layer: float | np.ndarray = 0.0) -> None:
         """Strip quads of :func:`strip_faces` (``side`` from it; ``axis_normals (m,3)`` the
         surface normal under each quad): back faces dropped, faces shaded, each placed nearer
         by ``bias`` on the viewer's side of the surface, farther on the other side.
 
         ``layer`` (metres) orders strips that lie in the surface and cross each other (GG: two
         layers bolted at the joints): positive puts this strip on the side of the normal, i.e.
-        nearer by ``layer`` where the normal faces the viewer, farther where it does not."""
+        nearer by ``layer`` where the normal faces the viewer, farther where it does not (one
+        value, or one per quad)."""
         c = self.camera.dir
         n = _unit(np.cross(Q[:, 2] - Q[:, 0], Q[:, 3] - Q[:, 1]))
         keep = n @ c > 1e-9
@@ -129,6 +182,7 @@ class Painter:
         edge = face  # no seams between the segments
         viewer_side = np.sign(axis_normals[keep] @ c)
         s = np.sign(np.where(np.abs(side[keep]) < 1e-12, 0.0, side[keep]))
+        layer = np.broadcast_to(np.asarray(layer, float), (len(Q),))[keep]
         b = np.where(s * viewer_side >= 0, bias, -bias) + layer * np.where(viewer_side >= 0, 1, -1)
         self.add(Q[keep], face, edge, b)
 
@@ -146,12 +200,107 @@ class Painter:
 
     def draw(self, ax, linewidth: float = 0.2) -> None:
         """Paint everything, far to near, into a 2D matplotlib ``ax`` (one collection; its
-        limits are the caller's: the collection does not autoscale the axes)."""
-        from matplotlib.collections import PolyCollection
+        limits are the caller's and must be set before: the collection does not autoscale
+        the axes).
+
+        Each polygon is outlined by a line ``linewidth`` points wide in its edge colour, drawn
+        as fills only (Agg's stroke takes as long as the fills; offsets by
+        :func:`grow_polygons` in display pixels at the axes' limits and the figure's dpi): a
+        polygon whose edge colour is its face colour (no seams between neighbours) is grown
+        by half the line width; any other is filled, then its outline is filled as the ring
+        between it grown and shrunk by half the line width. The covered areas are those of a
+        fill and a stroke.
+        """
+        from matplotlib.path import Path as MplPath
 
         if not self.polys:
             return
         P, face, edge = self.sorted_polygons()
-        # an (m, k, 2) array takes matplotlib's fast path (one template path shared by all)
-        coll = PolyCollection(P, facecolors=face, edgecolors=edge, linewidths=linewidth)
-        ax.add_collection(coll, autolim=False)
+        rings: list[tuple[int, np.ndarray]] = []
+        if linewidth > 0:
+            M = ax.transData.get_matrix()[:2, :2]   # data -> display pixels (linear axes)
+            half_px = 0.5 * float(linewidth) * ax.figure.dpi / 72.0
+            outlined = ~np.all(face == edge, axis=1)
+            X = P @ M.T
+            out = (grow_polygons(X, 1.0) - X) @ np.linalg.inv(M).T * half_px  # outward
+            P = np.where(outlined[:, None, None], P, P + out)
+            if np.any(outlined):
+                copies = np.where(outlined, 2, 1)
+                idx = np.repeat(np.arange(len(P)), copies)
+                ring = np.zeros(len(idx), bool)    # the outline after an outlined polygon
+                ring[np.cumsum(copies)[outlined] - 1] = True
+                rings = [(int(j), np.concatenate([P[i] + out[i], P[i][:1] + out[i][:1],
+                                                  (P[i] - out[i])[::-1],
+                                                  P[i][-1:] - out[i][-1:]]))
+                         for j, i in zip(np.flatnonzero(ring), idx[ring])]
+                P, face = P[idx], np.where(ring[:, None], edge[idx], face[idx])
+        k = P.shape[1]
+        loop = [MplPath.MOVETO] + [MplPath.LINETO] * (k - 1) + [MplPath.CLOSEPOLY]
+        ring_codes = np.array(loop + loop, dtype=MplPath.code_type)
+        # each outline: the grown polygon and, reversed, the shrunk one (a hole)
+        paths = _PolygonPaths(P, {j: MplPath(v, ring_codes) for j, v in rings})
+        ax.add_collection(_array_poly_collection()(paths, facecolors=face, edgecolors="none",
+                                               linewidths=0.0), autolim=False)
+
+
+def grow_polygons(P: np.ndarray, d: float) -> np.ndarray:
+    """Polygons ``P (m, k, 2)`` moved outward by ``d`` (same units) along their edges' normals:
+    each corner on the miter of its two edges (at most ``2 d`` from it, so a spike does not
+    shoot out). A corner repeated (the padding of :meth:`Painter.sorted_polygons`) is cut:
+    its first copy moves along the edge before it, its last along the edge after it, copies
+    between stay in place (a notch of at most ``d``). A polygon of zero area becomes a band
+    ``2 d`` wide, as a stroke of width ``2 d`` draws it."""
+    P = np.asarray(P, float)
+    E = np.roll(P, -1, axis=1) - P                      # edge i runs from corner i to i + 1
+    L = np.hypot(E[..., 0], E[..., 1])[..., None]
+    U = np.divide(E, L, out=np.zeros_like(E), where=L > 0)
+    x, y = P[..., 0], P[..., 1]
+    area2 = np.sum(x * np.roll(y, -1, axis=1) - np.roll(x, -1, axis=1) * y, axis=1)
+    s = np.where(area2 >= 0, 1.0, -1.0)[:, None]
+    N = np.stack([s * U[..., 1], -s * U[..., 0]], axis=-1)  # outward normal of edge i
+    Nin = np.roll(N, 1, axis=1)                              # of the edge into corner i
+    cos = np.sum(N * Nin, axis=-1, keepdims=True)
+    return P + d * (N + Nin) / np.maximum(1.0 + cos, 0.5)
+
+
+class _PolygonPaths(Sequence):
+    """The closed paths of polygons ``P (m, k, 2)`` made one at a time when asked for (Agg
+    converts them one by one): ``m`` matplotlib ``Path`` objects built and kept at once would
+    cost as much again in the garbage collector's sweeps as in their making. ``special``
+    replaces some by their index (the outlines)."""
+
+    def __init__(self, P: np.ndarray, special: dict[int, Any]) -> None:
+        from matplotlib.path import Path as MplPath
+
+        self._verts = np.concatenate([P, P[:, :1]], axis=1)   # closed: first corner again
+        self._template = MplPath(self._verts[0], closed=True)
+        self._codes = self._template.codes
+        self._special = special
+        self._make = MplPath._fast_from_codes_and_verts  # what PolyCollection uses
+
+    def __len__(self) -> int:
+        return len(self._verts)
+
+    def __getitem__(self, i):
+        if isinstance(i, slice):
+            return [self[j] for j in range(*i.indices(len(self)))]
+        i = range(len(self))[i]
+        if i in self._special:
+            return self._special[i]
+        return self._make(self._verts[i], self._codes, internals_from=self._template)
+
+
+@lru_cache(maxsize=1)
+def _array_poly_collection() -> type:
+    """The ``PolyCollection`` class drawing a :class:`_PolygonPaths` (made on first use: this
+    module does not import matplotlib)."""
+    from matplotlib.collections import PolyCollection
+
+    class ArrayPolyCollection(PolyCollection):
+        """A ``PolyCollection`` drawing the paths of a :class:`_PolygonPaths`."""
+
+        def __init__(self, paths: _PolygonPaths, **kwargs) -> None:
+            super().__init__([], **kwargs)
+            self._paths = paths
+
+    return ArrayPolyCollection
