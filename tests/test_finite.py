@@ -186,3 +186,16 @@ def test_rhino_export_refuses_non_finite_geometry(tmp_path):
     assert list(tmp_path.iterdir()) == []
     export_3dm(make_bundle("GG"), tmp_path / "m.3dm")
     assert (tmp_path / "m.3dm").stat().st_size > 0
+
+
+@pytest.mark.parametrize("text", [
+    b"10\n1.5\n20\n2.25\n", b"v 0 0 nan\n", b"v NaN", b"-INF", b"+Infinity 1", b"iNf",
+    b"information nanometres", b"\xc3\xa9nan\xff", b"x_nan inf_y", b"", b"N\nA\nN",
+])
+def test_prefilter_gives_the_token_scan_answer(tmp_path, text):
+    """The cheap "nan" / "inf" look-up before the token scan changes no answer."""
+    m = finite._TOKEN.search(text)
+    nl = b"\n"
+    want = None if m is None else \
+        f"'{m.group(0).decode(errors='replace')}' at line {text.count(nl, 0, m.start()) + 1}"
+    assert finite.problem(tmp_path / "a.dxf", text) == want
