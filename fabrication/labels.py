@@ -108,13 +108,12 @@ def strip_labels(strip: Strip, params: FabParams,
             continue
         text = ",".join(str(i) for i in nb)
         h = h0
+        # the next occupied stretch after the joint (occupied grows only when placed)
+        limit = min([a for a, _ in occupied if a > s_j + 1e-9] + [strip.s1 - 1.0])
         while h >= MIN_HEIGHT:
             L = text_length(text, h)
             s_c = s_j + pad + L / 2
-            nxt = [a for a, _ in occupied if a > s_j + 1e-9]
-            limit = min(nxt + [strip.s1 - 1.0])
-            lines = place_text(strip, text, h, s_c, band_t)
-            if s_c + L / 2 <= limit and fits(lines):
+            if s_c + L / 2 <= limit and fits(lines := place_text(strip, text, h, s_c, band_t)):
                 strokes += lines
                 occupied.append((s_j + pad, s_c + L / 2 + 1.0))
                 break
