@@ -109,8 +109,10 @@ def write_plan(path_png: str | Path, path_svg: str | Path, net: Net, title: str 
     """Write the plan as PNG and SVG, atomically (SVG text kept as text)."""
     import matplotlib
 
+    from .preview import PNG_LEVEL
+
     fig = plan_figure(net, title)
     with atomic_path(path_png) as tmp:
-        fig.savefig(tmp, format="png", dpi=150)
+        fig.savefig(tmp, format="png", dpi=150, pil_kwargs={"compress_level": PNG_LEVEL})
     with atomic_path(path_svg) as tmp, matplotlib.rc_context({"svg.fonttype": "none"}):
         fig.savefig(tmp, format="svg", metadata={"Date": None})

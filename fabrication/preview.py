@@ -29,6 +29,9 @@ TITLE_PX = 30             # band above the sheet for the title
 SHEET_FILL = "#F3EFE4"    # the material
 SHEET_EDGE = "#8C8C8C"
 LINE_WIDTH = {"CUT": 0.7, "SCORE": 0.7, "ENGRAVE": 0.5}   # points
+#: zlib level of the PNG files (lossless, the same pixels at any level): 3 encodes these
+#: drawings in ~60 % of the time of PIL's default 6, files within a few per cent
+PNG_LEVEL = 3
 
 
 def circle_polylines(centres: np.ndarray, radii: np.ndarray, n: int = 32) -> np.ndarray:
@@ -94,6 +97,6 @@ def write_sheet_png(path: str | FsPath, parts: list[Part], sheet: tuple[float, f
     """Write one sheet's preview PNG to ``path``, atomically."""
     fig = sheet_figure(parts, sheet, params, title)
     with atomic_path(path) as tmp:
-        fig.savefig(tmp, format="png", dpi=DPI,
+        fig.savefig(tmp, format="png", dpi=DPI, pil_kwargs={"compress_level": PNG_LEVEL},
                     metadata={"Title": title, "Description": "cut sheet preview: CUT red, "
                               "SCORE blue, ENGRAVE black; lengths in mm"})

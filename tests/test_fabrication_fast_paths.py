@@ -152,3 +152,27 @@ def test_drop_passes_stopped_early_give_the_same_layout(kind, monkeypatch):
     for p, q in zip(a.parts, b.parts):
         np.testing.assert_array_equal(p.outline.V, q.outline.V)
     assert any(stopped) == (kind == "CNC")   # (the GG case: one pass reaches the floor)
+
+
+def test_png_level_keeps_the_pixels(tmp_path, monkeypatch):
+    """The sheet previews and the plan at zlib level 3: the same pixels (and metadata) as
+    at PIL's default level 6."""
+    from PIL import Image
+
+    from fabrication import plan, preview
+
+    parts, params = _parts("GG", 4, 5)
+    layout = nesting.nest(parts, params)
+    net = make_bundle("GG", nr=4, nc=5).net
+    files = {}
+    for level in (preview.PNG_LEVEL, 6):
+        monkeypatch.setattr(preview, "PNG_LEVEL", level)
+        d = tmp_path / str(level)
+        preview.write_sheet_png(d / "s.png", layout.on_sheet(0), layout.sheet, params, "t")
+        plan.write_plan(d / "p.png", d / "p.svg", net, "t")
+        files[level] = [d / "s.png", d / "p.png"]
+    for a, b in zip(files[3], files[6]):
+        assert a.read_bytes() != b.read_bytes()           # the level was applied
+        ia, ib = Image.open(a), Image.open(b)
+        assert ia.info == ib.info
+        np.testing.assert_array_equal(np.asarray(ia), np.asarray(ib))
