@@ -28,10 +28,14 @@ class LineAxis:
     radius = None
 
     def point(self, s, t):
+        if isinstance(s, float) and isinstance(t, float):   # one point (labels): same array
+            return np.array([s, t])
         s, t = np.broadcast_arrays(np.asarray(s, float), np.asarray(t, float))
         return np.stack([s, t], axis=-1)
 
     def tangent(self, s):
+        if isinstance(s, float):
+            return np.array([1.0, 0.0])
         s = np.asarray(s, float)
         return np.stack([np.ones_like(s), np.zeros_like(s)], axis=-1)
 

@@ -176,3 +176,14 @@ def test_png_level_keeps_the_pixels(tmp_path, monkeypatch):
         ia, ib = Image.open(a), Image.open(b)
         assert ia.info == ib.info
         np.testing.assert_array_equal(np.asarray(ia), np.asarray(ib))
+
+
+def test_line_axis_one_point_equals_the_array_path():
+    from fabrication.axis import LineAxis
+
+    ax = LineAxis()
+    for s, t in [(0.0, 0.0), (12.25, -3.5), (np.float64(7.1), 2.0), (-0.0, 1e-300)]:
+        got, want = ax.point(s, t), ax.point(np.array(s), np.array(t))
+        assert got.dtype == want.dtype and got.shape == want.shape == (2,)
+        np.testing.assert_array_equal(got, want)
+        np.testing.assert_array_equal(ax.tangent(s), ax.tangent(np.array(s)))
