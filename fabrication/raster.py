@@ -28,7 +28,6 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.fft
-import scipy.ndimage
 import shapely
 import shapely.affinity
 from shapely.geometry import Polygon
@@ -72,6 +71,8 @@ def depth(mask: np.ndarray) -> float:
     """The largest Euclidean distance (pixels) of a pixel of the boolean ``mask`` to the
     nearest pixel outside it (outside the image counts as outside); 0 for an empty mask. A
     mask that fits inside another by a translation is at most as deep as it."""
+    import scipy.ndimage      # here: ~0.1 s to import, and only raster passes need it
+
     rows, cols = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
     if not len(rows):
         return 0.0
