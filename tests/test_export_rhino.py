@@ -233,7 +233,7 @@ def test_layers_objects_and_user_strings(tmp_path):
     assert objs["joints"][5].Attributes.GetUserString("lamellae").split() == ["1", str(N + 1)]
     # holes: 3 mm / 0.1 = 30 mm through each strip at its joints
     hole = objs["holes"][0]
-    assert isinstance(hole.Geometry, rhino3dm.Brep) and hole.Geometry.IsSolid
+    assert isinstance(hole.Geometry, rhino3dm.Extrusion) and hole.Geometry.IsSolid
     assert float(hole.Attributes.GetUserString("diameter")) == pytest.approx(0.03)
     bb = hole.Geometry.GetBoundingBox()
     centre = np.array([(bb.Min.X + bb.Max.X) / 2, (bb.Min.Y + bb.Max.Y) / 2,
@@ -376,3 +376,54 @@ def test_unwelded_sides_and_edge_axis(tmp_path):
     foot, _ = _foot(c, lam.axis)
     off = np.sum(A * np.sum((c - foot) * _paraboloid_normal(foot), axis=1)) / A.sum()
     assert abs(off) == pytest.approx(0.1, rel=0.05)       # centred: 0 (see above)
+
+
+def _face_points(face, n=7):
+    """Points ``(n * n, 3)`` of a Brep face's (untrimmed) surface over its domain."""
+    du, dv = face.Domain(0), face.Domain(1)
+    out = [face.PointAt(u, v) for u in np.linspace(du.T0, du.T1, n)
+           for v in np.linspace(dv.T0, dv.T1, n)]
+    return np.array([[p.X, p.Y, p.Z] for p in out])
+
+
+def test_hole_cylinder_is_the_capped_cylinder():
+    """The hole (an Extrusion) is the capped cylinder of the Brep it replaces: a closed solid
+    of a side and two caps, the side at the radius from the axis over exactly +-h/2, the
+    caps in the planes +-h/2, the edges the circles there (and the seam); the same holds for
+    Cylinder.ToBrep (what the holes were)."""
+    from gridshell.export.rhino_geometry import cylinder
+
+    c, a, r, h = np.array([0.3, -0.2, 0.7]), np.array([1.0, 2.0, -0.5]), 0.015, 0.01
+    e = cylinder(c, a, r, h)
+    a = a / np.linalg.norm(a)
+    base = c - 0.5 * h * a
+    circ = rhino3dm.Circle(rhino3dm.Point3d(*base.tolist()), r)
+    circ.Plane = rhino3dm.Plane(rhino3dm.Point3d(*base.tolist()), rhino3dm.Vector3d(*a))
+    old = rhino3dm.Cylinder(circ, h).ToBrep(True, True)
+    new = e.ToBrep(False)
+    assert e.IsSolid and new.IsSolid and len(new.Faces) == len(old.Faces) == 3
+
+    def local(X):
+        X = X - c
+        along = X @ a
+        return along, np.linalg.norm(X - along[:, None] * a, axis=1)
+
+    for brep in (new, old):
+        kinds = []
+        for face in brep.Faces:
+            along, radial = local(_face_points(face))
+            if np.ptp(along) < 1e-12:                      # a cap: a plane at +-h/2
+                kinds.append(round(float(along[0]) / h, 9))
+            else:                                          # the side
+                np.testing.assert_allclose(radial, r, rtol=1e-9)
+                assert (along.min(), along.max()) == pytest.approx((-h / 2, h / 2), abs=1e-12)
+                kinds.append("side")
+        assert sorted(map(str, kinds)) == ["-0.5", "0.5", "side"]
+        for edge in brep.Edges:
+            d = edge.Domain
+            along, radial = local(np.array([[p.X, p.Y, p.Z] for p in (
+                edge.PointAt(x) for x in np.linspace(d.T0, d.T1, 9))]))
+            np.testing.assert_allclose(radial, r, rtol=1e-9)
+            circle = np.ptp(along) < 1e-12            # else the side's seam, a line
+            assert abs(abs(along[0]) - h / 2) < 1e-12 if circle else np.ptp(along) == \
+                pytest.approx(h, abs=1e-12)

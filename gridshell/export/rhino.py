@@ -21,8 +21,9 @@ moved. Lengths in user strings are in the same unit (``units`` names it) and in 
     family 3          the same for C^3
     axes              one polyline per lamella axis (the design's centre line)
     joints            one point per joint (user strings joint_id, lamellae)
-    holes             joint style "hole": one capped cylinder per lamella and joint, the hole
-                      through the strip (real diameter = hole / scale)
+    holes             joint style "hole": one capped cylinder (an Extrusion, as Rhino makes
+                      cylinders) per lamella and joint, the hole through the strip (real
+                      diameter = hole / scale)
     collapsed         the collapsed (aligned) state: one polyline per lamella through its
                       aligned joints (aligned.obj)
     revolution        GG: the isometric surface of revolution as a mesh
@@ -214,11 +215,11 @@ def _strips(m: _Model, bundle, params, with_holes: bool) -> dict[str, Any]:
         centres = np.stack([np.interp(js, s, C[:, c]) for c in range(3)], axis=1)
         axes = np.stack([np.interp(js, s, H[:, c]) for c in range(3)], axis=1)
         for j, c, a in zip(lam.joints.tolist(), centres, axes):
-            brep = geo.cylinder_brep(m.u(c), a, radius / m.units.metres_per_unit,
-                                     t / m.units.metres_per_unit)
-            m.model.Objects.AddBrep(brep, m.attrs("holes", f"L{lam.id} J{j} hole",
-                                                  lamella_id=int(lam.id), joint_id=j,
-                                                  diameter=m.fmt(2 * radius)))
+            hole = geo.cylinder(m.u(c), a, radius / m.units.metres_per_unit,
+                                t / m.units.metres_per_unit)
+            m.model.Objects.AddExtrusion(hole, m.attrs("holes", f"L{lam.id} J{j} hole",
+                                                       lamella_id=int(lam.id), joint_id=j,
+                                                       diameter=m.fmt(2 * radius)))
             n_holes += 1
     return {"strips": len(lams), "holes": n_holes, "width_m": w, "thickness_m": t}
 
