@@ -427,3 +427,51 @@ def test_hole_cylinder_is_the_capped_cylinder():
             circle = np.ptp(along) < 1e-12            # else the side's seam, a line
             assert abs(abs(along[0]) - h / 2) < 1e-12 if circle else np.ptp(along) == \
                 pytest.approx(h, abs=1e-12)
+
+
+@pytest.mark.parametrize("kind", ["GG", "CNC"])
+def test_strip_solids_have_only_the_rings_they_need(tmp_path, kind):
+    """The strip meshes go through fewer rings than the axis has samples (solid_rings), and
+    every full-resolution corner edge (the frame of the axis samples, as the export builds
+    it) lies within ring_tolerance of the mesh's corner edge; the axis layer keeps every
+    sample. The axes are the test bundle's, 8 times as densely sampled."""
+    from gridshell.export.rhino import _clean_polyline
+    from gridshell.igl_adapter import closest_points_with_normals
+    from gridshell.strips3d import is_tangent, ring_tolerance, strip_frame
+
+    b = make_bundle(kind)
+    for lam in b.net.lamellae:       # 8 samples per span of the axis: straight stretches
+        A = np.asarray(lam.axis, float)
+        s = np.linspace(0.0, len(A) - 1, 8 * (len(A) - 1) + 1)
+        lam.axis = np.stack([np.interp(s, np.arange(len(A)), A[:, c]) for c in range(3)], 1)
+    info = write_3dm(b, tmp_path / "r.3dm", sheets=False)
+    w, t = info["strip_width_m"], info["strip_thickness_m"]
+    _, _, objs = _read(tmp_path / "r.3dm")
+    rings = samples = 0
+    for fam in (1, 3):
+        for obj, lam in zip(objs[f"family {fam}"], b.net.family(fam)):
+            P = _clean_polyline(lam.axis)
+            N = closest_points_with_normals(P, b.surface_V, b.surface_F)[1]
+            _, W, H = strip_frame(P, N, is_tangent(kind))
+            if kind == "GG":
+                P = P + (0.5 * t if fam == 1 else -0.5 * t) * H
+                _, W, H = strip_frame(P, N, True)
+            hw, ht = 0.5 * w * W, 0.5 * t * H
+            full = [P - hw - ht, P + hw - ht, P + hw + ht, P - hw + ht]
+            V, _ = _mesh_arrays(obj.Geometry)
+            n = (len(V) - 8) // 8                  # unwelded: 4 sides of 2 n, 2 caps of 4
+            side0, side2 = V[:2 * n].reshape(n, 2, 3), V[4 * n:6 * n].reshape(n, 2, 3)
+            simple = [side0[:, 0], side0[:, 1], side2[:, 0], side2[:, 1]]
+            for c in range(4):
+                Q = simple[c]
+                A, B = Q[:-1][None], Q[1:][None]
+                D = B - A
+                u = np.clip(np.einsum("nmi,nmi->nm", full[c][:, None] - A, D)
+                            / np.einsum("nmi,nmi->nm", D, D), 0.0, 1.0)
+                d = np.linalg.norm(full[c][:, None] - A - u[..., None] * D, axis=-1).min(axis=1)
+                assert d.max() <= ring_tolerance(t) * (1 + 1e-9) + 1e-12
+            rings, samples = rings + n, samples + len(P)
+    axes = {int(o.Attributes.GetUserString("lamella_id")): o for o in objs["axes"]}
+    for lam in b.net.lamellae:
+        assert len(_points(axes[lam.id].Geometry)) == len(_clean_polyline(lam.axis))
+    assert rings < samples / 2
