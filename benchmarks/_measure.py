@@ -99,3 +99,16 @@ def run_worker(script: str | Path, args: list[str], timeout: float) -> dict | No
         err = (p.stderr.strip().splitlines() or ["exit code %d" % p.returncode])[-1]
         return {"error": err}
     return json.loads(lines[-1])
+
+
+def compile_tree(root: Path) -> None:
+    """Compile the bytecode of ``root``'s packages (``gridshell``, ``fabrication``), as ``pip
+    install`` does: with ``PYTHONDONTWRITEBYTECODE`` set and no ``__pycache__``, a module
+    imported lazily inside a timed call would be compiled from source inside it (~0.05-0.2 s
+    a row), a cost an installed package does not have."""
+    import compileall
+
+    for pkg in ("gridshell", "fabrication"):
+        if (Path(root) / pkg).is_dir():
+            compileall.compile_dir(str(Path(root) / pkg), quiet=1)
+

@@ -26,6 +26,9 @@ import numpy as np
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
+sys.path.insert(0, str(HERE))
+
+from _measure import compile_tree  # noqa: E402
 
 
 def run(root: Path, stage: str, index: int, timeout: float, runner: Path | None = None) -> dict:
@@ -67,6 +70,8 @@ def main(argv: list[str] | None = None) -> None:
     a = ap.parse_args(argv)
     base = Path(a.base).resolve()
     base_runner = base / "benchmarks" / "run_all.py" if a.own_runner else None
+    for root in (base, ROOT):                 # bytecode, as an installed package has it
+        compile_tree(root)
     out = []
     print(f"{'stage':<16} {'size':>4} {'base wall':>10} {'base cpu':>9} {'this wall':>10} "
           f"{'this cpu':>9} {'ratio':>9}")

@@ -42,3 +42,17 @@ def test_median_of_repeats_skips_failed_runs():
             {"seconds": 1.0, "cpu_seconds": 4.0}, {"seconds": 2.0, "cpu_seconds": 3.0}]
     assert sbs.median(runs) == {"seconds": 2.0, "cpu_seconds": 3.0}
     assert sbs.median([{"error": "x"}, {"error": "y"}]) == {"error": "x"}
+
+
+def test_trees_are_compiled_before_measuring(tmp_path):
+    """compile_tree writes the bytecode of gridshell/ and fabrication/ (PYTHONDONTWRITEBYTECODE
+    aside), so lazily imported modules are not compiled inside a timed call."""
+    import importlib.util as iu
+
+    sbs = _module()
+    for pkg in ("gridshell", "fabrication"):
+        (tmp_path / pkg).mkdir()
+        (tmp_path / pkg / "late.py").write_text("X = 1\n")
+    sbs.compile_tree(tmp_path)
+    for pkg in ("gridshell", "fabrication"):
+        assert (tmp_path / pkg / iu.cache_from_source("late.py")).is_file()
