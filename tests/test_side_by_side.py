@@ -12,27 +12,33 @@ def _module():
     return mod
 
 
-def test_own_runner_runs_the_base_script_in_its_checkout(tmp_path):
+def test_own_runner_builds_the_base_row_and_measures_it_here(tmp_path):
+    """--own-runner: the row as the base's run_all.py defines it (setup(param) of its STAGES),
+    run in the base checkout with its PYTHONPATH, timed by this checkout's measure (CPU too)."""
     sbs = _module()
     (tmp_path / "benchmarks").mkdir()
     runner = tmp_path / "benchmarks" / "run_all.py"
-    # the base's own worker: reports its working directory and PYTHONPATH through the figures
     runner.write_text(
-        "import json, os, sys\n"
-        "assert sys.argv[1:] == ['--worker', 'phlw', '1'], sys.argv\n"
-        "print('noise line')\n"
-        "print(json.dumps({'seconds': 2.5, 'cwd_ok': float(os.getcwd() == %r),\n"
-        "                  'path_ok': float(os.environ['PYTHONPATH'] == %r)}))\n"
-        % (str(tmp_path), str(tmp_path)))
+        "import os, time\n"
+        "from types import SimpleNamespace as NS\n"
+        "def setup(param):\n"
+        "    def call():\n"
+        "        t = time.process_time()\n"
+        "        while time.process_time() - t < param:\n"
+        "            pass\n"
+        "        open('ran.txt', 'w').write(os.getcwd() + '|' + os.environ['PYTHONPATH'])\n"
+        "    return call\n"
+        "BY_NAME = {'phlw': NS(setup=setup, sizes=[NS(param=0.0), NS(param=0.2)])}\n")
     r = sbs.run(tmp_path, "phlw", 1, 60.0, runner)
-    assert r == {"seconds": 2.5, "cwd_ok": 1.0, "path_ok": 1.0}
+    assert r["cpu_seconds"] >= 0.19 and r["seconds"] >= r["cpu_seconds"] * 0.9
+    assert (tmp_path / "ran.txt").read_text() == f"{tmp_path}|{tmp_path}"
 
 
 def test_failed_worker_reports_its_last_error_line(tmp_path):
     sbs = _module()
     (tmp_path / "benchmarks").mkdir()
     runner = tmp_path / "benchmarks" / "run_all.py"
-    runner.write_text("import sys\nsys.exit('ImportError: no such name')\n")
+    runner.write_text("raise ImportError('no such name')\n")
     assert sbs.run(tmp_path, "outputs", 0, 60.0, runner) == {"error": "ImportError: no such name"}
 
 
