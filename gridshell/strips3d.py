@@ -19,7 +19,7 @@ import numpy as np
 from .errors import InputError
 
 __all__ = ["TANGENT_KINDS", "is_tangent", "nearest_vertex_normals", "strip_frame",
-           "strip_solid", "real_section_m"]
+           "strip_solid", "solid_rings", "ring_tolerance", "real_section_m"]
 
 #: design kinds whose lamellae lie tangent to the surface (the others stand on it)
 TANGENT_KINDS = ("GG",)
@@ -112,6 +112,61 @@ def strip_solid(axis: np.ndarray, normals: np.ndarray, width: float, thickness: 
                            [last, last + 1, last + 2], [last, last + 2, last + 3]]))
     F = np.concatenate(faces).astype(np.int64)
     return V, F
+
+
+def ring_tolerance(thickness: float) -> float:
+    """How far (metres) a corner edge of a strip solid with fewer rings may deviate from the
+    full-resolution one (:func:`solid_rings`): 1 % of the strip's real ``thickness``
+    (metres) or 0.05 mm (5e-5 m) at real size, whichever is smaller."""
+    return min(0.01 * float(thickness), 5e-5)
+
+
+def _segment_distance(X: np.ndarray, A: np.ndarray, B: np.ndarray) -> np.ndarray:
+    """Distances ``(...)`` of the points ``X (...,3)`` to the segments ``A B (...,3)``."""
+    D = B - A
+    dd = np.einsum("...i,...i->...", D, D)
+    u = np.einsum("...i,...i->...", X - A, D)
+    u = np.clip(np.divide(u, dd, out=np.zeros_like(u), where=dd > 0), 0.0, 1.0)
+    return np.linalg.norm(X - A - u[..., None] * D, axis=-1)
+
+
+def solid_rings(axis: np.ndarray, W: np.ndarray, H: np.ndarray, width: float,
+                thickness: float, tol: float | None = None) -> np.ndarray:
+    """The indices (ascending, ``int64``) of the axis samples a strip solid needs: the
+    cross-sections at the other samples lie, within ``tol`` metres, on the solid through
+    these ones.
+
+    Ramer-Douglas-Peucker on the four corner polylines at once (``axis +- width/2 W +-
+    thickness/2 H``, metres, the order of :func:`strip_solid`), vectorized level by level: a
+    span between two kept samples is split at its sample farthest from the chords of the
+    span (the largest of the four corners' distances) while that distance exceeds ``tol``.
+    So every full-resolution corner point lies within ``tol`` of the simplified corner
+    polyline, and the ends are always kept. ``tol``: default :func:`ring_tolerance`
+    (``thickness``).
+    """
+    P = np.asarray(axis, float).reshape(-1, 3)
+    k = len(P)
+    if k <= 2:
+        return np.arange(k, dtype=np.int64)
+    tol = ring_tolerance(thickness) if tol is None else float(tol)
+    w, h = 0.5 * float(width) * np.asarray(W, float), 0.5 * float(thickness) * np.asarray(H, float)
+    X = np.stack([P - w - h, P + w - h, P + w + h, P - w + h], axis=1)      # (k,4,3)
+    keep = np.zeros(k, bool)
+    keep[[0, -1]] = True
+    at = np.arange(k)
+    while True:
+        idx = np.flatnonzero(keep)
+        seg = np.minimum(np.searchsorted(idx, at, side="right") - 1, len(idx) - 2)
+        d = _segment_distance(X, X[idx[seg]], X[idx[seg + 1]]).max(axis=1)
+        d[keep] = 0.0
+        worst = np.maximum.reduceat(d, idx[:-1])         # per span [idx[j], idx[j+1])
+        split = np.flatnonzero(worst > tol)
+        if not len(split):
+            return idx.astype(np.int64)
+        # the first sample of each span that needs a split where its distance is the span's
+        far = (d == worst[seg]) & (worst[seg] > tol)
+        _, first = np.unique(seg[far], return_index=True)
+        keep[np.flatnonzero(far)[first]] = True
 
 
 def real_section_m(width_mm: float, thickness_mm: float, scale: float) -> tuple[float, float]:

@@ -91,3 +91,91 @@ def test_strip_solid_with_the_frame_given_is_the_strip_solid():
         plain = strip_solid(P, N, 0.2, 0.01, tangent)
         given = strip_solid(P, N, 0.2, 0.01, tangent, frame=strip_frame(P, N, tangent))
         assert all(np.array_equal(a, b) for a, b in zip(plain, given))
+
+
+# ------------------------------------------------------------------ solids with fewer rings
+
+def _corners(P, W, H, w, t):
+    hw, ht = 0.5 * w * W, 0.5 * t * H
+    return np.stack([P - hw - ht, P + hw - ht, P + hw + ht, P - hw + ht], axis=1)
+
+
+def _to_polyline(X, Q):
+    """Distance of each point of ``X (n,3)`` to the polyline ``Q (m,3)`` (brute force)."""
+    A, B = Q[:-1][None], Q[1:][None]
+    D = B - A
+    u = np.clip(np.einsum("nmi,nmi->nm", X[:, None] - A, D) / np.einsum("nmi,nmi->nm", D, D),
+                0.0, 1.0)
+    return np.linalg.norm(X[:, None] - A - u[..., None] * D, axis=-1).min(axis=1)
+
+
+def _check_rings(P, N, w, t, tangent):
+    """solid_rings keeps the ends, its solid's corner edges within ring_tolerance of the full
+    ones (each full-resolution corner point to the simplified corner polyline), and the
+    solid through the kept rings is closed and consistently oriented like strip_solid's."""
+    from gridshell.strips3d import ring_tolerance, solid_rings
+
+    T, W, H = strip_frame(P, N, tangent)
+    r = solid_rings(P, W, H, w, t)
+    assert r[0] == 0 and r[-1] == len(P) - 1 and np.all(np.diff(r) > 0)
+    full = _corners(P, W, H, w, t)
+    V, F = strip_solid(P[r], N[r], w, t, tangent, frame=(T[r], W[r], H[r]))
+    np.testing.assert_array_equal(V.reshape(-1, 4, 3), full[r])    # the same corners
+    tol = ring_tolerance(t)
+    worst = max(_to_polyline(full[:, c], full[r, c]).max() for c in range(4))
+    assert worst <= tol
+    edges = np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]])
+    _, counts = np.unique(np.sort(edges, axis=1), axis=0, return_counts=True)
+    assert np.all(counts == 2)                              # closed: every edge twice
+    assert len(np.unique(edges, axis=0)) == len(edges)      # consistently oriented
+    return r, worst, tol
+
+
+@pytest.mark.parametrize("tangent", [True, False])
+def test_solid_rings_of_a_helix_strip(tangent):
+    """A helix strip (bent and twisted: the normal of its cylinder turns round the axis),
+    2000 samples over two turns of radius 0.5 m: far fewer rings, every corner edge within
+    ring_tolerance (0.05 mm here: 1 % of 10 mm is 0.1 mm) of the full-resolution one."""
+    from gridshell.strips3d import ring_tolerance
+
+    k, R, pitch = 2000, 0.5, 0.3
+    a = np.linspace(0.0, 4 * np.pi, k)
+    P = np.c_[R * np.cos(a), R * np.sin(a), pitch * a / (2 * np.pi)]
+    N = -np.c_[np.cos(a), np.sin(a), np.zeros(k)]           # the cylinder's inner normal
+    assert ring_tolerance(0.01) == pytest.approx(5e-5)
+    assert ring_tolerance(0.001) == pytest.approx(1e-5)
+    r, worst, tol = _check_rings(P, N, 0.2, 0.01, tangent)
+    assert len(r) < k / 2                # ~1/3 (14 mm spans where the samples are 3 mm)
+    assert worst > 0.2 * tol             # not more rings than the tolerance asks for
+
+
+def test_solid_rings_keep_what_a_finer_tolerance_needs():
+    """A tolerance of 0 keeps every sample of a curved axis; a straight axis needs its ends."""
+    from gridshell.strips3d import solid_rings
+
+    P = _circle(k=50)
+    N = np.tile([0.0, 0.0, 1.0], (len(P), 1))
+    _, W, H = strip_frame(P, N, True)
+    np.testing.assert_array_equal(solid_rings(P, W, H, 0.2, 0.01, tol=0.0), np.arange(50))
+    L = np.c_[np.linspace(0, 1, 30), np.zeros(30), np.zeros(30)]
+    _, W, H = strip_frame(L, np.tile([0.0, 0.0, 1.0], (30, 1)), True)
+    np.testing.assert_array_equal(solid_rings(L, W, H, 0.2, 0.01), [0, 29])
+    np.testing.assert_array_equal(solid_rings(L[:2], W[:2], H[:2], 0.2, 0.01), [0, 1])
+
+
+def test_solid_rings_of_an_ncp_bundle():
+    """The lamellae of an NCP design (pseudosphere, AA, 10 curves; strips 0.2 x 0.01 m as
+    the .3dm export builds them): within the tolerance, and at most half the rings."""
+    from ncp_cases import pseudosphere
+
+    from gridshell.igl_adapter import closest_points_with_normals
+    from gridshell.ncp.pipeline import design_ncp
+
+    bundle, _ = design_ncp(pseudosphere(), mode="aa", curves=10)
+    total = kept = 0
+    for lam in bundle.net.lamellae:
+        P = lam.axis[np.r_[True, np.linalg.norm(np.diff(lam.axis, axis=0), axis=1) > 0]]
+        N = closest_points_with_normals(P, bundle.surface_V, bundle.surface_F)[1]
+        r, _, _ = _check_rings(P, N, 0.2, 0.01, False)
+        total, kept = total + len(P), kept + len(r)
+    assert kept < 0.5 * total

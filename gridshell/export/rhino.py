@@ -11,7 +11,9 @@ moved. Lengths in user strings are in the same unit (``units`` names it) and in 
     surface           the designed surface as a mesh
     B-spline surface  NCP kinds: the PHLW B-spline of surface.json as a NURBS surface
     family 1          one closed mesh per C^1 lamella (each side its own vertices, shaded
-                      flat; see unwelded_sides): the strip as built, real width x
+                      flat; see unwelded_sides; only the axis samples it needs, its
+                      corner edges within gridshell.strips3d.ring_tolerance of the
+                      full-resolution ones: solid_rings): the strip as built, real width x
                       thickness (gridshell.strips3d), tangent to the surface for GG (stacked:
                       family 1 on the side the surface.obj normals point to, family 3 on the
                       other, so that crossing strips touch on the surface), standing on
@@ -156,7 +158,8 @@ def _strips(m: _Model, bundle, params, with_holes: bool) -> dict[str, Any]:
     """Strip solids on the family layers, axes, and the holes; returns figures."""
     from ..igl_adapter import closest_points_with_normals
     from ..net import polyline_arclength
-    from ..strips3d import is_tangent, real_section_m, strip_frame, strip_solid
+    from ..strips3d import (is_tangent, real_section_m, solid_rings, strip_frame,
+                            strip_solid)
 
     tangent = is_tangent(bundle.kind)
     w, t = real_section_m(params.width, params.thickness, params.scale)
@@ -184,7 +187,12 @@ def _strips(m: _Model, bundle, params, with_holes: bool) -> dict[str, Any]:
         else:
             C = P
         # the solid's frame along C: the one above when C is the axis itself
-        V, F = strip_solid(C, N, w, t, tangent, frame=frame if C is P else None)
+        Tc, Wc, Hc = frame if C is P else strip_frame(C, N, tangent)
+        # only the rings the solid needs: its corner edges within ring_tolerance(t) (1 % of
+        # the thickness or 0.05 mm, real size) of the full-resolution ones; the axis
+        # polyline, the holes and the user strings keep every sample
+        r = solid_rings(C, Wc, Hc, w, t)
+        V, F = strip_solid(C[r], N[r], w, t, tangent, frame=(Tc[r], Wc[r], Hc[r]))
         s = polyline_arclength(P)
         strings = {"lamella_id": int(lam.id), "family": int(lam.family), "kind": bundle.kind,
                    "length": m.fmt(lam.length), "length_m": f"{lam.length:.9g}",
