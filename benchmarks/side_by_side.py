@@ -9,8 +9,8 @@ CPU time much less) and the ratio, base / this.
 
     .venv/bin/python benchmarks/side_by_side.py --base ../base phlw:0 phlw:1 ncp_e2e:0
 
-``--own-runner`` runs the base with its own ``run_all.py`` (the row as that checkout defined and
-measured it, e.g. the code of an older figures table whose library lacks today's names);
+``--own-runner`` runs the base's rows as its own ``run_all.py`` defines them (e.g. the code of an
+older figures table whose library lacks today's names), measured by this checkout's clock;
 ``--repeat N`` alternates N times and prints the medians.
 """
 from __future__ import annotations
@@ -26,23 +26,49 @@ import numpy as np
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
+sys.path.insert(0, str(HERE))
+
+from _measure import compile_tree, measure  # noqa: E402
 
 
 def run(root: Path, stage: str, index: int, timeout: float, runner: Path | None = None) -> dict:
-    """One (stage, size) of ``runner`` (this checkout's ``run_all.py`` by default) importing the
-    ``gridshell`` of ``root``, in its own process: the worker's JSON figures."""
+    """One (stage, size) importing the ``gridshell`` of ``root``, in its own process: the
+    worker's JSON figures. The row is this checkout's ``run_all.py`` row, or with ``runner``
+    (another checkout's ``run_all.py``) that checkout's row, measured by this checkout's
+    :func:`_measure.measure` (:func:`rows_of`)."""
     env = dict(os.environ, PYTHONPATH=str(root), MPLBACKEND="Agg")
-    runner = runner or HERE / "run_all.py"
+    if runner is None:
+        cmd = [sys.executable, str(HERE / "run_all.py"), "--worker", stage, str(index)]
+    else:
+        cmd = [sys.executable, str(Path(__file__).resolve()), "--rows-of", str(runner), stage,
+               str(index)]
     try:
-        p = subprocess.run([sys.executable, str(runner), "--worker", stage, str(index)],
-                           capture_output=True, text=True, env=env, timeout=timeout,
-                           cwd=runner.parent.parent)
+        p = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=timeout,
+                           cwd=(runner or HERE / "run_all.py").parent.parent)
     except subprocess.TimeoutExpired:
         return {"error": f"stopped after {timeout:g} s"}
     lines = [ln for ln in p.stdout.splitlines() if ln.startswith("{")]
     if p.returncode or not lines:
         return {"error": (p.stderr.strip().splitlines() or [f"exit {p.returncode}"])[-1]}
     return json.loads(lines[-1])
+
+
+def rows_of(runner: Path, stage: str, index: int) -> dict:
+    """Build row ``stage`` size ``index`` as the ``run_all.py`` at ``runner`` defines it (its
+    ``STAGES``, each with ``setup(param)``) and measure it with this checkout's ``measure``:
+    the same clock, CPU figure and garbage collection on both sides."""
+    import importlib.util
+
+    sys.path.insert(0, str(runner.parent))    # its helpers (this checkout's _measure is loaded)
+    spec = importlib.util.spec_from_file_location("base_run_all", runner)
+    mod = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = mod              # its dataclasses look their module up
+    spec.loader.exec_module(mod)
+    st = mod.BY_NAME[stage]
+    call = st.setup(st.sizes[index].param)
+    m = measure(call)
+    return {"seconds": m.seconds, "cpu_seconds": m.cpu_seconds, "peak_mb": m.peak_mb,
+            "rss_peak_mb": m.rss_peak_mb}
 
 
 def median(runs: list[dict]) -> dict:
@@ -67,6 +93,8 @@ def main(argv: list[str] | None = None) -> None:
     a = ap.parse_args(argv)
     base = Path(a.base).resolve()
     base_runner = base / "benchmarks" / "run_all.py" if a.own_runner else None
+    for root in (base, ROOT):                 # bytecode, as an installed package has it
+        compile_tree(root)
     out = []
     print(f"{'stage':<16} {'size':>4} {'base wall':>10} {'base cpu':>9} {'this wall':>10} "
           f"{'this cpu':>9} {'ratio':>9}")
@@ -91,4 +119,7 @@ def main(argv: list[str] | None = None) -> None:
 
 
 if __name__ == "__main__":
-    main()
+    if len(sys.argv) == 5 and sys.argv[1] == "--rows-of":
+        print(json.dumps(rows_of(Path(sys.argv[2]), sys.argv[3], int(sys.argv[4]))))
+    else:
+        main()

@@ -245,6 +245,22 @@ def _check_spread(ctrl: np.ndarray) -> None:
                          "degenerate input); re-export the surface")
 
 
+def _paired_params(surf: "BSplineSurface", u: Any, v: Any, du: int, dv: int, who: str,
+                   hint: str = "") -> tuple[np.ndarray, np.ndarray]:
+    """Paired 1-D parameters ``u, v`` checked and clipped to the domain of ``surf``, after
+    checking the derivative orders ``du, dv``; :class:`InputError` names ``who`` otherwise."""
+    u = np.atleast_1d(np.asarray(u, dtype=float))
+    v = np.atleast_1d(np.asarray(v, dtype=float))
+    if u.shape != v.shape or u.ndim != 1:
+        raise InputError(f"{who} needs paired 1-D u and v of equal length, got shapes "
+                         f"{u.shape} and {v.shape}{hint}")
+    for name, d in (("du", du), ("dv", dv)):
+        if int(d) != d or d < 0:
+            raise InputError(f"{name} must be a non-negative integer, got {d!r}")
+    return (_params(u, surf.knots_u, surf.degree_u, "u"),
+            _params(v, surf.knots_v, surf.degree_v, "v"))
+
+
 _DERIVS = {"S": (0, 0), "Su": (1, 0), "Sv": (0, 1), "Suu": (2, 0), "Suv": (1, 1), "Svv": (0, 2)}
 
 
@@ -345,16 +361,8 @@ class BSplineSurface:
             Row ``s`` is the Kronecker product of the ``u`` and ``v`` basis rows; each row has
             ``(d_u + 1)(d_v + 1)`` stored entries (a constant sparsity pattern per span).
         """
-        u = np.atleast_1d(np.asarray(u, dtype=float))
-        v = np.atleast_1d(np.asarray(v, dtype=float))
-        if u.shape != v.shape or u.ndim != 1:
-            raise InputError(f"operator needs paired 1-D u and v of equal length, got shapes "
-                             f"{u.shape} and {v.shape}; use operator_grid for a tensor grid")
-        for name, d in (("du", du), ("dv", dv)):
-            if int(d) != d or d < 0:
-                raise InputError(f"{name} must be a non-negative integer, got {d!r}")
-        u = _params(u, self.knots_u, self.degree_u, "u")
-        v = _params(v, self.knots_v, self.degree_v, "v")
+        u, v = _paired_params(self, u, v, du, dv, "operator",
+                              "; use operator_grid for a tensor grid")
         nu, nv = self.shape
         fu, bu = _local_basis(self.knots_u, self.degree_u, u, int(du))
         fv, bv = _local_basis(self.knots_v, self.degree_v, v, int(dv))

@@ -12,27 +12,33 @@ def _module():
     return mod
 
 
-def test_own_runner_runs_the_base_script_in_its_checkout(tmp_path):
+def test_own_runner_builds_the_base_row_and_measures_it_here(tmp_path):
+    """--own-runner: the row as the base's run_all.py defines it (setup(param) of its STAGES),
+    run in the base checkout with its PYTHONPATH, timed by this checkout's measure (CPU too)."""
     sbs = _module()
     (tmp_path / "benchmarks").mkdir()
     runner = tmp_path / "benchmarks" / "run_all.py"
-    # the base's own worker: reports its working directory and PYTHONPATH through the figures
     runner.write_text(
-        "import json, os, sys\n"
-        "assert sys.argv[1:] == ['--worker', 'phlw', '1'], sys.argv\n"
-        "print('noise line')\n"
-        "print(json.dumps({'seconds': 2.5, 'cwd_ok': float(os.getcwd() == %r),\n"
-        "                  'path_ok': float(os.environ['PYTHONPATH'] == %r)}))\n"
-        % (str(tmp_path), str(tmp_path)))
+        "import os, time\n"
+        "from types import SimpleNamespace as NS\n"
+        "def setup(param):\n"
+        "    def call():\n"
+        "        t = time.process_time()\n"
+        "        while time.process_time() - t < param:\n"
+        "            pass\n"
+        "        open('ran.txt', 'w').write(os.getcwd() + '|' + os.environ['PYTHONPATH'])\n"
+        "    return call\n"
+        "BY_NAME = {'phlw': NS(setup=setup, sizes=[NS(param=0.0), NS(param=0.2)])}\n")
     r = sbs.run(tmp_path, "phlw", 1, 60.0, runner)
-    assert r == {"seconds": 2.5, "cwd_ok": 1.0, "path_ok": 1.0}
+    assert r["cpu_seconds"] >= 0.19 and r["seconds"] >= r["cpu_seconds"] * 0.9
+    assert (tmp_path / "ran.txt").read_text() == f"{tmp_path}|{tmp_path}"
 
 
 def test_failed_worker_reports_its_last_error_line(tmp_path):
     sbs = _module()
     (tmp_path / "benchmarks").mkdir()
     runner = tmp_path / "benchmarks" / "run_all.py"
-    runner.write_text("import sys\nsys.exit('ImportError: no such name')\n")
+    runner.write_text("raise ImportError('no such name')\n")
     assert sbs.run(tmp_path, "outputs", 0, 60.0, runner) == {"error": "ImportError: no such name"}
 
 
@@ -42,3 +48,17 @@ def test_median_of_repeats_skips_failed_runs():
             {"seconds": 1.0, "cpu_seconds": 4.0}, {"seconds": 2.0, "cpu_seconds": 3.0}]
     assert sbs.median(runs) == {"seconds": 2.0, "cpu_seconds": 3.0}
     assert sbs.median([{"error": "x"}, {"error": "y"}]) == {"error": "x"}
+
+
+def test_trees_are_compiled_before_measuring(tmp_path):
+    """compile_tree writes the bytecode of gridshell/ and fabrication/ (PYTHONDONTWRITEBYTECODE
+    aside), so lazily imported modules are not compiled inside a timed call."""
+    import importlib.util as iu
+
+    sbs = _module()
+    for pkg in ("gridshell", "fabrication"):
+        (tmp_path / pkg).mkdir()
+        (tmp_path / pkg / "late.py").write_text("X = 1\n")
+    sbs.compile_tree(tmp_path)
+    for pkg in ("gridshell", "fabrication"):
+        assert (tmp_path / pkg / iu.cache_from_source("late.py")).is_file()

@@ -20,11 +20,12 @@ from typing import Callable, NamedTuple
 import numpy as np
 import scipy.sparse as sp
 
-from ..bspline import BSplineSurface, _local_basis, _params, open_uniform_knots
+from ..bspline import BSplineSurface, _local_basis, _paired_params, open_uniform_knots
 from ..errors import InputError, NoNetError
 from ..net import Lamella, Net
 from ..solver import Layout, TermResult, result, term
 from ..solver.linear import NotPositiveDefinite, shared_solver
+from ..solver.solve import lm_update
 from ..solver.threads import one_blas_thread
 from .directions import NetDirections
 
@@ -67,16 +68,7 @@ def _patches(F: BSplineSurface, u: np.ndarray, v: np.ndarray, du: int, dv: int
     """Local data of ``xi`` at paired parameters ``(k,)``: the ``xi`` control values of each
     parameter's span ``(k, d_u + 1, d_v + 1)``, the non-zero ``u`` basis values (or ``du``-th
     derivatives) ``(k, d_u + 1)``, those in ``v``, and the checked, clipped ``u, v``."""
-    u = np.atleast_1d(np.asarray(u, dtype=float))
-    v = np.atleast_1d(np.asarray(v, dtype=float))
-    if u.shape != v.shape or u.ndim != 1:
-        raise InputError(f"xi needs paired 1-D u and v of equal length, got shapes {u.shape} "
-                         f"and {v.shape}")
-    for name, d in (("du", du), ("dv", dv)):
-        if int(d) != d or d < 0:
-            raise InputError(f"{name} must be a non-negative integer, got {d!r}")
-    u = _params(u, F.knots_u, F.degree_u, "u")
-    v = _params(v, F.knots_v, F.degree_v, "v")
+    u, v = _paired_params(F, u, v, du, dv, "xi")
     fu, bu = _local_basis(F.knots_u, F.degree_u, u, int(du))
     fv, bv = _local_basis(F.knots_v, F.degree_v, v, int(dv))
     iu = fu[:, None, None] + np.arange(bu.shape[1])[None, :, None]
@@ -224,16 +216,8 @@ def _linear_least_squares(J: sp.csr_matrix, t: np.ndarray, free: np.ndarray, *, 
             x_new[free] += dx
             r_new = J @ x_new - t
             E_new = float(r_new @ r_new)
-            pred = -(2 * g @ dx + dx @ (N @ dx))
-            rho = (E - E_new) / pred if pred > 0 else -1.0
-            if np.isfinite(E_new) and E_new < E:
-                accepted = True
-                lam *= max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0) ** 3) if rho > 0 else 1.0
-                nu = 2.0
-                break
-            lam *= nu
-            nu *= 2.0
-            if lam > 1e16:
+            accepted, lam, nu = lm_update(E, E_new, g, dx, N, lam, nu)
+            if accepted or lam > 1e16:
                 break
         if not accepted:  # no step lowers the energy: a minimum if the gradient is round-off
             converged = bool(np.max(np.abs(g)) <= max(tol_grad, 1e-8 * max(E, 1e-300) ** 0.5))

@@ -90,6 +90,19 @@ def factorized(A: sp.csc_matrix) -> Callable[[np.ndarray], np.ndarray]:
 
 
 @one_blas_thread
+def lm_update(E: float, E_new: float, g: np.ndarray, dx: np.ndarray, JTJ, lam: float,
+              nu: float) -> tuple[bool, float, float]:
+    """One Levenberg-Marquardt damping update (Nielsen's rule) after a trial step ``dx``:
+    ``(accepted, lam, nu)``. Accepted when the energy ``E_new`` is finite and below ``E``; the
+    damping then shrinks with the gain ratio (actual over predicted decrease, the prediction
+    from the gradient ``g`` and ``JTJ``), else it grows by ``nu`` and ``nu`` doubles."""
+    if np.isfinite(E_new) and E_new < E:
+        pred = -(2 * g @ dx + dx @ (JTJ @ dx))
+        rho = (E - E_new) / pred if pred > 0 else -1.0
+        return True, lam * (max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0) ** 3) if rho > 0 else 1.0), 2.0
+    return False, lam * nu, nu * 2.0
+
+
 def solve(problem: Problem, x0: np.ndarray, *, fixed: np.ndarray | None = None,
           method: Method = "lm", max_iter: int = 100, damping: float = 1e-3,
           tol_energy: float = 1e-20, tol_rel: float = 1e-10, tol_step: float = 1e-12,
@@ -170,17 +183,8 @@ def solve(problem: Problem, x0: np.ndarray, *, fixed: np.ndarray | None = None,
             if method != "lm":
                 accepted = np.isfinite(E_new)
                 break
-            # gain ratio: actual over predicted decrease
-            pred = -(2 * g @ dx + dx @ (JTJ @ dx))
-            rho = (E - E_new) / pred if pred > 0 else -1.0
-            if np.isfinite(E_new) and E_new < E:
-                accepted = True
-                lam *= max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0) ** 3) if rho > 0 else 1.0
-                nu = 2.0
-                break
-            lam *= nu
-            nu *= 2.0
-            if lam > 1e16:
+            accepted, lam, nu = lm_update(E, E_new, g, dx, JTJ, lam, nu)
+            if accepted or lam > 1e16:
                 break
         step = float(np.linalg.norm(dx)) if accepted else 0.0
         rec = {"it": it, "energy": E_new if accepted else E, "step": step, "lambda": lam,
