@@ -24,6 +24,7 @@ the sheet as given.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 import shapely
@@ -77,20 +78,39 @@ def sheet_bound(parts: list[Part], sheet: tuple[float, float], slack: float = 1.
 class _Shape:
     """One orientation of a part in the nesting frame: fine polygon with its bounding box at
     the origin, size ``w x h``; the outer approximation's x range ``ox`` and its lowest y per
-    column from ``ox[0]`` on (``low``; ``up``: the highest), which the placement uses."""
+    column from ``ox[0]`` on (``low``; ``up``: the highest), which the drop placement uses
+    (made on first use: a rows-and-columns layout, see :func:`_rows_best`, needs only the
+    sizes)."""
 
     part: Part
     poly: Polygon
     w: float
     h: float
-    ox: tuple[float, float]
-    low: np.ndarray
-    up: np.ndarray
-    runs_low: list = field(init=False)     # _runs of low and up (Sheet._profiles)
-    runs_up: list = field(init=False)
 
-    def __post_init__(self) -> None:
-        self.runs_low, self.runs_up = _runs(self.low, np.inf), _runs(self.up, -np.inf)
+    @cached_property
+    def _profile(self) -> tuple:
+        """``(ox, low, up, runs_low, runs_up)``; see :func:`_profile`."""
+        return _profile(self.poly)
+
+    @property
+    def ox(self) -> tuple[float, float]:
+        return self._profile[0]
+
+    @property
+    def low(self) -> np.ndarray:
+        return self._profile[1]
+
+    @property
+    def up(self) -> np.ndarray:
+        return self._profile[2]
+
+    @property
+    def runs_low(self) -> list:            # _runs of low and up (Sheet._profiles)
+        return self._profile[3]
+
+    @property
+    def runs_up(self) -> list:
+        return self._profile[4]
 
 
 @dataclass
@@ -125,14 +145,21 @@ def _shapes(part: Part, curved: bool) -> list[_Shape]:
 
 
 def _shape(base: Part, turn: float, curved: bool) -> _Shape:
-    """``base`` turned by ``turn`` (radians), its box at the origin, with its profiles."""
+    """``base`` turned by ``turn`` (radians), its box at the origin (its profiles made when
+    first used)."""
     p = base.moved(Motion(turn, 0.0, 0.0)) if turn else base
     pad = FLAT_TOL if curved else 0.0               # arcs bulge out by up to FLAT_TOL
     x0, y0, _, _ = p.polygon(FLAT_TOL).bounds
     p = p.moved(Motion(0.0, pad - x0, pad - y0))
     poly = p.polygon(FLAT_TOL)
     _, _, w, h = poly.bounds
-    w, h = w + pad, h + pad
+    return _Shape(p, poly, w + pad, h + pad)
+
+
+def _profile(poly: Polygon) -> tuple:
+    """The profiles of a shape's polygon ``poly`` (mm): the x range ``ox`` of its outer
+    approximation, its lowest / highest y per column from ``ox[0]`` on (``low``, ``up``) and
+    their :func:`_runs`."""
     ring = _outer_ring(poly, 0.0)
     ox = (float(ring[:, 0].min()), float(ring[:, 0].max()))
     n = int(np.ceil((ox[1] - ox[0]) / COLUMN)) + 1
@@ -141,7 +168,7 @@ def _shape(base: Part, turn: float, curved: bool) -> _Shape:
     # shape anywhere between two column offsets (so it may also touch the margins)
     low = np.minimum(np.append(low, np.inf), np.insert(low, 0, np.inf))
     up = np.maximum(np.append(up, -np.inf), np.insert(up, 0, -np.inf))
-    return _Shape(p, poly, w, h, ox, low, up)
+    return ox, low, up, _runs(low, np.inf), _runs(up, -np.inf)
 
 
 def _columns(ring: np.ndarray, x0: float, n: int, top: bool) -> np.ndarray:
@@ -403,15 +430,17 @@ def _rows_best(parts: list[Part], shapes: list[list[_Shape]], Lx: float, Ly: flo
     return best
 
 
-def _place_plan(shapes: list[list[_Shape]], plan: list, Lx: float, Ly: float, g: float
-                ) -> tuple[list[_Sheet], dict[int, tuple[int, Part]]]:
-    """Sheets and placed parts of a :func:`fabrication.rows.plan_rows` plan."""
-    sheets = [_Sheet(Lx, Ly, g) for _ in range(max(s for s, *_ in plan) + 1)]
+def _place_plan(shapes: list[list[_Shape]], plan: list
+                ) -> tuple[int, dict[int, tuple[int, tuple[Part, Motion]]]]:
+    """Sheet count and placed parts of a :func:`fabrication.rows.plan_rows` plan: each part
+    (turned by 90 degrees where the plan says so, its box at the origin) and its move to
+    ``(x, y)``, as :meth:`_Sheet.add` would leave them (no sheet profiles: nothing is placed
+    after them)."""
     placed = {}
     for i, (k, x, y, turned) in enumerate(plan):
         s = _shape(shapes[i][0].part, np.pi / 2, False) if turned else shapes[i][0]
-        placed[i] = (k, sheets[k].add(s, float(x), float(y)))
-    return sheets, placed
+        placed[i] = (k, (s.part, Motion(0.0, float(x), float(y))))
+    return max(s for s, *_ in plan) + 1, placed
 
 
 def _drop_best(shapes: list[list[_Shape]], Lx: float, Ly: float, g: float, strategies: list,
@@ -491,7 +520,7 @@ def nest(parts: list[Part], params: FabParams) -> Layout:
         best = _raster_best(parts, shapes, Lx, Ly, g, params.rotation, best, floor, RASTER)
     _, sheets, placed = best
     if isinstance(placed, list):           # a rows-and-columns plan: place it now
-        sheets, placed = _place_plan(shapes, placed, Lx, Ly, g)
+        sheets, placed = _place_plan(shapes, placed)
     n = sheets if isinstance(sheets, int) else len(sheets)
     idx = sorted(placed)
     return Layout([_moved(placed[i][1]).moved(to_sheet) for i in idx], [placed[i][0] for i in idx],

@@ -207,3 +207,28 @@ def test_line_axis_one_point_equals_the_array_path():
         assert got.dtype == want.dtype and got.shape == want.shape == (2,)
         np.testing.assert_array_equal(got, want)
         np.testing.assert_array_equal(ax.tangent(s), ax.tangent(np.array(s)))
+
+
+def test_rows_plan_placed_as_the_sheets_would_place_it():
+    """A rows-and-columns plan is placed without building sheet profiles: the same parts and
+    moves (turned parts included) as adding each shape to its sheet, and no shape's drop
+    profiles are made for it."""
+    parts, params = _parts("GG", 6, 6)
+    W, H = params.sheet
+    Lx, Ly, g = max(W, H), min(W, H), params.gap
+    shapes = [nesting._shapes(p, False) for p in parts]
+    best = nesting._rows_best(parts, shapes, Lx, Ly, g)
+    assert best is not None
+    plan = best[2]
+    assert all("_profile" not in s[0].__dict__ for s in shapes)    # sizes only so far
+    n, placed = nesting._place_plan(shapes, plan)
+    sheets = [nesting._Sheet(Lx, Ly, g) for _ in range(n)]
+    assert n == max(k for k, *_ in plan) + 1
+    for i, (k, x, y, turned) in enumerate(plan):
+        s = nesting._shape(shapes[i][0].part, np.pi / 2, False) if turned else shapes[i][0]
+        part, motion = sheets[k].add(s, float(x), float(y))
+        got_k, (got_part, got_motion) = placed[i]
+        assert got_k == k and got_motion == motion
+        np.testing.assert_array_equal(got_part.outline.V, part.outline.V)
+        np.testing.assert_array_equal(nesting._moved(placed[i][1]).outline.V,
+                                      part.moved(motion).outline.V)
