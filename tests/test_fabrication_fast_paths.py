@@ -232,3 +232,21 @@ def test_rows_plan_placed_as_the_sheets_would_place_it():
         np.testing.assert_array_equal(got_part.outline.V, part.outline.V)
         np.testing.assert_array_equal(nesting._moved(placed[i][1]).outline.V,
                                       part.moved(motion).outline.V)
+
+
+def test_hole_circles_buffered_at_once_equal_one_by_one():
+    """The material of a part (outline less its holes) from the circles buffered at once is
+    the one of Point(c).buffer(r, 32) one by one, bit for bit."""
+    import shapely
+    from shapely.geometry import Point
+    from shapely.ops import unary_union
+
+    parts, params = _parts("GG", 5, 5)
+    assert any(len(p.holes) for p in parts)
+    for p in parts:
+        if not len(p.holes):
+            continue
+        one = unary_union([Point(c).buffer(params.hole / 2, 32) for c in p.holes])
+        once = shapely.union_all(shapely.buffer(shapely.points(np.asarray(p.holes, float)),
+                                                params.hole / 2, quad_segs=32))
+        assert one.wkb == once.wkb
