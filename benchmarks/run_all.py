@@ -246,6 +246,10 @@ def _outputs(curves: int) -> Callable[[], Any]:
 # ============================================================================ fabrication
 
 def _fabrication(p: tuple[int, float]) -> Callable[[], Any]:
+    """``fabricate`` of a GG bundle. The DXF writer (ezdxf, ~0.2 s to import) is imported in
+    the set-up, as ``fabrication.pipeline`` itself imported it until 2026-12-02 (it is lazy
+    since, for the .3dm export): the row times fabricating, not importing."""
+    import fabrication.dxf  # noqa: F401
     from fabrication.pipeline import fabricate
     from gg_pipeline import helicoid
 
