@@ -19,35 +19,12 @@ from .strip import Strip
 MIN_HEIGHT = 1.5  # mm; smaller single-line text does not engrave legibly
 
 
-FONT = "futural"   # Hershey simplex roman, the first font of HersheyFonts' built-in archive
-
-
-def _load_font(f) -> None:
-    """Load :data:`FONT` into the HersheyFonts object ``f``: the font file read from the
-    package's built-in tar.bz2 archive in one pass, stopping at that file (it is the first
-    member). ``load_default_font`` unpacks the whole archive to list its names and then
-    again up to the font (~25 -> ~13 ms); the same glyphs (test). Falls back to
-    ``load_default_font`` when the package no longer holds its archive that way."""
-    import io
-    import tarfile
-
-    try:
-        raw = f._HersheyFonts__get_compressed_font_bytes()
-        with tarfile.open(fileobj=io.BytesIO(raw), mode="r") as tar:
-            member = tar.extractfile(FONT)
-            if member is None:
-                raise KeyError(FONT)
-            f.read_from_string_lines(member)
-    except (AttributeError, KeyError, NotImplementedError, tarfile.TarError):
-        f.load_default_font(FONT)
-
-
 @lru_cache(maxsize=1)
 def _font():
     from HersheyFonts import HersheyFonts
 
     f = HersheyFonts()
-    _load_font(f)
+    f.load_default_font("futural")
     f.normalize_rendering(1.0)
     segs = np.array(list(f.lines_for_text("0123456789L")), float).reshape(-1, 2, 2)
     y0, y1 = segs[..., 1].min(), segs[..., 1].max()

@@ -75,26 +75,6 @@ def test_stroke_joining_matches_allclose():
         assert sum(len(L) for L in lines) == len(segs) + len(lines)
 
 
-def test_font_loaded_in_one_pass_has_the_default_glyphs():
-    """The Hershey font read straight from the archive draws every printable character with
-    the same strokes as HersheyFonts' own load_default_font."""
-    import string
-
-    from HersheyFonts import HersheyFonts
-
-    from fabrication.labels import FONT, _load_font
-
-    ours, ref = HersheyFonts(), HersheyFonts()
-    _load_font(ours)
-    ref.load_default_font(FONT)
-    for f in (ours, ref):
-        f.normalize_rendering(1.0)
-    for ch in string.printable.strip() + " ":
-        assert list(ours.lines_for_text(ch)) == list(ref.lines_for_text(ch)), ch
-    assert list(ours.lines_for_text("L12-S3")) == list(ref.lines_for_text("L12-S3"))
-    assert list(ref.lines_for_text("L1"))   # not two empty fonts
-
-
 def _entities_text(doc) -> str:
     import io
     buf = io.StringIO()
