@@ -20,8 +20,6 @@ from __future__ import annotations
 import copy
 import hashlib
 import json
-import threading
-from collections import OrderedDict
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, NamedTuple, Sequence
@@ -32,6 +30,7 @@ from .atomic import atomic_dir
 from .errors import InputError
 from .io.units import METRES, Units
 from .net import Lamella, Net
+from .recent import Recent
 
 FORMAT = "gridshell.design"
 VERSION = 1
@@ -359,9 +358,7 @@ def _finite_field(value: Any, what: str) -> None:
 BUNDLE_FILES = ("design.json", "net.obj", "aligned.obj", "axes.obj", "surface.obj",
                 "revolution.obj")
 #: bundles read in this process, by content (:func:`content_key`); a few, most recent last
-_READ: OrderedDict[tuple, DesignBundle] = OrderedDict()
-_READ_SIZE = 4
-_READ_LOCK = threading.Lock()
+_READ = Recent(4, copy=copy.deepcopy)
 
 
 def content_key(path: str | Path, names: Sequence[str] = BUNDLE_FILES) -> tuple | None:
@@ -388,19 +385,7 @@ def cached_bundle(path: str | Path) -> DesignBundle | None:
     """A copy of what :func:`read_bundle` read at ``path`` in this process if its files are
     byte for byte unchanged since (:func:`content_key`), else None (the files are hashed,
     not parsed)."""
-    return _cached(content_key(path))
-
-
-def _cached(key: tuple | None) -> DesignBundle | None:
-    """A copy of the bundle read under ``key``, or None."""
-    if key is None:
-        return None
-    with _READ_LOCK:
-        hit = _READ.get(key)
-        if hit is None:
-            return None
-        _READ.move_to_end(key)
-        return copy.deepcopy(hit)
+    return _READ.get(content_key(path))
 
 
 def read_bundle(path: str | Path) -> DesignBundle:
@@ -412,16 +397,13 @@ def read_bundle(path: str | Path) -> DesignBundle:
     returns its own copy, so the caller may change it."""
     path = Path(path)
     key = content_key(path)
-    hit = _cached(key)
+    hit = _READ.get(key)
     if hit is not None:
         return hit
     bundle = _read_bundle(path)
     # stored only if the files did not change while they were read
     if key is not None and content_key(path) == key:
-        with _READ_LOCK:
-            _READ[key] = copy.deepcopy(bundle)
-            while len(_READ) > _READ_SIZE:
-                _READ.popitem(last=False)
+        _READ.put(key, bundle)
     return bundle
 
 

@@ -17,8 +17,6 @@ bends towards the (per-vertex) normal, ``k1 <= k2``.
 from __future__ import annotations
 
 import hashlib
-import threading
-from collections import OrderedDict
 from typing import Any, Callable, Literal
 
 import igl
@@ -27,6 +25,7 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
 from .errors import InputError, MeshError
+from .recent import Recent
 
 __all__ = [
     "closest_points",
@@ -124,12 +123,10 @@ def per_vertex_normals(V: Any, F: np.ndarray | None = None) -> np.ndarray:
 #: results of the closest-point queries asked with ``reuse=True`` in this process, by the
 #: content of their arrays (:func:`_content`): the same query again (a design verified, then
 #: exported: the joints' and the axes' closest points on surface.obj) is answered without igl.
-#: A few, newest last, of at most _QUERIES_BYTES together. Opt-in: a loop that queries new
+#: A few, newest last, of at most 16 MB together. Opt-in: a loop that queries new
 #: points on one large mesh would only pay for the hashing.
-_QUERIES: OrderedDict[tuple, tuple[np.ndarray, ...]] = OrderedDict()
-_QUERIES_SIZE = 8
-_QUERIES_BYTES = 16 << 20
-_QUERIES_LOCK = threading.Lock()
+_QUERIES = Recent(8, copy=lambda v: tuple(a.copy() for a in v),
+                  nbytes=lambda v: sum(a.nbytes for a in v), max_bytes=16 << 20)
 
 
 def _content(*arrays: np.ndarray) -> tuple:
@@ -149,19 +146,11 @@ def _once(what: str, arrays: tuple[np.ndarray, ...],
     if not reuse:
         return compute()
     key = (what, _content(*arrays))
-    with _QUERIES_LOCK:
-        hit = _QUERIES.get(key)
-        if hit is not None:
-            _QUERIES.move_to_end(key)
-            return tuple(a.copy() for a in hit)
+    hit = _QUERIES.get(key)
+    if hit is not None:
+        return hit
     out = tuple(np.asarray(a) for a in compute())
-    if sum(a.nbytes for a in out) > _QUERIES_BYTES:
-        return out
-    with _QUERIES_LOCK:
-        _QUERIES[key] = tuple(a.copy() for a in out)
-        while len(_QUERIES) > _QUERIES_SIZE or sum(
-                a.nbytes for v in _QUERIES.values() for a in v) > _QUERIES_BYTES:
-            _QUERIES.popitem(last=False)
+    _QUERIES.put(key, out)
     return out
 
 
