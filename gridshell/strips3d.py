@@ -19,7 +19,7 @@ import numpy as np
 from .errors import InputError
 
 __all__ = ["TANGENT_KINDS", "is_tangent", "nearest_vertex_normals", "strip_frame",
-           "strip_solid", "solid_rings", "ring_tolerance", "real_section_m"]
+           "strip_frames", "strip_solid", "solid_rings", "ring_tolerance", "real_section_m"]
 
 #: design kinds whose lamellae lie tangent to the surface (the others stand on it)
 TANGENT_KINDS = ("GG",)
@@ -68,18 +68,43 @@ def strip_frame(axis: np.ndarray, normals: np.ndarray, tangent: bool
         (``W = n - (n.T) T``, lamellae standing on the surface).
     """
     P = np.asarray(axis, float).reshape(-1, 3)
-    N = _unit(np.asarray(normals, float).reshape(-1, 3))
+    N = np.asarray(normals, float).reshape(-1, 3)
     if len(P) != len(N):
         raise InputError(f"strip frame: {len(P)} axis points but {len(N)} normals")
     if len(P) < 2:
         raise InputError("strip frame: a lamella axis needs at least 2 points")
-    T = _unit(np.gradient(P, axis=0))
+    _, _, T, W, H = strip_frames([P], [N], tangent)
+    return T, W, H
+
+
+def strip_frames(axes: list[np.ndarray], normals: list[np.ndarray], tangent: bool
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`strip_frame` of every axis ``(k_i,3)`` (metres, ``k_i >= 2``)
+    with its normals, in one vectorized pass: ``P, N, T, W, H``, each ``(sum k_i, 3)``, the
+    axis points, unit normals and frames concatenated (the same numbers as one call per axis:
+    the tangent is ``np.gradient``'s at unit spacing, central inside, one-sided at the ends)."""
+    sizes = np.array([len(a) for a in axes], dtype=np.int64)
+    if len(sizes) and sizes.min() < 2:
+        raise InputError("strip frame: a lamella axis needs at least 2 points")
+    P = np.concatenate([np.asarray(a, float).reshape(-1, 3) for a in axes]) if len(sizes) \
+        else np.zeros((0, 3))
+    N = _unit(np.concatenate([np.asarray(n, float).reshape(-1, 3) for n in normals])) \
+        if len(sizes) else np.zeros((0, 3))
+    if len(N) != len(P):
+        raise InputError(f"strip frame: {len(P)} axis points but {len(N)} normals")
+    first = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64)
+    last = first + sizes - 1
+    D = np.empty_like(P)
+    D[1:-1] = (P[2:] - P[:-2]) / 2.0
+    D[first] = P[first + 1] - P[first]
+    D[last] = P[last] - P[last - 1]
+    T = _unit(D)
     if tangent:
         W = _unit(np.cross(N, T))
     else:
         W = _unit(N - np.sum(N * T, axis=1, keepdims=True) * T)
     H = _unit(np.cross(T, W))
-    return T, W, H
+    return P, N, T, W, H
 
 
 def strip_solid(axis: np.ndarray, normals: np.ndarray, width: float, thickness: float,

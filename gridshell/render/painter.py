@@ -24,10 +24,9 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import InputError
+from ..strips3d import strip_frames
 
-__all__ = ["Camera", "Painter", "grow_polygons", "strip_faces", "strip_frames",
-           "strips_faces"]
+__all__ = ["Camera", "Painter", "grow_polygons", "strip_faces", "strips_faces"]
 
 
 def _unit(X: np.ndarray) -> np.ndarray:
@@ -63,36 +62,6 @@ class Camera:
         r, u, c = self.basis()
         P = np.asarray(P, float)
         return np.stack([P @ r, P @ u], axis=-1), P @ c
-
-
-def strip_frames(axes: list[np.ndarray], normals: list[np.ndarray], tangent: bool
-                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """:func:`gridshell.strips3d.strip_frame` of every axis ``(k_i,3)`` (metres, ``k_i >= 2``)
-    with its normals, in one vectorized pass: ``P, N, T, W, H``, each ``(sum k_i, 3)``, the
-    axis points, unit normals and frames concatenated (the same numbers as one call per axis:
-    the tangent is ``np.gradient``'s at unit spacing, central inside, one-sided at the ends)."""
-    sizes = np.array([len(a) for a in axes], dtype=np.int64)
-    if len(sizes) and sizes.min() < 2:
-        raise InputError("strip frame: a lamella axis needs at least 2 points")
-    P = np.concatenate([np.asarray(a, float).reshape(-1, 3) for a in axes]) if len(sizes) \
-        else np.zeros((0, 3))
-    N = _unit(np.concatenate([np.asarray(n, float).reshape(-1, 3) for n in normals])) \
-        if len(sizes) else np.zeros((0, 3))
-    if len(N) != len(P):
-        raise InputError(f"strip frame: {len(P)} axis points but {len(N)} normals")
-    first = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64)
-    last = first + sizes - 1
-    D = np.empty_like(P)
-    D[1:-1] = (P[2:] - P[:-2]) / 2.0
-    D[first] = P[first + 1] - P[first]
-    D[last] = P[last] - P[last - 1]
-    T = _unit(D)
-    if tangent:
-        W = _unit(np.cross(N, T))
-    else:
-        W = _unit(N - np.sum(N * T, axis=1, keepdims=True) * T)
-    H = _unit(np.cross(T, W))
-    return P, N, T, W, H
 
 
 def strip_faces(axis: np.ndarray, normals: np.ndarray, width: float, thickness: float,

@@ -33,8 +33,7 @@ from typing import Any
 import numpy as np
 
 from ...errors import InputError
-from ...strips3d import is_tangent, nearest_vertex_normals, strip_solid
-from ..painter import strip_frames
+from ...strips3d import is_tangent, nearest_vertex_normals, strip_frames, strip_solid
 from ..section import bundle_section
 
 __all__ = ["encode", "decode", "build_scene", "scene_json", "strip_solids_vertices",
