@@ -119,10 +119,8 @@ def move_joints(net: Net, joints: np.ndarray) -> Net:
     return move_joints_states(net, [joints])[0]
 
 
-def move_joints_states(net: Net, states: list[np.ndarray] | np.ndarray) -> list[Net]:
-    """:func:`move_joints` for every joint state of ``states`` (each ``(n,3)``, metres): the
-    state-independent part of each axis (its joints inserted, the smooth curve through it) is
-    built once, and one displacement spline carries all states' columns at once."""
+def _joint_states(net: Net, states: list[np.ndarray] | np.ndarray) -> np.ndarray | None:
+    """``states`` as one ``(m, n, 3)`` array (metres), checked against ``net``; None if empty."""
     Js = [np.asarray(J, dtype=float).reshape(-1, 3) for J in states]
     for J in Js:
         if J.shape != net.joints.shape:
@@ -130,22 +128,58 @@ def move_joints_states(net: Net, states: list[np.ndarray] | np.ndarray) -> list[
                              f"{len(net.joints)} joints")
         if not np.all(np.isfinite(J)):
             raise InputError("move_joints: joint positions must be finite")
-    if not Js:
+    return np.stack(Js) if Js else None
+
+
+def move_joints_states(net: Net, states: list[np.ndarray] | np.ndarray) -> list[Net]:
+    """:func:`move_joints` for every joint state of ``states`` (each ``(n,3)``, metres): the
+    state-independent part of each axis (its joints inserted, the smooth curve through it) is
+    built once, and one displacement spline carries all states' columns at once."""
+    Js = _joint_states(net, states)
+    if Js is None:
         return []
-    per_lam = [_carry_axis(lam, np.stack(Js)) for lam in net.lamellae]
+    per_lam = []
+    for lam in net.lamellae:
+        X, S, js, s_all = _carry_axis(lam, Js)
+        per_lam.append([Lamella(id=lam.id, family=lam.family, joints=lam.joints.copy(),
+                                joint_s=js.copy() if s_all is None else
+                                np.interp(js, s_all, S[k]), axis=X[k])
+                        for k in range(len(Js))])
     return [Net(joints=J, loops=net.loops.copy(), lamellae=[lams[k] for lams in per_lam])
             for k, J in enumerate(Js)]
 
 
-def _carry_axis(lam: Lamella, Js: np.ndarray) -> list[Lamella]:
-    """``lam`` carried to each joint state ``Js (m, n, 3)``: one lamella per state."""
+def carried_axes(net: Net, states: list[np.ndarray] | np.ndarray
+                 ) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The lamella axes of :func:`move_joints_states` as arrays, without building the nets:
+    for every lamella of ``net`` (in order), its axis carried to each of the ``m`` joint
+    states ``(m, p, 3)`` and the cumulative arc length along each ``(m, p)`` (metres; the
+    numbers of the moved lamellae's ``axis`` and of :func:`polyline_arclength` of it)."""
+    Js = _joint_states(net, states)
+    if Js is None:
+        return [(np.zeros((0, len(lam.axis), 3)), np.zeros((0, len(lam.axis))))
+                for lam in net.lamellae]
+    return [_carry_axis(lam, Js)[:2] for lam in net.lamellae]
+
+
+def _arclengths(X: np.ndarray) -> np.ndarray:
+    """:func:`polyline_arclength` of each polyline ``X[k] (p,3)``: ``(m, p)``, the same sums."""
+    seg = np.linalg.norm(np.diff(X, axis=1), axis=2)
+    return np.concatenate([np.zeros((len(X), 1)), np.cumsum(seg, axis=1)], axis=1)
+
+
+def _carry_axis(lam: Lamella, Js: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]:
+    """``lam`` carried to each joint state ``Js (m, n, 3)``: the axes ``(m, p, 3)``, their arc
+    lengths ``(m, p)``, the joints' arc lengths ``js`` on the axis before the move and the arc
+    lengths ``s_all (p,)`` of the axis points before it (None when the axis is only shifted,
+    ``js`` then stays the joints' arc lengths), metres."""
     from scipy.interpolate import CubicSpline
 
     X, js = lam.axis, lam.joint_s
     if len(X) < 2 or len(js) == 0:
-        return [Lamella(id=lam.id, family=lam.family, joints=lam.joints.copy(),
-                        joint_s=js.copy(), axis=X + (J[lam.joints[0]] - X[0] if len(js) else 0))
-                for J in Js]
+        Xs = np.stack([X + (J[lam.joints[0]] - X[0] if len(js) else 0) for J in Js])
+        return Xs, _arclengths(Xs), js, None
     X = X[np.concatenate([[True], np.linalg.norm(np.diff(X, axis=0), axis=1) > 0])]
     s = polyline_arclength(X)
     js = np.clip(js, 0.0, s[-1])
@@ -171,10 +205,5 @@ def _carry_axis(lam: Lamella, Js: np.ndarray) -> list[Lamella]:
         d = cs(t) + (s_all - t)[:, None] * np.where((s_all < js[0])[:, None], cs(js[0], 1),
                                                      cs(js[-1], 1))
         disp = np.moveaxis(d.reshape(len(s_all), m, 3), 1, 0)
-    out = []
-    for k in range(m):
-        Xk = X + disp[k]
-        s_new = polyline_arclength(Xk)
-        out.append(Lamella(id=lam.id, family=lam.family, joints=lam.joints.copy(),
-                           joint_s=np.interp(js, s_all, s_new), axis=Xk))
-    return out
+    Xs = X[None] + disp
+    return Xs, _arclengths(Xs), js, s_all

@@ -150,7 +150,15 @@ def area_weighted_vertex_normals(V: np.ndarray, F: np.ndarray) -> np.ndarray:
     N = np.zeros_like(V)
     valid = P >= 0
     rows = np.broadcast_to(np.arange(len(P))[:, None], P.shape)[valid]
-    np.add.at(N, P[valid], A[rows])
+    idx = P[valid]
+    if len(idx) and idx.max() < len(V):
+        # np.add.at(N, idx, A[rows]) by coordinates: bincount adds the same terms in the same
+        # order (corner by corner, from 0), the same sums, ~4x faster
+        Ar = A[rows]
+        for c in range(3):
+            N[:, c] = np.bincount(idx, weights=Ar[:, c], minlength=len(V))
+    else:
+        np.add.at(N, idx, A[rows])
     return _unit(N)
 
 

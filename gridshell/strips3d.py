@@ -14,15 +14,22 @@ geometry from here, so that what is drawn, exported and checked is the strip tha
 """
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from .errors import InputError
+from .recent import Recent
 
 __all__ = ["TANGENT_KINDS", "is_tangent", "nearest_vertex_normals", "strip_frame",
-           "strip_frames", "strip_solid", "solid_rings", "ring_tolerance", "real_section_m"]
+           "strip_frames", "strip_solid", "strip_solid_faces", "solid_rings", "ring_tolerance",
+           "real_section_m"]
 
 #: design kinds whose lamellae lie tangent to the surface (the others stand on it)
 TANGENT_KINDS = ("GG",)
+#: the surfaces of :func:`nearest_vertex_normals` in this process (normals, k-d tree), by
+#: content; the values are read only, so each caller gets them as they are (no copies)
+_SURFACES = Recent(2, copy=lambda v: v)
 
 
 def is_tangent(kind: str) -> bool:
@@ -38,19 +45,42 @@ def _unit(X: np.ndarray) -> np.ndarray:
 
 def nearest_vertex_normals(P: np.ndarray, V: np.ndarray, F: np.ndarray) -> np.ndarray:
     """Unit normals ``(k,3)`` at points ``P (k,3)``: the area-weighted vertex normal of the
-    closest vertex of the surface ``V (n,3)``, ``F (m,3|4)`` (only vertices used by a face)."""
-    from scipy.spatial import cKDTree
+    closest vertex of the surface ``V (n,3)``, ``F (m,3|4)`` (only vertices used by a face).
 
-    from .quadmesh import area_weighted_vertex_normals
-
+    The surface's side of it (the used vertices' normals and their k-d tree) is kept for the
+    last few surfaces of this process, by content (:func:`_surface_lookup`): the picture and the
+    report's viewer of one bundle ask about the same surface."""
     V = np.asarray(V, float).reshape(-1, 3)
     F = np.asarray(F, np.int64)
     if not len(V) or not F.size:
         raise InputError("the surface is empty; a strip's frame needs the surface mesh")
-    used = np.unique(F[F >= 0])
-    N = area_weighted_vertex_normals(V, F)[used]
-    _, idx = cKDTree(V[used]).query(np.asarray(P, float).reshape(-1, 3))
+    N, tree = _surface_lookup(V, F)
+    _, idx = tree.query(np.asarray(P, float).reshape(-1, 3))
     return N[idx]
+
+
+def _surface_lookup(V: np.ndarray, F: np.ndarray) -> tuple[np.ndarray, Any]:
+    """The unit area-weighted normals ``(u,3)`` of the vertices of ``V (n,3)`` used by the
+    faces ``F`` and a ``cKDTree`` of those vertices; the same objects again for a surface of the
+    same content (dtype, shape and bytes of ``V`` and ``F``). Both are read only: the normals
+    are not writeable and a query does not change a tree."""
+    import hashlib
+
+    from scipy.spatial import cKDTree
+
+    from .quadmesh import area_weighted_vertex_normals, unique_ints
+
+    key = tuple((a.dtype.str, a.shape, hashlib.blake2b(np.ascontiguousarray(a).data,
+                                                        digest_size=20).digest()) for a in (V, F))
+    hit = _SURFACES.get(key)
+    if hit is not None:
+        return hit
+    used = unique_ints(F[F >= 0])
+    N = area_weighted_vertex_normals(V, F)[used]
+    N.flags.writeable = False
+    out = (N, cKDTree(V[used]))
+    _SURFACES.put(key, out)
+    return out
 
 
 def strip_frame(axis: np.ndarray, normals: np.ndarray, tangent: bool
@@ -125,7 +155,13 @@ def strip_solid(axis: np.ndarray, normals: np.ndarray, width: float, thickness: 
     _, W, H = frame if frame is not None else strip_frame(P, normals, tangent)
     w, h = 0.5 * float(width) * W, 0.5 * float(thickness) * H
     V = np.stack([P - w - h, P + w - h, P + w + h, P - w + h], axis=1).reshape(-1, 3)
-    k = len(P)
+    return V, strip_solid_faces(len(P))
+
+
+def strip_solid_faces(k: int) -> np.ndarray:
+    """The faces ``(8(k-1)+4, 3)`` (int64, vertex indices) of :func:`strip_solid` of an axis of
+    ``k >= 2`` points: they depend on ``k`` alone (vertex ``4i + c`` is corner ``c`` of the
+    cross-section at axis point ``i``)."""
     i = np.arange(k - 1)[:, None] * 4
     faces = []
     for a in range(4):                       # the four long sides, each a quad per segment
@@ -135,8 +171,7 @@ def strip_solid(axis: np.ndarray, normals: np.ndarray, width: float, thickness: 
     last = 4 * (k - 1)
     faces.append(np.array([[0, 2, 1], [0, 3, 2],
                            [last, last + 1, last + 2], [last, last + 2, last + 3]]))
-    F = np.concatenate(faces).astype(np.int64)
-    return V, F
+    return np.concatenate(faces).astype(np.int64)
 
 
 def ring_tolerance(thickness: float) -> float:

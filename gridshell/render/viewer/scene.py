@@ -28,12 +28,12 @@ import base64
 import json
 import os
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
 from ...errors import InputError
-from ...strips3d import is_tangent, nearest_vertex_normals, strip_frames, strip_solid
+from ...strips3d import is_tangent, nearest_vertex_normals, strip_frames, strip_solid_faces
 from ..section import bundle_section
 
 __all__ = ["encode", "decode", "build_scene", "scene_json", "strip_solids_vertices",
@@ -68,25 +68,47 @@ def _arc(P: np.ndarray) -> np.ndarray:
     return np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(P, axis=0), axis=1))])
 
 
-def _sample(P: np.ndarray, frac: np.ndarray) -> np.ndarray:
-    """Points of polyline ``P (k,3)`` at arc-length fractions ``frac (m,)`` in [0, 1]."""
-    s = _arc(P)
-    if s[-1] <= 0:
-        return np.repeat(P[:1], len(frac), axis=0)
-    return np.stack([np.interp(frac * s[-1], s, P[:, c]) for c in range(3)], axis=1)
+def _interp_rows(x: np.ndarray, rx: np.ndarray, xp: np.ndarray, rxp: np.ndarray
+                 ) -> Callable[[np.ndarray], np.ndarray]:
+    """``np.interp`` in many rows at once, bit for bit: the function of ``fp (..., M, c)`` that
+    gives ``(..., N, c)`` with ``np.interp(x[rx == r], xp[rxp == r], fp[..., rxp == r, c])``
+    for every row ``r`` and column ``c`` (0 in a row without knots).
 
+    ``xp (M,)`` must be sorted by row ``rxp (M,)``, then by value, and ``x (N,)``, ``xp``
+    finite. The knot of each ``x`` is found once, for any number of ``fp``: the last of its
+    row at or below it (``searchsorted`` in the (row, value) pairs, ordered as complex numbers
+    are, lexicographically), and the value is numpy's: ``fp[j]`` at or beyond the row's ends
+    or on a knot, else ``slope * (x - xp[j]) + fp[j]`` with ``slope = (fp[j+1] - fp[j]) /
+    (xp[j+1] - xp[j])``, the same operations in the same order.
+    """
+    x, xp = np.asarray(x, float), np.asarray(xp, float)
+    rx, rxp = np.asarray(rx, np.int64), np.asarray(rxp, np.int64)
+    first = np.searchsorted(rxp, rx, side="left")
+    last = np.searchsorted(rxp, rx, side="right") - 1
+    empty = last < first
+    kp = np.empty(len(xp), complex)
+    kp.real, kp.imag = rxp, xp
+    kx = np.empty(len(x), complex)
+    kx.real, kx.imag = rx, x
+    j = np.searchsorted(kp, kx, side="right") - 1
+    below = j < first
+    j = np.where(empty, 0, np.minimum(np.maximum(j, first), last))
+    inner = np.flatnonzero(~empty & ~below & (j < last))
+    inner = inner[xp[j[inner]] != x[inner]]
+    ji = j[inner]
+    dx, at = xp[ji + 1] - xp[ji], x[inner] - xp[ji]
+    gone = np.flatnonzero(empty)
 
-def _interp_along(frac: np.ndarray, joint_frac: np.ndarray, values: np.ndarray) -> np.ndarray:
-    """Per-joint ``values (j,...)`` at the arc-length fractions ``frac`` of a lamella."""
-    values = np.asarray(values, float)
-    if len(joint_frac) == 0:
-        return np.zeros((len(frac),) + values.shape[1:])
-    if len(joint_frac) == 1:
-        return np.repeat(values[:1], len(frac), axis=0)
-    if values.ndim == 1:
-        return np.interp(frac, joint_frac, values)
-    return np.stack([np.interp(frac, joint_frac, values[:, c]) for c in range(values.shape[1])],
-                    axis=1)
+    def lookup(fp: np.ndarray) -> np.ndarray:
+        fp = np.asarray(fp, float)
+        if not len(xp):
+            return np.zeros(fp.shape[:-2] + (len(x),) + fp.shape[-1:])
+        out = fp[..., j, :]
+        f0 = fp[..., ji, :]
+        out[..., inner, :] = (fp[..., ji + 1, :] - f0) / dx[:, None] * at[:, None] + f0
+        out[..., gone, :] = 0.0
+        return out
+    return lookup
 
 
 def _loop_area_vectors(J: np.ndarray, loops: np.ndarray) -> np.ndarray:
@@ -176,6 +198,72 @@ def strip_solids_vertices(axes: list[np.ndarray], normals: list[np.ndarray], wid
     return np.stack([P - w - h, P + w - h, P + w + h, P - w + h], axis=1).reshape(-1, 3)
 
 
+def _axis_samples(net, use: list[int], states: list[np.ndarray], arcs: list[np.ndarray],
+                  fracs: list[np.ndarray]) -> np.ndarray:
+    """The points ``(K, T, 3)`` (metres) of the lamellae ``net.lamellae[i]``, ``i`` in ``use``,
+    at their arc-length fractions ``fracs`` in each of the ``K`` states: on the axes in the
+    first state (arc lengths ``arcs``), on the axes carried with the joints
+    (:func:`gridshell.net.carried_axes`) in the others; samples of all lamellae one after the
+    other (``T = sum len(fracs)``). A lamella of zero length gives its first point."""
+    from ...net import carried_axes
+
+    K, n = len(states), len(use)
+    carried = carried_axes(net, list(states[1:]))
+    xp, fp, counts = [], [], np.empty((n, K), np.int64)
+    length = np.empty((n, K))
+    for i, s in zip(range(n), arcs):       # the rows (lamella i, state k), i * K + k, in order
+        X, S = carried[use[i]]
+        xp += [s, S.reshape(-1)]
+        fp += [net.lamellae[use[i]].axis, X.reshape(-1, 3)]
+        counts[i] = [len(s)] + [S.shape[1]] * (K - 1)
+        length[i, 0], length[i, 1:] = s[-1], S[:, -1]
+    sizes = [len(f) for f in fracs]
+    lam = np.repeat(np.arange(n), sizes)
+    rows = lam[None, :] * K + np.arange(K)[:, None]                      # (K, T)
+    x = np.concatenate(fracs)[None, :] * length[lam].T
+    rxp = np.repeat(np.arange(n * K), counts.reshape(-1))
+    fp = np.concatenate(fp)
+    P = _interp_rows(x.reshape(-1), rows.reshape(-1), np.concatenate(xp), rxp)(fp)
+    zero = (length[lam].T <= 0).reshape(-1)
+    if zero.any():
+        P[zero] = fp[np.searchsorted(rxp, rows.reshape(-1)[zero])]
+    return P.reshape(K, len(lam), 3)
+
+
+def _sample_normals(lams: list, sizes: list[int], P0: np.ndarray, normals: list[np.ndarray],
+                    at_joints: Callable[[np.ndarray], np.ndarray], joints: np.ndarray,
+                    V: np.ndarray, F: np.ndarray) -> np.ndarray:
+    """The strips' normals ``(K, T, 3)`` at the axis samples of every state: the joints'
+    ``normals`` interpolated by arc length (``at_joints`` of the lamellae's ``joints``), made
+    unit; for a lamella with fewer than two joints the surface's nearest-vertex normal at its
+    samples ``P0`` in the first state and its joint's normal in the others."""
+    NS = np.stack(normals)
+    N = _unit(at_joints(NS[:, joints]))  # smooth along the strip (the nearest vertex's is not)
+    start = np.concatenate([[0], np.cumsum(sizes)])
+    few = [i for i, lam in enumerate(lams) if len(lam.joints) < 2]
+    if few and len(NS) > 1 and any(not len(lams[i].joints) for i in few):
+        T = int(start[-1])
+        none = sum(sizes[i] for i in few if not len(lams[i].joints))
+        raise InputError(f"strip frame: {T} axis points but {T - none} normals")
+    for i in few:
+        a, b = start[i], start[i + 1]
+        N[0, a:b] = nearest_vertex_normals(P0[a:b], V, F)
+        N[1:, a:b] = NS[1:, lams[i].joints[:1]]
+    return N
+
+
+def _extremes(X: np.ndarray) -> np.ndarray:
+    """``[X[k].min(axis=0), X[k].max(axis=0)]`` of every ``X[k] (n,3)``: ``(2, K, 3)``, the
+    same numbers. Taken along contiguous rows (fast); a minimum or maximum that is not 0 is
+    one value whatever the order, and where one is 0 (+0.0 or -0.0 may depend on the order)
+    that state is taken as ``X[k].min(axis=0)``, ``X[k].max(axis=0)``."""
+    Xt = np.ascontiguousarray(np.swapaxes(X, 1, 2))                   # (K, 3, n)
+    out = np.stack([Xt.min(axis=2), Xt.max(axis=2)])
+    for k in np.flatnonzero(np.any(out == 0.0, axis=(0, 2))):
+        out[:, k] = X[k].min(axis=0), X[k].max(axis=0)
+    return out
+
+
 def build_scene(bundle_dir: str | os.PathLike) -> dict[str, Any]:
     """The viewer's scene of a design bundle directory (see the module docstring).
 
@@ -183,7 +271,6 @@ def build_scene(bundle_dir: str | os.PathLike) -> dict[str, Any]:
     in their key's ``*_dtype`` companion or as documented: vertices ``f4``, faces ``u4``).
     """
     from ...bundle import read_bundle
-    from ...net import move_joints_states
 
     d = Path(bundle_dir)
     b = read_bundle(d)
@@ -191,7 +278,8 @@ def build_scene(bundle_dir: str | os.PathLike) -> dict[str, Any]:
     w, t = section.width_m, section.thickness_m
     tangent = is_tangent(b.kind)
     net = b.net
-    lams = [lam for lam in net.lamellae if len(lam.axis) >= 2]
+    use = [i for i, lam in enumerate(net.lamellae) if len(lam.axis) >= 2]
+    lams = [net.lamellae[i] for i in use]
     if not lams:
         raise InputError(f"{d}: no lamella axis with two points; nothing to show")
     states, labels = _states(d, b)
@@ -200,56 +288,53 @@ def build_scene(bundle_dir: str | os.PathLike) -> dict[str, Any]:
     diag = float(np.linalg.norm(allP.max(axis=0) - allP.min(axis=0))) or 1.0
 
     # axis samples by arc-length fraction, fixed over the states
+    arcs = [_arc(lam.axis) for lam in lams]
     fracs, joint_fracs = [], []
-    for lam in lams:
-        L = float(_arc(lam.axis)[-1])
+    for lam, s in zip(lams, arcs):
+        L = float(s[-1])
         m = int(np.clip(np.ceil(L / (_STEP * diag)) + 1, 8, MAX_SAMPLES))
         fracs.append(np.linspace(0.0, 1.0, m))
         joint_fracs.append(np.clip(lam.joint_s / L, 0.0, 1.0) if L > 0 else lam.joint_s * 0)
     n0 = nearest_vertex_normals(states[0], V, F)
     normals = joint_normals(states, net.loops, n0)
+    sizes = [len(f) for f in fracs]
+    at_joints = _interp_rows(np.concatenate(fracs), np.repeat(np.arange(len(lams)), sizes),
+                             np.concatenate(joint_fracs),
+                             np.repeat(np.arange(len(lams)), [len(jf) for jf in joint_fracs]))
+    joints = np.concatenate([lam.joints for lam in lams])
 
-    strip_V, strip_F, offsets = [], None, []
-    carried = [net] + move_joints_states(net, list(states[1:]))
-    for k, J in enumerate(states):
-        moved = carried[k]
-        by_id = {lam.id: lam for lam in moved.lamellae}
-        Pk, Nk, Fk, nv = [], [], [], 0
-        for lam, frac, jf in zip(lams, fracs, joint_fracs):
-            P = _sample(by_id[lam.id].axis, frac)
-            if len(lam.joints) >= 2:  # smooth along the strip (the nearest vertex's is not)
-                N = _unit(_interp_along(frac, jf, normals[k][lam.joints]))
-            else:
-                N = nearest_vertex_normals(P, V, F) if k == 0 else \
-                    np.repeat(normals[k][lam.joints[:1]], len(P), axis=0)
-            if tangent:  # two layers, bolted at the joints: C1 on the outer side, C3 inside
-                P = P + (0.5 * t if lam.family == 1 else -0.5 * t) * N
-            if k == 0:  # the faces (the same in every state) from the strip's own solid
-                SV, SF = strip_solid(P, N, w, t, tangent)
-                offsets.append((nv, len(SV), sum(len(f) for f in Fk), len(SF)))
-                Fk.append(SF + nv)
-                nv += len(SV)
-            Pk.append(P)
-            Nk.append(N)
-        strip_V.append(strip_solids_vertices(Pk, Nk, w, t, tangent))
-        if k == 0:
-            strip_F = np.concatenate(Fk)
+    P = _axis_samples(net, use, states, arcs, fracs)                      # (K, T, 3)
+    N = _sample_normals(lams, sizes, P[0], normals, at_joints, joints, V, F)
+    if tangent:  # two layers, bolted at the joints: C1 on the outer side, C3 inside
+        side = np.repeat([0.5 * t if lam.family == 1 else -0.5 * t for lam in lams], sizes)
+        P = P + side[None, :, None] * N
+    K, T = P.shape[:2]
+    cut = np.cumsum(np.tile(sizes, K))[:-1]
+    strip_V = strip_solids_vertices(np.split(P.reshape(-1, 3), cut),
+                                    np.split(N.reshape(-1, 3), cut), w, t,
+                                    tangent).reshape(K, 4 * T, 3)
+    # the faces, the same in every state: strip_solid's of each strip, one after the other
+    Fk, offsets, nv, nf = [], [], 0, 0
+    for k in sizes:
+        SF = strip_solid_faces(k)
+        offsets.append((nv, 4 * k, nf, len(SF)))
+        Fk.append(SF + nv)
+        nv, nf = nv + 4 * k, nf + len(SF)
+    strip_F = np.concatenate(Fk)
 
     loop_da, jda = joint_delta_a(states[0], net.loops)
-    da = np.concatenate([_interp_along(f, jf, jda[lam.joints])
-                         for lam, f, jf in zip(lams, fracs, joint_fracs)])
+    da = at_joints(jda[joints][:, None])[:, 0]
     scalars: dict[str, Any] = {"delta_a": encode(da, "f4")}
     structure = _structure(d)
     lam_util: dict[int, float] = {}
     if structure is not None:
         util = []
-        for lam, f in zip(lams, fracs):
+        for lam, s, f in zip(lams, arcs, fracs):
             u = structure.get(int(lam.id))
             if u is None or not len(u):
                 util.append(np.full(len(f), np.nan))
                 continue
             if len(u) == len(lam.axis):
-                s = _arc(lam.axis)
                 uf = s / s[-1] if s[-1] > 0 else np.linspace(0, 1, len(u))
             else:  # not one value per axis point: spread evenly
                 uf = np.linspace(0.0, 1.0, len(u))
@@ -260,7 +345,8 @@ def build_scene(bundle_dir: str | os.PathLike) -> dict[str, Any]:
     Ftri = F if F.shape[1] == 3 else np.concatenate([F[:, [0, 1, 2]], F[:, [0, 2, 3]]])
     Ftri = Ftri[np.all(Ftri >= 0, axis=1)]
     lo, hi = allP.min(axis=0), allP.max(axis=0)
-    centres = [(0.5 * (X.min(axis=0) + X.max(axis=0))).tolist() for X in strip_V]
+    lo_hi = _extremes(strip_V)
+    centres = (0.5 * (lo_hi[0] + lo_hi[1])).tolist()
     return {
         "format": "gridshell.viewer", "version": 1, "kind": b.kind, "units": "m",
         "tangent": bool(tangent),
@@ -273,11 +359,11 @@ def build_scene(bundle_dir: str | os.PathLike) -> dict[str, Any]:
         "strips": {"F": encode(strip_F, "u4"), "nv": int(len(strip_V[0])),
                    "nf": int(len(strip_F)), "V": [encode(X, "f4") for X in strip_V]},
         "lamellae": [{"id": int(lam.id), "family": int(lam.family),
-                      "length": float(_arc(lam.axis)[-1]), "samples": len(f),
+                      "length": float(s[-1]), "samples": len(f),
                       "v0": o[0], "nv": o[1], "f0": o[2], "nf": o[3],
                       **({"max_utilisation": lam_util[int(lam.id)]}
                          if int(lam.id) in lam_util else {})}
-                     for lam, f, o in zip(lams, fracs, offsets)],
+                     for lam, s, f, o in zip(lams, arcs, fracs, offsets)],
         "joints": {"n": int(len(net.joints)), "radius": min(0.6 * w, diag / 80.0),
                    "V": [encode(J, "f4") for J in states],
                    "delta_a": encode(jda, "f4")},
