@@ -83,8 +83,8 @@ def _interp_rows(x: np.ndarray, rx: np.ndarray, xp: np.ndarray, rxp: np.ndarray
     """
     x, xp = np.asarray(x, float), np.asarray(xp, float)
     rx, rxp = np.asarray(rx, np.int64), np.asarray(rxp, np.int64)
-    first = np.searchsorted(rxp, rx, side="left")
-    last = np.searchsorted(rxp, rx, side="right") - 1
+    ends = np.cumsum(np.bincount(rxp, minlength=int(rx.max(initial=-1)) + 1))
+    first, last = (ends - np.bincount(rxp, minlength=len(ends)))[rx], ends[rx] - 1
     empty = last < first
     kp = np.empty(len(xp), complex)
     kp.real, kp.imag = rxp, xp
@@ -208,22 +208,22 @@ def _axis_samples(net, use: list[int], states: list[np.ndarray], arcs: list[np.n
     from ...net import carried_axes
 
     K, n = len(states), len(use)
-    carried = carried_axes(net, list(states[1:]))
-    xp, fp, counts = [], [], np.empty((n, K), np.int64)
-    length = np.empty((n, K))
-    for i, s in zip(range(n), arcs):       # the rows (lamella i, state k), i * K + k, in order
-        X, S = carried[use[i]]
-        xp += [s, S.reshape(-1)]
-        fp += [net.lamellae[use[i]].axis, X.reshape(-1, 3)]
-        counts[i] = [len(s)] + [S.shape[1]] * (K - 1)
-        length[i, 0], length[i, 1:] = s[-1], S[:, -1]
+    every = carried_axes(net, list(states[1:]))
+    carried = [every[i] for i in use]
+    # the rows (lamella i, state k), numbered i * K + k, in order: knots xp, values fp
+    xp = np.concatenate([a for s, (_, S) in zip(arcs, carried) for a in (s, S.reshape(-1))])
+    fp = np.concatenate([a for i, (X, _) in zip(use, carried)
+                         for a in (net.lamellae[i].axis, X.reshape(-1, 3))])
+    counts = np.repeat([[len(s), S.shape[1]] for s, (_, S) in zip(arcs, carried)],
+                       [1, K - 1], axis=1)
+    length = np.concatenate([np.array([[s[-1]] for s in arcs]),
+                             np.stack([S[:, -1] for _, S in carried])], axis=1)    # (n, K)
     sizes = [len(f) for f in fracs]
     lam = np.repeat(np.arange(n), sizes)
     rows = lam[None, :] * K + np.arange(K)[:, None]                      # (K, T)
     x = np.concatenate(fracs)[None, :] * length[lam].T
     rxp = np.repeat(np.arange(n * K), counts.reshape(-1))
-    fp = np.concatenate(fp)
-    P = _interp_rows(x.reshape(-1), rows.reshape(-1), np.concatenate(xp), rxp)(fp)
+    P = _interp_rows(x.reshape(-1), rows.reshape(-1), xp, rxp)(fp)
     zero = (length[lam].T <= 0).reshape(-1)
     if zero.any():
         P[zero] = fp[np.searchsorted(rxp, rows.reshape(-1)[zero])]
@@ -314,9 +314,9 @@ def build_scene(bundle_dir: str | os.PathLike) -> dict[str, Any]:
                                     np.split(N.reshape(-1, 3), cut), w, t,
                                     tangent).reshape(K, 4 * T, 3)
     # the faces, the same in every state: strip_solid's of each strip, one after the other
-    Fk, offsets, nv, nf = [], [], 0, 0
+    Fk, offsets, nv, nf, of_k = [], [], 0, 0, {}
     for k in sizes:
-        SF = strip_solid_faces(k)
+        SF = of_k[k] if k in of_k else of_k.setdefault(k, strip_solid_faces(k))
         offsets.append((nv, 4 * k, nf, len(SF)))
         Fk.append(SF + nv)
         nv, nf = nv + 4 * k, nf + len(SF)
@@ -386,4 +386,5 @@ def scene_json(bundle_dir: str | os.PathLike) -> str:
 
     text = json.dumps(finite_json(build_scene(bundle_dir)), separators=(",", ":"),
                       allow_nan=False)
-    return text.replace("</", "<\\/")
+    # no "<" (base64 and numbers have none): no "</" either, and the 2 MB need no second scan
+    return text.replace("</", "<\\/") if "<" in text else text
