@@ -168,6 +168,25 @@ def _arclengths(X: np.ndarray) -> np.ndarray:
     return np.concatenate([np.zeros((len(X), 1)), np.cumsum(seg, axis=1)], axis=1)
 
 
+def _smooth_at(s: np.ndarray, X: np.ndarray, js: np.ndarray) -> np.ndarray:
+    """The points ``(k,3)`` at arc lengths ``js`` of the not-a-knot cubic spline through the
+    vertices ``X (p,3)`` at arc lengths ``s`` (the chord's through two vertices), metres.
+
+    Where every ``js`` is the arc length of a vertex other than the last (joints are axis
+    vertices in the bundles the tool writes), these are the vertices themselves: at its knot
+    ``s[i]`` the spline's piece ``i`` gives ``0.0 + X[i]`` (its constant coefficient; the other
+    terms are 0), so ``X[i] + 0.0``, bit for bit, without building the spline."""
+    from scipy.interpolate import CubicSpline
+
+    if len(s) <= 2:
+        return np.stack([np.interp(js, s, X[:, c]) for c in range(3)], axis=1)
+    i = np.minimum(np.searchsorted(s, js), len(s) - 1)
+    if np.all((s[i] == js) & (i < len(s) - 1)) and np.all(np.diff(s) > 0) \
+            and np.all(np.isfinite(X)):
+        return X[i] + 0.0
+    return CubicSpline(s, X, axis=0)(js)
+
+
 def _carry_axis(lam: Lamella, Js: np.ndarray
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]:
     """``lam`` carried to each joint state ``Js (m, n, 3)``: the axes ``(m, p, 3)``, their arc
@@ -188,9 +207,7 @@ def _carry_axis(lam: Lamella, Js: np.ndarray
     seg = np.diff(s)
     near = 0.2 * np.interp(s, 0.5 * (s[:-1] + s[1:]), seg) if len(seg) else s
     keep = np.min(np.abs(s[:, None] - js[None, :]), axis=1) > near
-    smooth = CubicSpline(s, X, axis=0) if len(s) > 2 else None
-    at = smooth(js) if smooth is not None else \
-        np.stack([np.interp(js, s, X[:, c]) for c in range(3)], axis=1)
+    at = _smooth_at(s, X, js)
     order = np.argsort(np.concatenate([s[keep], js]), kind="stable")
     s_all = np.concatenate([s[keep], js])[order]
     X = np.concatenate([X[keep], at])[order]

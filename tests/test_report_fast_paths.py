@@ -265,3 +265,26 @@ def test_surface_lookup_is_kept_by_content_only():
     used = np.unique(F[F >= 0])
     want = area_weighted_vertex_normals(V2, F)[used][cKDTree(V2[used]).query(P)[1]]
     assert np.array_equal(flipped, want) and not np.allclose(flipped, first)
+
+
+def test_smooth_curve_at_its_knots_is_the_vertices():
+    """net._smooth_at skips the spline where the joints are axis vertices: CubicSpline at an
+    interior knot is 0.0 + y there (+-0 included), bit for bit; elsewhere it is the spline."""
+    from scipy.interpolate import CubicSpline
+
+    from gridshell.net import _smooth_at
+
+    rng = np.random.default_rng(6)
+    for trial in range(300):
+        n = int(rng.integers(3, 120))
+        s = np.concatenate([[0.0], np.cumsum(rng.uniform(1e-4, 1, n - 1))])
+        X = rng.normal(size=(n, 3)) * 10.0 ** rng.uniform(-3, 3)
+        X[rng.random((n, 3)) < 0.1] = rng.choice([0.0, -0.0])
+        at = s[np.sort(rng.choice(n - 1, size=min(n - 1, 5), replace=False))]
+        want = CubicSpline(s, X, axis=0)(at)
+        assert np.array_equal(_bits(_smooth_at(s, X, at)), _bits(want))
+        off = at + 0.25 * (s[1] - s[0])                 # not at knots: the spline itself
+        assert np.array_equal(_bits(_smooth_at(s, X, off)),
+                              _bits(CubicSpline(s, X, axis=0)(off)))
+    ends = np.array([0.0, s[-1]])                       # the last knot: the spline too
+    assert np.array_equal(_bits(_smooth_at(s, X, ends)), _bits(CubicSpline(s, X, axis=0)(ends)))
