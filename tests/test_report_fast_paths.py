@@ -45,6 +45,30 @@ def _interp_along(frac, joint_frac, values):
                     axis=1)
 
 
+def _former_loop_area_vectors(J, loops):
+    L = np.asarray(loops, np.int64).reshape(-1, 4)
+    A = 0.5 * np.cross(J[L[:, 2]] - J[L[:, 0]], J[L[:, 3]] - J[L[:, 1]])
+    out = np.zeros_like(J)
+    for c in range(4):
+        np.add.at(out, L[:, c], A)
+    return out
+
+
+def _former_joint_normals(states, loops, n0):
+    out = [sc._unit(np.asarray(n0, float))]
+    if not len(loops):
+        return out * len(states)
+    A0 = np.linalg.norm(_former_loop_area_vectors(states[0], loops), axis=1)
+    for J in states[1:]:
+        A = _former_loop_area_vectors(J, loops)
+        prev = out[-1]
+        n = sc._unit(A)
+        n = np.where(np.sum(n * prev, axis=1, keepdims=True) < 0, -n, n)
+        ok = np.linalg.norm(A, axis=1) > sc._COLLAPSED * np.maximum(A0, 1e-300)
+        out.append(np.where(ok[:, None], n, prev))
+    return out
+
+
 def _former_strips(d: Path) -> dict:
     """The strips, Delta_a samples and centres of build_scene as computed before 2026-12-02:
     move_joints_states' nets, one _sample / np.interp / strip_solid per lamella and state."""
@@ -68,7 +92,7 @@ def _former_strips(d: Path) -> dict:
         m = int(np.clip(np.ceil(L / (sc._STEP * diag)) + 1, 8, sc.MAX_SAMPLES))
         fracs.append(np.linspace(0.0, 1.0, m))
         joint_fracs.append(np.clip(lam.joint_s / L, 0.0, 1.0) if L > 0 else lam.joint_s * 0)
-    normals = sc.joint_normals(states, net.loops, nearest_vertex_normals(states[0], V, F))
+    normals = _former_joint_normals(states, net.loops, nearest_vertex_normals(states[0], V, F))
     strip_V, strip_F, offsets = [], None, []
     carried = [net] + move_joints_states(net, list(states[1:]))
     for k in range(len(states)):
@@ -288,3 +312,18 @@ def test_smooth_curve_at_its_knots_is_the_vertices():
                               _bits(CubicSpline(s, X, axis=0)(off)))
     ends = np.array([0.0, s[-1]])                       # the last knot: the spline too
     assert np.array_equal(_bits(_smooth_at(s, X, ends)), _bits(CubicSpline(s, X, axis=0)(ends)))
+
+
+def test_joint_normals_of_all_states_at_once_are_state_by_state():
+    rng = np.random.default_rng(9)
+    net = _edge_net()
+    states = [net.joints + 0.1 * rng.normal(size=net.joints.shape) for _ in range(5)]
+    states[3][net.loops[0]] = states[3][net.loops[0, 0]]     # a collapsed loop keeps the normal
+    n0 = rng.normal(size=net.joints.shape)
+    for got, want in zip(sc.joint_normals(states, net.loops, n0),
+                         _former_joint_normals(states, net.loops, n0)):
+        assert np.array_equal(_bits(got), _bits(want))
+    loops = rng.integers(0, len(net.joints), size=(40, 4))  # joints at one corner of many loops
+    for got, want in zip(sc._loop_area_vectors(np.stack(states), loops),
+                         [_former_loop_area_vectors(J, loops) for J in states]):
+        assert np.array_equal(_bits(got), _bits(want))

@@ -112,13 +112,20 @@ def _interp_rows(x: np.ndarray, rx: np.ndarray, xp: np.ndarray, rxp: np.ndarray
 
 
 def _loop_area_vectors(J: np.ndarray, loops: np.ndarray) -> np.ndarray:
-    """Sum of the vector areas of the loops at each joint ``(n,3)``, m^2."""
+    """Sum of the vector areas of the loops at each joint ``(..., n, 3)``, m^2, of joints
+    ``J (..., n, 3)`` (several states at once): the loops' areas added corner by corner (all
+    first corners, then all second ones, ...), each loop in order, from 0."""
+    J = np.asarray(J, float)
     L = np.asarray(loops, np.int64).reshape(-1, 4)
-    A = 0.5 * np.cross(J[L[:, 2]] - J[L[:, 0]], J[L[:, 3]] - J[L[:, 1]])
-    out = np.zeros_like(J)
-    for c in range(4):
-        np.add.at(out, L[:, c], A)
-    return out
+    A = 0.5 * np.cross(J[..., L[:, 2], :] - J[..., L[:, 0], :],
+                       J[..., L[:, 3], :] - J[..., L[:, 1], :])        # (..., m, 3)
+    lead, n, m = J.shape[:-2], J.shape[-2], len(L)
+    cols = int(np.prod(lead, dtype=np.int64)) * 3
+    # np.add.at(out, L[:, c], A) for c = 0..3 as one bincount: the same terms in the same order
+    W = np.moveaxis(A.reshape(-1, m, 3), 0, 1).reshape(m, cols)       # (m, states * 3)
+    idx = (L.T.reshape(-1)[:, None] * cols + np.arange(cols)).reshape(-1)
+    out = np.bincount(idx, weights=np.tile(W, (4, 1)).reshape(-1), minlength=n * cols)
+    return np.moveaxis(out.reshape(n, -1, 3), 1, 0).reshape(J.shape)
 
 
 def joint_normals(states: list[np.ndarray], loops: np.ndarray, n0: np.ndarray) -> list[np.ndarray]:
@@ -128,14 +135,14 @@ def joint_normals(states: list[np.ndarray], loops: np.ndarray, n0: np.ndarray) -
     out = [_unit(np.asarray(n0, float))]
     if not len(loops):
         return out * len(states)
-    A0 = np.linalg.norm(_loop_area_vectors(states[0], loops), axis=1)
-    for J in states[1:]:
-        A = _loop_area_vectors(J, loops)
+    A = _loop_area_vectors(np.stack(states), loops)                    # (K, n, 3)
+    size = np.linalg.norm(A, axis=2)
+    U = _unit(A)
+    floor = _COLLAPSED * np.maximum(size[0], 1e-300)
+    for k in range(1, len(states)):
         prev = out[-1]
-        n = _unit(A)
-        n = np.where(np.sum(n * prev, axis=1, keepdims=True) < 0, -n, n)
-        ok = np.linalg.norm(A, axis=1) > _COLLAPSED * np.maximum(A0, 1e-300)
-        out.append(np.where(ok[:, None], n, prev))
+        n = np.where(np.sum(U[k] * prev, axis=1, keepdims=True) < 0, -U[k], U[k])
+        out.append(np.where((size[k] > floor)[:, None], n, prev))
     return out
 
 
