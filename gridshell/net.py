@@ -164,7 +164,9 @@ def carried_axes(net: Net, states: list[np.ndarray] | np.ndarray
 
 def _arclengths(X: np.ndarray) -> np.ndarray:
     """:func:`polyline_arclength` of each polyline ``X[k] (p,3)``: ``(m, p)``, the same sums."""
-    seg = np.linalg.norm(np.diff(X, axis=1), axis=2)
+    from .strips3d import row_norms
+
+    seg = row_norms(np.diff(X, axis=1))
     return np.concatenate([np.zeros((len(X), 1)), np.cumsum(seg, axis=1)], axis=1)
 
 

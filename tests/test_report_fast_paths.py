@@ -26,8 +26,17 @@ def _bits(a) -> np.ndarray:
 
 # ---- the former scene: lamella by lamella, state by state -------------------------------------
 
+def _former_unit(X):
+    n = np.linalg.norm(X, axis=-1, keepdims=True)
+    return np.divide(X, n, out=np.zeros_like(X), where=n > 0)
+
+
+def _former_arc(P):
+    return np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(P, axis=0), axis=1))])
+
+
 def _sample(P, frac):
-    s = sc._arc(P)
+    s = _former_arc(P)
     if s[-1] <= 0:
         return np.repeat(P[:1], len(frac), axis=0)
     return np.stack([np.interp(frac * s[-1], s, P[:, c]) for c in range(3)], axis=1)
@@ -55,14 +64,14 @@ def _former_loop_area_vectors(J, loops):
 
 
 def _former_joint_normals(states, loops, n0):
-    out = [sc._unit(np.asarray(n0, float))]
+    out = [_former_unit(np.asarray(n0, float))]
     if not len(loops):
         return out * len(states)
     A0 = np.linalg.norm(_former_loop_area_vectors(states[0], loops), axis=1)
     for J in states[1:]:
         A = _former_loop_area_vectors(J, loops)
         prev = out[-1]
-        n = sc._unit(A)
+        n = _former_unit(A)
         n = np.where(np.sum(n * prev, axis=1, keepdims=True) < 0, -n, n)
         ok = np.linalg.norm(A, axis=1) > sc._COLLAPSED * np.maximum(A0, 1e-300)
         out.append(np.where(ok[:, None], n, prev))
@@ -88,7 +97,7 @@ def _former_strips(d: Path) -> dict:
     diag = float(np.linalg.norm(allP.max(axis=0) - allP.min(axis=0))) or 1.0
     fracs, joint_fracs = [], []
     for lam in lams:
-        L = float(sc._arc(lam.axis)[-1])
+        L = float(_former_arc(lam.axis)[-1])
         m = int(np.clip(np.ceil(L / (sc._STEP * diag)) + 1, 8, sc.MAX_SAMPLES))
         fracs.append(np.linspace(0.0, 1.0, m))
         joint_fracs.append(np.clip(lam.joint_s / L, 0.0, 1.0) if L > 0 else lam.joint_s * 0)
@@ -101,7 +110,7 @@ def _former_strips(d: Path) -> dict:
         for lam, frac, jf in zip(lams, fracs, joint_fracs):
             P = _sample(by_id[lam.id].axis, frac)
             if len(lam.joints) >= 2:
-                N = sc._unit(_interp_along(frac, jf, normals[k][lam.joints]))
+                N = _former_unit(_interp_along(frac, jf, normals[k][lam.joints]))
             else:
                 N = nearest_vertex_normals(P, V, F) if k == 0 else \
                     np.repeat(normals[k][lam.joints[:1]], len(P), axis=0)
@@ -327,3 +336,18 @@ def test_joint_normals_of_all_states_at_once_are_state_by_state():
     for got, want in zip(sc._loop_area_vectors(np.stack(states), loops),
                          [_former_loop_area_vectors(J, loops) for J in states]):
         assert np.array_equal(_bits(got), _bits(want))
+
+
+def test_row_norms_are_numpys_norms():
+    from gridshell.strips3d import row_norms
+
+    rng = np.random.default_rng(12)
+    for trial in range(200):
+        X = rng.normal(size=(int(rng.integers(1, 400)), 3)) * 10.0 ** rng.uniform(-150, 150)
+        X[rng.random(X.shape) < 0.1] = rng.choice([0.0, -0.0, 1e-310, np.nan, np.inf])
+        with np.errstate(all="ignore"):
+            want = np.linalg.norm(X, axis=-1)
+            got = row_norms(X)
+        assert np.array_equal(_bits(got), _bits(want))
+    Y = rng.normal(size=(4, 50, 3))
+    assert np.array_equal(_bits(row_norms(Y)), _bits(np.linalg.norm(Y, axis=-1)))

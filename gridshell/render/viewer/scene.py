@@ -33,7 +33,8 @@ from typing import Any, Callable
 import numpy as np
 
 from ...errors import InputError
-from ...strips3d import is_tangent, nearest_vertex_normals, strip_frames, strip_solid_faces
+from ...strips3d import (is_tangent, nearest_vertex_normals, row_norms, strip_frames,
+                         strip_solid_faces)
 from ..section import bundle_section
 
 __all__ = ["encode", "decode", "build_scene", "scene_json", "strip_solids_vertices",
@@ -60,12 +61,12 @@ def decode(text: str, dtype: str) -> np.ndarray:
 
 
 def _unit(X: np.ndarray) -> np.ndarray:
-    n = np.linalg.norm(X, axis=-1, keepdims=True)
+    n = row_norms(X)[..., None]
     return np.divide(X, n, out=np.zeros_like(X), where=n > 0)
 
 
 def _arc(P: np.ndarray) -> np.ndarray:
-    return np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(P, axis=0), axis=1))])
+    return np.concatenate([[0.0], np.cumsum(row_norms(np.diff(P, axis=0)))])
 
 
 def _interp_rows(x: np.ndarray, rx: np.ndarray, xp: np.ndarray, rxp: np.ndarray
@@ -136,7 +137,7 @@ def joint_normals(states: list[np.ndarray], loops: np.ndarray, n0: np.ndarray) -
     if not len(loops):
         return out * len(states)
     A = _loop_area_vectors(np.stack(states), loops)                    # (K, n, 3)
-    size = np.linalg.norm(A, axis=2)
+    size = row_norms(A)
     U = _unit(A)
     floor = _COLLAPSED * np.maximum(size[0], 1e-300)
     for k in range(1, len(states)):
