@@ -23,7 +23,7 @@ from .recent import Recent
 
 __all__ = ["TANGENT_KINDS", "is_tangent", "nearest_vertex_normals", "strip_frame",
            "strip_frames", "strip_solid", "strip_solid_faces", "solid_rings", "ring_tolerance",
-           "real_section_m", "row_norms"]
+           "real_section_m", "row_norms", "packed_strip_frames"]
 
 #: design kinds whose lamellae lie tangent to the surface (the others stand on it)
 TANGENT_KINDS = ("GG",)
@@ -126,8 +126,21 @@ def strip_frames(axes: list[np.ndarray], normals: list[np.ndarray], tangent: boo
         raise InputError("strip frame: a lamella axis needs at least 2 points")
     P = np.concatenate([np.asarray(a, float).reshape(-1, 3) for a in axes]) if len(sizes) \
         else np.zeros((0, 3))
-    N = _unit(np.concatenate([np.asarray(n, float).reshape(-1, 3) for n in normals])) \
+    N = np.concatenate([np.asarray(n, float).reshape(-1, 3) for n in normals]) \
         if len(sizes) else np.zeros((0, 3))
+    return packed_strip_frames(P, N, sizes, tangent)
+
+
+def packed_strip_frames(P: np.ndarray, N: np.ndarray, sizes: np.ndarray, tangent: bool
+                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`strip_frames` of the axes packed one after the other in ``P (sum k_i, 3)``
+    (metres) with their normals ``N`` (any length) and point counts ``sizes (k_i >= 2)``:
+    the same ``P, N, T, W, H`` without splitting and joining the arrays."""
+    P = np.asarray(P, float).reshape(-1, 3)
+    sizes = np.asarray(sizes, np.int64).reshape(-1)
+    if len(sizes) and sizes.min() < 2:
+        raise InputError("strip frame: a lamella axis needs at least 2 points")
+    N = _unit(np.asarray(N, float).reshape(-1, 3))
     if len(N) != len(P):
         raise InputError(f"strip frame: {len(P)} axis points but {len(N)} normals")
     first = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64)

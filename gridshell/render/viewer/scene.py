@@ -33,8 +33,8 @@ from typing import Any, Callable
 import numpy as np
 
 from ...errors import InputError
-from ...strips3d import (is_tangent, nearest_vertex_normals, row_norms, strip_frames,
-                         strip_solid_faces)
+from ...strips3d import (is_tangent, nearest_vertex_normals, packed_strip_frames, row_norms,
+                         strip_frames, strip_solid_faces)
 from ..section import bundle_section
 
 __all__ = ["encode", "decode", "build_scene", "scene_json", "strip_solids_vertices",
@@ -196,12 +196,24 @@ def strip_solids_vertices(axes: list[np.ndarray], normals: list[np.ndarray], wid
     ``k_i >= 2``) with its normals, concatenated ``(4 sum k_i, 3)``: the same numbers, in one
     vectorized pass instead of one call per lamella (the frame's tangent is ``np.gradient``'s
     at unit spacing: central differences inside, one-sided at each axis's ends)."""
-    if not (np.isfinite(width) and np.isfinite(thickness) and width > 0 and thickness > 0):
-        raise InputError(f"strip solid: width {width!r} and thickness {thickness!r} must be "
-                         "positive lengths in metres")
+    _check_section(width, thickness)
     if not axes:
         return np.zeros((0, 3))
     P, _, _, W, H = strip_frames(axes, normals, tangent)
+    return _solids_vertices(P, W, H, width, thickness)
+
+
+def _check_section(width: float, thickness: float) -> None:
+    if not (np.isfinite(width) and np.isfinite(thickness) and width > 0 and thickness > 0):
+        raise InputError(f"strip solid: width {width!r} and thickness {thickness!r} must be "
+                         "positive lengths in metres")
+
+
+def _solids_vertices(P: np.ndarray, W: np.ndarray, H: np.ndarray, width: float,
+                     thickness: float) -> np.ndarray:
+    """The corners ``-W-H, +W-H, +W+H, -W+H`` of the sections at the axis points ``P``
+    (:func:`gridshell.strips3d.strip_solid`'s vertices), ``(4 len(P), 3)``, metres."""
+    _check_section(width, thickness)
     w, h = 0.5 * float(width) * W, 0.5 * float(thickness) * H
     return np.stack([P - w - h, P + w - h, P + w + h, P - w + h], axis=1).reshape(-1, 3)
 
@@ -317,10 +329,8 @@ def build_scene(bundle_dir: str | os.PathLike) -> dict[str, Any]:
         side = np.repeat([0.5 * t if lam.family == 1 else -0.5 * t for lam in lams], sizes)
         P = P + side[None, :, None] * N
     K, T = P.shape[:2]
-    cut = np.cumsum(np.tile(sizes, K))[:-1]
-    strip_V = strip_solids_vertices(np.split(P.reshape(-1, 3), cut),
-                                    np.split(N.reshape(-1, 3), cut), w, t,
-                                    tangent).reshape(K, 4 * T, 3)
+    frames = packed_strip_frames(P.reshape(-1, 3), N.reshape(-1, 3), np.tile(sizes, K), tangent)
+    strip_V = _solids_vertices(frames[0], frames[3], frames[4], w, t).reshape(K, 4 * T, 3)
     # the faces, the same in every state: strip_solid's of each strip, one after the other
     Fk, offsets, nv, nf, of_k = [], [], 0, 0, {}
     for k in sizes:
