@@ -104,9 +104,12 @@ def _interp_rows(x: np.ndarray, rx: np.ndarray, xp: np.ndarray, rxp: np.ndarray
         fp = np.asarray(fp, float)
         if not len(xp):
             return np.zeros(fp.shape[:-2] + (len(x),) + fp.shape[-1:])
-        out = fp[..., j, :]
-        f0 = fp[..., ji, :]
-        out[..., inner, :] = (fp[..., ji + 1, :] - f0) / dx[:, None] * at[:, None] + f0
+        out = np.take(fp, j, axis=-2)
+        f0, f1 = np.take(fp, ji, axis=-2), np.take(fp, ji + 1, axis=-2)
+        # dx, at spread over the columns as full-shape views: the same numbers, and numpy's
+        # loops run along the rows instead of once per 3-long row
+        out[..., inner, :] = (f1 - f0) / np.broadcast_to(dx[:, None], f0.shape) \
+            * np.broadcast_to(at[:, None], f0.shape) + f0
         out[..., gone, :] = 0.0
         return out
     return lookup
