@@ -201,8 +201,10 @@ def _carry_axis(lam: Lamella, Js: np.ndarray
     if len(X) < 2 or len(js) == 0:
         Xs = np.stack([X + (J[lam.joints[0]] - X[0] if len(js) else 0) for J in Js])
         return Xs, _arclengths(Xs), js, None
-    X = X[np.concatenate([[True], np.linalg.norm(np.diff(X, axis=0), axis=1) > 0])]
-    s = polyline_arclength(X)
+    from .strips3d import row_norms
+
+    X = X[np.concatenate([[True], row_norms(np.diff(X, axis=0)) > 0])]
+    s = _arclengths(X[None])[0]                            # polyline_arclength(X)
     js = np.clip(js, 0.0, s[-1])
     # the axis with its joints as vertices, placed on the smooth curve through the axis
     # vertices (not on a chord); vertices within a fifth of a segment of a joint give way
@@ -221,8 +223,8 @@ def _carry_axis(lam: Lamella, Js: np.ndarray
         Dc = np.moveaxis(D, 0, 1).reshape(len(js), 3 * m)  # every state's columns at once
         cs = CubicSpline(js, Dc, axis=0, bc_type="natural" if len(js) > 2 else "not-a-knot")
         t = np.clip(s_all, js[0], js[-1])
-        d = cs(t) + (s_all - t)[:, None] * np.where((s_all < js[0])[:, None], cs(js[0], 1),
-                                                     cs(js[-1], 1))
+        slope0, slope1 = cs(js[[0, -1]], 1)                # the slopes at the end joints
+        d = cs(t) + (s_all - t)[:, None] * np.where((s_all < js[0])[:, None], slope0, slope1)
         disp = np.moveaxis(d.reshape(len(s_all), m, 3), 1, 0)
     Xs = X[None] + disp
     return Xs, _arclengths(Xs), js, s_all
