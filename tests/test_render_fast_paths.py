@@ -137,3 +137,56 @@ def test_strips_faces_are_each_strips_solid_sides(tangent):
             for g, (X, Y) in enumerate(((A, M), (M, B))):
                 want = np.stack([X[:-1], Y[:-1], Y[1:], X[1:]], axis=1)
                 assert np.allclose(G[2 * s + g], want, atol=1e-12)
+
+
+def _padded_reference(painter: Painter, ax, linewidth: float = 0.2) -> None:
+    """The drawing :meth:`Painter.draw` stands for, one padded array: every polygon padded to
+    the most corners (:meth:`Painter.sorted_polygons`), grown by :func:`grow_polygons` as a
+    whole, outlined ones filled and then their ring."""
+    from matplotlib.collections import PathCollection
+    from matplotlib.path import Path as MplPath
+
+    P, face, edge = painter.sorted_polygons()
+    M = ax.transData.get_matrix()[:2, :2]
+    half_px = 0.5 * linewidth * ax.figure.dpi / 72.0
+    X = P @ M.T
+    out = (grow_polygons(X, 1.0) - X) @ np.linalg.inv(M).T * half_px
+    paths, colours = [], []
+    for p, o, f, e in zip(P, out, face, edge):
+        if np.all(f == e):
+            paths.append(MplPath(np.concatenate([p + o, p[:1] + o[:1]]), closed=True))
+            colours.append(f)
+        else:
+            paths.append(MplPath(np.concatenate([p, p[:1]]), closed=True))
+            colours.append(f)
+            ring = np.concatenate([p + o, p[:1] + o[:1], (p - o)[::-1], p[-1:] - o[-1:]])
+            loop = [MplPath.MOVETO] + [MplPath.LINETO] * (len(p) - 1) + [MplPath.CLOSEPOLY]
+            paths.append(MplPath(ring, loop + loop))
+            colours.append(e)
+    ax.add_collection(PathCollection(paths, facecolors=colours, edgecolors="none",
+                                     linewidths=0.0), autolim=False)
+
+
+@pytest.mark.parametrize("dots", [8, 5, 0])
+def test_painter_draw_list_by_list_paints_the_padded_array(dots):
+    """Each list of polygons grown with its own corner count (the padding's notch at the last
+    corner made directly: one, two or more copies) paints exactly the pixels of the padded
+    array grown as a whole."""
+    rng = np.random.default_rng(11)
+    painter = Painter(Camera(35.0, -50.0))
+    r, u, _ = painter.camera.basis()
+    tri = rng.uniform(-1, 1, (40, 3, 3))
+    grey = np.column_stack([rng.uniform(0.3, 1, (40, 3)), np.ones(40)])
+    painter.add(tri, grey, grey)
+    quad = rng.uniform(-1, 1, (50, 1, 3)) + rng.uniform(-0.2, 0.2, (50, 4, 3))
+    blue = np.column_stack([rng.uniform(0.1, 0.9, (50, 3)), np.ones(50)])
+    painter.add(quad, blue, blue, rng.uniform(-0.1, 0.1, 50))
+    if dots:
+        ring = np.linspace(0, 2 * np.pi, dots + 1)[:-1]
+        J = rng.uniform(-1, 1, (12, 3))
+        dot = J[:, None] + 0.06 * (np.cos(ring)[None, :, None] * r +
+                                   np.sin(ring)[None, :, None] * u)
+        painter.add(dot, np.array([0.1, 0.1, 0.1, 1.0]), np.array([0.0, 0.0, 0.0, 1.0]), 0.02)
+    fast, ref = _pixels(painter.draw), _pixels(lambda ax: _padded_reference(painter, ax))
+    assert fast.std() > 10
+    assert np.array_equal(fast, ref)
