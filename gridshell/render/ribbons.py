@@ -283,7 +283,8 @@ def render_ribbons(path: str | os.PathLike, axes: Sequence[np.ndarray],
 def _write_png(fig, path: str | os.PathLike, dpi: int) -> None:
     """``fig`` drawn once by Agg and written as PNG at ``dpi``, atomically: RGB when every pixel
     is opaque (the same picture as ``savefig``'s RGBA, a tenth smaller and faster to encode),
-    zlib level 3 (the same pixels in half the encoding time of the default 6)."""
+    zlib level 1 (the same pixels; for the 1000 x 750 picture of a 20-curve NCP bundle ~28 ms
+    and 540 kB against ~34 ms and 521 kB at level 3, ~60 ms at the default 6)."""
     from matplotlib import __version__ as mpl_version
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from PIL import Image, PngImagePlugin
@@ -295,7 +296,7 @@ def _write_png(fig, path: str | os.PathLike, dpi: int) -> None:
     info = PngImagePlugin.PngInfo()
     info.add_text("Software", f"Matplotlib version{mpl_version}, https://matplotlib.org/")
     with atomic_path(path) as tmp:
-        Image.fromarray(np.ascontiguousarray(img)).save(tmp, format="png", compress_level=3,
+        Image.fromarray(np.ascontiguousarray(img)).save(tmp, format="png", compress_level=1,
                                                         dpi=(dpi, dpi), pnginfo=info)
 
 
