@@ -265,7 +265,7 @@ def _grow_as_padded(P: np.ndarray, M: np.ndarray, Minv_T: np.ndarray, half_px: f
     grows the padded polygons, the same numbers with at most two copies of the last corner:
     padded, the last corner moves along the edge before it only, its last copy along the
     closing edge only and copies between stay (:func:`_padded_layout` order)."""
-    X = P @ M.T
+    X = _linear(P, M.T)
     G, N, Nin = _grow_parts(X, 1.0)
     if pad:
         last = X[:, -1:]
@@ -274,11 +274,21 @@ def _grow_as_padded(P: np.ndarray, M: np.ndarray, Minv_T: np.ndarray, half_px: f
             moved.append(last)
         G = np.concatenate(moved + [last + 1.0 * N[:, -1:]], axis=1)
         X = _padded_layout(X, pad)
-    out = (G - X) @ Minv_T * half_px
+    out = _linear(G - X, Minv_T) * half_px
     Pp = _padded_layout(P, pad)
     if grow.all():
         return Pp + out
     return np.where(grow[:, None, None], Pp + out, Pp)
+
+
+def _linear(P: np.ndarray, A: np.ndarray) -> np.ndarray:
+    """``P @ A`` for points ``P (..., 2)`` and a ``(2, 2)`` matrix ``A``: when ``A`` is diagonal
+    (the axes' data -> pixel scale) the product of each coordinate by its diagonal entry, the
+    same numbers (the other term is a product by zero) without numpy's stacked product of
+    many 2 x 2 ones (~2 ms for 35k quads)."""
+    if A[0, 1] == 0.0 and A[1, 0] == 0.0:
+        return P * np.diag(A)
+    return P @ A
 
 
 def _grow_parts(P: np.ndarray, d: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
