@@ -190,3 +190,15 @@ def test_painter_draw_list_by_list_paints_the_padded_array(dots):
     fast, ref = _pixels(painter.draw), _pixels(lambda ax: _padded_reference(painter, ax))
     assert fast.std() > 10
     assert np.array_equal(fast, ref)
+
+
+def test_linear_is_the_matrix_product_bit_for_bit():
+    """The growth's data <-> pixel scale: a diagonal matrix as products by its entries, the
+    same numbers as numpy's stacked product; any other matrix through the product."""
+    from gridshell.render.painter import _linear
+
+    rng = np.random.default_rng(3)
+    P = rng.normal(size=(500, 6, 2)) * 37.0
+    D = np.diag([779.3523568869717, 779.3523568869716])
+    for A in (D, np.linalg.inv(D).T, np.array([[2.0, 0.5], [-0.25, 3.0]])):
+        assert np.array_equal(_linear(P, A), P @ A)
