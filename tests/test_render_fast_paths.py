@@ -202,3 +202,20 @@ def test_linear_is_the_matrix_product_bit_for_bit():
     D = np.diag([779.3523568869717, 779.3523568869716])
     for A in (D, np.linalg.inv(D).T, np.array([[2.0, 0.5], [-0.25, 3.0]])):
         assert np.array_equal(_linear(P, A), P @ A)
+
+
+@pytest.mark.parametrize("rect", [(0.01, 0.01, 0.98, 0.91), (0.01, 0.01, 0.98, 0.98)])
+def test_picture_transform_is_the_axes_transdata(rect):
+    """render_ribbons draws without an axes: its data -> pixel map is the ``transData`` of an
+    axes at ``rect`` with the same limits, number for number."""
+    from matplotlib.figure import Figure
+
+    from gridshell.render.ribbons import _data_to_pixels
+
+    fig = Figure(figsize=(10.0, 7.5), dpi=100)
+    lo, hi = np.array([-3.123456789, -1.2345]), np.array([4.98765, 2.718281828])
+    ax = fig.add_axes(rect)
+    ax.set_xlim(lo[0], hi[0])
+    ax.set_ylim(lo[1], hi[1])
+    assert np.array_equal(_data_to_pixels(fig, rect, lo, hi).get_matrix(),
+                          ax.transData.get_matrix())

@@ -166,9 +166,17 @@ class Painter:
                 np.concatenate(self.edge)[order])
 
     def draw(self, ax, linewidth: float = 0.2) -> None:
-        """Paint everything, far to near, into a 2D matplotlib ``ax`` (one collection; its
-        limits are the caller's and must be set before: the collection does not autoscale
-        the axes).
+        """Paint everything, far to near, into a 2D matplotlib ``ax`` (one collection,
+        :meth:`collection` through ``ax.transData``; its limits are the caller's and must be
+        set before: the collection does not autoscale the axes)."""
+        coll = self.collection(ax.transData, ax.figure.dpi, linewidth)
+        if coll is not None:
+            ax.add_collection(coll, autolim=False)
+
+    def collection(self, transform, dpi: float, linewidth: float = 0.2):
+        """Everything, far to near, as one matplotlib collection in data coordinates drawn
+        through ``transform`` (an affine data -> display pixels map, e.g. an axes'
+        ``transData``) at ``dpi``; None when there is nothing to draw.
 
         Each polygon is outlined by a line ``linewidth`` points wide in its edge colour, drawn
         as fills only (Agg's stroke takes as long as the fills; offsets by
@@ -182,13 +190,13 @@ class Painter:
         most is padded by repeating its last corner, which the growth turns into a notch at
         that corner: :func:`grow_polygons`), computed and drawn list by list of
         :meth:`add` with each list's own corner count (:func:`_grow_as_padded`): the same
-        vertices without the repeated points, a third of the corners of the surface and strip
-        quads when the joint dots have eight.
+        vertices without the repeated points (six corners for a surface or strip quad instead of
+        eight when the joint dots have eight).
         """
         from matplotlib.path import Path as MplPath
 
         if not self.polys:
-            return
+            return None
         kmax = max(p.shape[1] for p in self.polys)
         order = np.argsort(np.concatenate(self.keys), kind="stable")
         face = np.concatenate(self.face)[order]
@@ -201,9 +209,9 @@ class Painter:
         out_of = np.empty(len(order), bool)
         out_of[order] = outlined                                  # outlined, in list order
         if linewidth > 0:
-            M = ax.transData.get_matrix()[:2, :2]   # data -> display pixels (linear axes)
+            M = transform.get_matrix()[:2, :2]   # data -> display pixels (linear axes)
             Minv_T = np.linalg.inv(M).T
-            half_px = 0.5 * float(linewidth) * ax.figure.dpi / 72.0
+            half_px = 0.5 * float(linewidth) * float(dpi) / 72.0
         sources = []
         for c, (P, s0) in enumerate(zip(self.polys, starts)):
             pad = kmax - P.shape[1]
@@ -240,8 +248,10 @@ class Painter:
             chunk[ring], local[ring] = -1, np.arange(len(special))
             face = np.where(ring[:, None], edge[idx], face[idx])
         paths = _PolygonPaths(sources, chunk, local, special)
-        ax.add_collection(_array_poly_collection()(paths, facecolors=face, edgecolors="none",
-                                                   linewidths=0.0), autolim=False)
+        coll = _array_poly_collection()(paths, facecolors=face, edgecolors="none",
+                                        linewidths=0.0)
+        coll.set_transform(transform)
+        return coll
 
 
 def _pad_to(P: np.ndarray, k: int) -> np.ndarray:

@@ -251,16 +251,17 @@ def render_ribbons(path: str | os.PathLike, axes: Sequence[np.ndarray],
                     np.array([0.0, 0.0, 0.0, 1.0]), bias + 1.5 * w)
 
     fig = Figure(figsize=(size[0] / dpi, size[1] / dpi), dpi=dpi)
-    ax = fig.add_axes((0.01, 0.01, 0.98, 0.91 if title else 0.98))
+    rect = (0.01, 0.01, 0.98, 0.91 if title else 0.98)   # the picture's box, figure fraction
     xy = np.concatenate([p.reshape(-1, 2) for p in painter.polys])
     lo, hi = xy.min(axis=0), xy.max(axis=0)
-    box = np.array([0.98 * size[0], (0.91 if title else 0.98) * size[1]])  # axes, pixels
+    box = np.array([0.98 * size[0], (0.91 if title else 0.98) * size[1]])  # the box, pixels
     scale = 1.06 * float(np.max((hi - lo) / box)) or 1.0  # metres per pixel, equal both ways
     mid = 0.5 * (lo + hi)
-    ax.set_xlim(mid[0] - 0.5 * scale * box[0], mid[0] + 0.5 * scale * box[0])
-    ax.set_ylim(mid[1] - 0.5 * scale * box[1], mid[1] + 0.5 * scale * box[1])
-    ax.set_axis_off()
-    painter.draw(ax, linewidth=0.2)  # after the limits: it grows polygons in display pixels
+    coll = painter.collection(_data_to_pixels(fig, rect, mid - 0.5 * scale * box,
+                                              mid + 0.5 * scale * box), dpi, linewidth=0.2)
+    if coll is not None:
+        coll.set_zorder(0)  # under everything else, as in an axes added first
+        fig.add_artist(coll)
     if colorbar is not None:
         from matplotlib import colormaps
         from matplotlib.cm import ScalarMappable
@@ -278,6 +279,19 @@ def render_ribbons(path: str | os.PathLike, axes: Sequence[np.ndarray],
         fig.suptitle(title, fontsize=max(6.0, min(10.0, size[0] / 60.0)))
     _write_png(fig, path, dpi)
     return Path(path)
+
+
+def _data_to_pixels(fig, rect: tuple[float, float, float, float], lo: np.ndarray,
+                    hi: np.ndarray):
+    """The affine map from data (the picture's plane, metres) to the display pixels of
+    ``fig`` that takes the box ``lo``-``hi`` onto ``rect`` (left, bottom, width, height as
+    fractions of the figure): an axes' ``transData`` with these limits (the same transforms,
+    the same numbers) without making the axes (its ticks, spines and titles are not drawn).
+    The picture's polygons lie inside the box with a margin, so nothing needs clipping."""
+    from matplotlib.transforms import Bbox, BboxTransformFrom, BboxTransformTo, TransformedBbox
+
+    return (BboxTransformFrom(Bbox([[lo[0], lo[1]], [hi[0], hi[1]]])) +
+            BboxTransformTo(TransformedBbox(Bbox.from_bounds(*rect), fig.transSubfigure)))
 
 
 def _write_png(fig, path: str | os.PathLike, dpi: int) -> None:
