@@ -19,7 +19,6 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -193,6 +192,7 @@ class Painter:
         vertices without the repeated points (six corners for a surface or strip quad instead of
         eight when the joint dots have eight).
         """
+        from matplotlib.collections import PathCollection
         from matplotlib.path import Path as MplPath
 
         if not self.polys:
@@ -248,8 +248,7 @@ class Painter:
             chunk[ring], local[ring] = -1, np.arange(len(special))
             face = np.where(ring[:, None], edge[idx], face[idx])
         paths = _PolygonPaths(sources, chunk, local, special)
-        coll = _array_poly_collection()(paths, facecolors=face, edgecolors="none",
-                                        linewidths=0.0)
+        coll = PathCollection(paths, facecolors=face, edgecolors="none", linewidths=0.0)
         coll.set_transform(transform)
         return coll
 
@@ -343,7 +342,9 @@ class _PolygonPaths(Sequence):
         self._chunk = chunk.tolist()
         self._local = local.tolist()
         self._special = special
-        self._make = MplPath._fast_from_codes_and_verts  # what PolyCollection uses
+        # what PolyCollection uses (a private matplotlib method, as before: the public
+        # constructor checks and reads rcParams for each of the ~35k paths)
+        self._make = MplPath._fast_from_codes_and_verts
 
     def __len__(self) -> int:
         return len(self._chunk)
@@ -356,19 +357,3 @@ class _PolygonPaths(Sequence):
             return self._special[self._local[i]]
         V, codes, template = self._sources[c]
         return self._make(V[self._local[i]], codes, internals_from=template)
-
-
-@lru_cache(maxsize=1)
-def _array_poly_collection() -> type:
-    """The ``PolyCollection`` class drawing a :class:`_PolygonPaths` (made on first use: this
-    module does not import matplotlib)."""
-    from matplotlib.collections import PolyCollection
-
-    class ArrayPolyCollection(PolyCollection):
-        """A ``PolyCollection`` drawing the paths of a :class:`_PolygonPaths`."""
-
-        def __init__(self, paths: _PolygonPaths, **kwargs) -> None:
-            super().__init__([], **kwargs)
-            self._paths = paths
-
-    return ArrayPolyCollection
