@@ -155,11 +155,18 @@ def unwelded_sides(V: np.ndarray, F: np.ndarray) -> tuple[np.ndarray, np.ndarray
     return np.asarray(V, float)[uniq % M], inverse.reshape(-1, 3)
 
 
+def _split_frames(PNTWH: tuple[np.ndarray, ...], ends: np.ndarray) -> list[tuple]:
+    """The ``(T, W, H)`` of each lamella from :func:`gridshell.strips3d.strip_frames`' output
+    ``(P, N, T, W, H)`` of all lamellae, split at the row offsets ``ends``."""
+    _, _, T, W, H = PNTWH
+    return list(zip(np.split(T, ends), np.split(W, ends), np.split(H, ends)))
+
+
 def _strips(m: _Model, bundle, params, with_holes: bool) -> dict[str, Any]:
     """Strip solids on the family layers, axes, and the holes; returns figures."""
     from ..igl_adapter import closest_points_with_normals
     from ..net import polyline_arclength
-    from ..strips3d import (is_tangent, real_section_m, solid_rings, strip_frame,
+    from ..strips3d import (is_tangent, real_section_m, solid_rings_many, strip_frames,
                             strip_solid)
 
     tangent = is_tangent(bundle.kind)
@@ -175,24 +182,28 @@ def _strips(m: _Model, bundle, params, with_holes: bool) -> dict[str, Any]:
     # (reuse: the query the verification of the design asked, gridshell.verification)
     normals = closest_points_with_normals(np.concatenate([P for _, P in lams]),
                                           bundle.surface_V, bundle.surface_F, reuse=True)[1]
-    n_holes, at = 0, 0
-    for lam, P in lams:
-        N = normals[at:at + len(P)]
-        at += len(P)
-        frame = strip_frame(P, N, tangent)
-        _, W, H = frame
-        if tangent:      # stacked: family 1 on the normals' side of the surface, 3 below
-            C = P + (0.5 * t if lam.family == 1 else -0.5 * t) * H
-        elif params.axis == "edge":    # the axis on the edge the strip stands on
-            C = P + 0.5 * w * W
-        else:
-            C = P
-        # the solid's frame along C: the one above when C is the axis itself
-        Tc, Wc, Hc = frame if C is P else strip_frame(C, N, tangent)
-        # only the rings the solid needs: its corner edges within ring_tolerance(t) (1 % of
-        # the thickness or 0.05 mm, real size) of the full-resolution ones; the axis
-        # polyline, the holes and the user strings keep every sample
-        r = solid_rings(C, Wc, Hc, w, t)
+    # the frames of all lamellae in one pass each (strip_frames: the numbers of one
+    # strip_frame per lamella)
+    ends = np.cumsum([len(P) for _, P in lams])[:-1]
+    Ns = np.split(normals, ends)
+    frames = _split_frames(strip_frames([P for _, P in lams], Ns, tangent), ends)
+    if tangent:      # stacked: family 1 on the normals' side of the surface, 3 below
+        Cs = [P + (0.5 * t if lam.family == 1 else -0.5 * t) * H
+              for (lam, P), (_, _, H) in zip(lams, frames)]
+    elif params.axis == "edge":    # the axis on the edge the strip stands on
+        Cs = [P + 0.5 * w * W for (_, P), (_, W, _) in zip(lams, frames)]
+    else:
+        Cs = [P for _, P in lams]
+    # the solids' frames along C: the ones above when C is the axis itself
+    solid = frames if Cs[0] is lams[0][1] else \
+        _split_frames(strip_frames(Cs, Ns, tangent), ends)
+    # only the rings the solid needs: its corner edges within ring_tolerance(t) (1 % of
+    # the thickness or 0.05 mm, real size) of the full-resolution ones; the axis
+    # polyline, the holes and the user strings keep every sample (solid_rings_many: the
+    # indices of one solid_rings per lamella)
+    rings = solid_rings_many(Cs, [f[1] for f in solid], [f[2] for f in solid], w, t)
+    n_holes = 0
+    for (lam, P), N, (_, _, H), C, (Tc, Wc, Hc), r in zip(lams, Ns, frames, Cs, solid, rings):
         V, F = strip_solid(C[r], N[r], w, t, tangent, frame=(Tc[r], Wc[r], Hc[r]))
         s = polyline_arclength(P)
         strings = {"lamella_id": int(lam.id), "family": int(lam.family), "kind": bundle.kind,
