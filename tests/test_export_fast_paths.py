@@ -76,3 +76,50 @@ def test_unwelded_sides_equal_the_row_wise_unique():
     assert np.array_equal(V2, np.asarray(V, float)[uniq[:, 1]])
     assert np.array_equal(F2, inverse.reshape(-1, 3))
     assert np.array_equal(V2[F2], np.asarray(V, float)[F])     # the same triangles
+
+
+def _attributes(obj):
+    a = obj.Attributes
+    return (a.LayerIndex, a.Name, a.GetUserStrings(), a.Visible, a.Mode, a.ColorSource,
+            str(a.ObjectColor), a.PlotColorSource, a.PlotWeight)
+
+
+def test_shared_attributes_equal_one_set_per_object(tmp_path):
+    """Objects added with one shared set of attributes (_Model.shared, _Model.again: a part's
+    holes and labels, a strip and its axis) read back with the attributes one new set per
+    object gives, each object its own (distinct ids, the name it was added with); counts per
+    layer as with one set each."""
+    from gridshell.export.rhino import _Model
+    from gridshell.export.units import parse_units
+
+    def model(shared: bool):
+        m = _Model(parse_units("mm"))
+        m.layer("a", (1, 2, 3, 255))
+        m.layer("b", (4, 5, 6, 255))
+        strings = {"lamella_id": 3, "family": 1, "joints": "1 2 3"}
+        circles = [geo.circle((float(i), 0.0), 0.5, 1.0) for i in range(3)]
+        if shared:
+            a = m.shared(3, "a", "L3 hole", role="hole", **strings)
+            for c in circles:
+                m.model.Objects.AddCircle(c, a)
+            a = m.attrs("a", "L3", **strings)
+            m.model.Objects.AddPoint(rhino3dm.Point3d(0, 0, 0), a)
+            m.model.Objects.AddPoint(rhino3dm.Point3d(1, 0, 0), m.again(a, "b", "L3 axis"))
+        else:
+            for c in circles:
+                m.model.Objects.AddCircle(c, m.attrs("a", "L3 hole", role="hole", **strings))
+            m.model.Objects.AddPoint(rhino3dm.Point3d(0, 0, 0), m.attrs("a", "L3", **strings))
+            m.model.Objects.AddPoint(rhino3dm.Point3d(1, 0, 0),
+                                     m.attrs("b", "L3 axis", **strings))
+        path = tmp_path / f"{shared}.3dm"
+        assert m.model.Write(str(path), 8)
+        return rhino3dm.File3dm.Read(str(path)), m.counts
+
+    (one, counts1), (each, counts2) = model(True), model(False)
+    assert counts1 == counts2 == {"a": 4, "b": 1}
+    assert len(one.Objects) == len(each.Objects) == 5
+    assert [_attributes(o) for o in one.Objects] == [_attributes(o) for o in each.Objects]
+    assert [o.Attributes.Name for o in one.Objects] == ["L3 hole"] * 3 + ["L3", "L3 axis"]
+    assert len({str(o.Attributes.Id) for o in one.Objects}) == 5
+    assert [o.Geometry.Encode()["data"] for o in one.Objects] == \
+        [o.Geometry.Encode()["data"] for o in each.Objects]

@@ -122,6 +122,24 @@ class _Model:
         self.counts[layer] += 1
         return a
 
+    def shared(self, n: int, layer: str, name: str, **strings: object):
+        """:meth:`attrs` for ``n`` objects at once (counted ``n`` times): rhino3dm copies the
+        attributes into each object it adds, so objects with equal attributes (a part's
+        holes, its label strokes) can share one set."""
+        a = self.attrs(layer, name, **strings)
+        self.counts[layer] += n - 1
+        return a
+
+    def again(self, a, layer: str, name: str):
+        """The attributes ``a`` (:meth:`attrs`) for one more object on ``layer`` named
+        ``name``, their user strings kept: rhino3dm copies the attributes into each object
+        it adds, so one set serves objects whose attributes differ only in layer and name
+        (the same object attributes as a new :meth:`attrs` with the same strings)."""
+        a.LayerIndex = self.layers[layer]
+        a.Name = name
+        self.counts[layer] += 1
+        return a
+
     def u(self, X):
         """Metres -> the user's unit."""
         return np.asarray(X, float) / self.units.metres_per_unit
@@ -216,10 +234,10 @@ def _strips(m: _Model, bundle, params, with_holes: bool) -> dict[str, Any]:
                    "width_m": f"{w:.9g}", "thickness_m": f"{t:.9g}"}
         layer = f"family {lam.family}"
         V, F = unwelded_sides(V, F)
-        m.model.Objects.AddMesh(geo.mesh(m.u(V), F, what=f"lamella {lam.id} strip"),
-                                m.attrs(layer, f"L{lam.id}", **strings))
-        m.model.Objects.AddPolyline(geo.point_list(m.u(P)), m.attrs("axes", f"L{lam.id} axis",
-                                                                    **strings))
+        a = m.attrs(layer, f"L{lam.id}", **strings)
+        m.model.Objects.AddMesh(geo.mesh(m.u(V), F, what=f"lamella {lam.id} strip"), a)
+        m.model.Objects.AddPolyline(geo.point_list(m.u(P)),
+                                    m.again(a, "axes", f"L{lam.id} axis"))
         if not with_holes or not len(lam.joints):
             continue
         js = np.clip(lam.joint_s, 0.0, s[-1])
@@ -272,15 +290,20 @@ def _sheets(m: _Model, bundle, layout, params) -> list[dict[str, Any]]:
             m.model.Objects.AddCurve(geo.bulge_curve(place(p.outline.V), p.outline.B,
                                                      p.outline.closed, z),
                                      m.attrs(layer, name, role="outline", **ids))
-            for c, r in zip(p.holes, p.radii):
-                m.model.Objects.AddCircle(geo.circle(place(c)[0], float(r) * to_unit, z),
-                                         m.attrs(layer, f"{name} hole", role="hole", **ids))
-            for a, b in p.scores:
-                m.model.Objects.AddCurve(geo.bulge_curve(place([a, b]), None, False, z),
-                                         m.attrs(layer, f"{name} score", role="score", **ids))
-            for L in p.engrave:
-                m.model.Objects.AddCurve(geo.bulge_curve(place(L), None, False, z),
-                                         m.attrs(layer, f"{name} label", role="engrave", **ids))
+            # one set of attributes for a part's holes, one for its scores, one for its
+            # labels (copied into each object: the same attributes as one set each)
+            if len(p.holes):
+                a = m.shared(len(p.holes), layer, f"{name} hole", role="hole", **ids)
+                for c, r in zip(place(p.holes), p.radii.tolist()):
+                    m.model.Objects.AddCircle(geo.circle(c, r * to_unit, z), a)
+            if len(p.scores):
+                a = m.shared(len(p.scores), layer, f"{name} score", role="score", **ids)
+                for ab in p.scores:
+                    m.model.Objects.AddCurve(geo.bulge_curve(place(ab), None, False, z), a)
+            if len(p.engrave):
+                a = m.shared(len(p.engrave), layer, f"{name} label", role="engrave", **ids)
+                for L in p.engrave:
+                    m.model.Objects.AddCurve(geo.bulge_curve(place(L), None, False, z), a)
         out.append({"layer": layer, "parts": len(parts),
                     "origin": [float(origin[0]), float(origin[1]), z]})
         x = x + (W + 0.05 * W) * to_unit
