@@ -123,3 +123,20 @@ def test_shared_attributes_equal_one_set_per_object(tmp_path):
     assert len({str(o.Attributes.Id) for o in one.Objects}) == 5
     assert [o.Geometry.Encode()["data"] for o in one.Objects] == \
         [o.Geometry.Encode()["data"] for o in each.Objects]
+
+
+@pytest.mark.parametrize("shape", [(0, 3), (1, 3), (57, 3), (9, 2)])
+def test_point_list_equals_one_by_one(shape):
+    """point_list (points added through map) holds the points a loop adding them one by one
+    holds, in order (z = 0 for 2-d input), and makes the same polyline curve."""
+    P = np.random.default_rng(3).normal(size=shape) * 1e3
+    ref = rhino3dm.Point3dList()
+    for p in P.tolist():
+        ref.Add(p[0], p[1], p[2] if len(p) == 3 else 0.0)
+    pts = geo.point_list(P)
+    assert pts.Count == ref.Count == shape[0]
+    assert [(q.X, q.Y, q.Z) for q in (pts[i] for i in range(pts.Count))] == \
+        [(q.X, q.Y, q.Z) for q in (ref[i] for i in range(ref.Count))]
+    if shape[0] >= 2:
+        assert rhino3dm.PolylineCurve(pts).Encode()["data"] == \
+            rhino3dm.PolylineCurve(ref).Encode()["data"]
