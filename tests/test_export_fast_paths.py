@@ -105,22 +105,35 @@ def test_shared_attributes_equal_one_set_per_object(tmp_path):
             a = m.attrs("a", "L3", **strings)
             m.model.Objects.AddPoint(rhino3dm.Point3d(0, 0, 0), a)
             m.model.Objects.AddPoint(rhino3dm.Point3d(1, 0, 0), m.again(a, "b", "L3 axis"))
+            a = m.shared(0, "b", "", joint_id="-", lamellae="-")
+            for j, lams in joints:
+                m.model.Objects.AddPoint(rhino3dm.Point3d(j, 1, 0),
+                                         m.again(a, "b", f"J{j}", joint_id=j, lamellae=lams))
         else:
             for c in circles:
                 m.model.Objects.AddCircle(c, m.attrs("a", "L3 hole", role="hole", **strings))
             m.model.Objects.AddPoint(rhino3dm.Point3d(0, 0, 0), m.attrs("a", "L3", **strings))
             m.model.Objects.AddPoint(rhino3dm.Point3d(1, 0, 0),
                                      m.attrs("b", "L3 axis", **strings))
+            for j, lams in joints:
+                m.model.Objects.AddPoint(rhino3dm.Point3d(j, 1, 0),
+                                         m.attrs("b", f"J{j}", joint_id=j, lamellae=lams))
         path = tmp_path / f"{shared}.3dm"
         assert m.model.Write(str(path), 8)
         return rhino3dm.File3dm.Read(str(path)), m.counts
 
+    # a joint on no lamella has no "lamellae" string (an empty value sets none, and removes
+    # one the shared set had): the same keys in the same order as a new set each
+    joints = [(0, "1 2"), (1, ""), (2, "3"), (3, "")]
     (one, counts1), (each, counts2) = model(True), model(False)
-    assert counts1 == counts2 == {"a": 4, "b": 1}
-    assert len(one.Objects) == len(each.Objects) == 5
+    assert counts1 == counts2 == {"a": 4, "b": 5}
+    assert len(one.Objects) == len(each.Objects) == 9
     assert [_attributes(o) for o in one.Objects] == [_attributes(o) for o in each.Objects]
-    assert [o.Attributes.Name for o in one.Objects] == ["L3 hole"] * 3 + ["L3", "L3 axis"]
-    assert len({str(o.Attributes.Id) for o in one.Objects}) == 5
+    assert [o.Attributes.Name for o in one.Objects] == \
+        ["L3 hole"] * 3 + ["L3", "L3 axis"] + [f"J{j}" for j in range(4)]
+    assert [o.Attributes.GetUserStrings() for o in one.Objects][5:7] == \
+        [(("joint_id", "0"), ("lamellae", "1 2")), (("joint_id", "1"),)]
+    assert len({str(o.Attributes.Id) for o in one.Objects}) == 9
     assert [o.Geometry.Encode()["data"] for o in one.Objects] == \
         [o.Geometry.Encode()["data"] for o in each.Objects]
 
@@ -140,3 +153,16 @@ def test_point_list_equals_one_by_one(shape):
     if shape[0] >= 2:
         assert rhino3dm.PolylineCurve(pts).Encode()["data"] == \
             rhino3dm.PolylineCurve(ref).Encode()["data"]
+
+
+def test_cylinder_equals_the_circle_at_its_centre_construction():
+    """geo.cylinder (a circle of the radius given its plane) writes the extrusion that a
+    circle made at the base centre and then given the same plane makes."""
+    rng = np.random.default_rng(5)
+    for centre, axis in zip(rng.normal(size=(20, 3)), rng.normal(size=(20, 3))):
+        a = axis / np.linalg.norm(axis)
+        base = centre - 0.5 * 0.01 * a
+        c = rhino3dm.Circle(rhino3dm.Point3d(*base.tolist()), 0.015)
+        c.Plane = rhino3dm.Plane(rhino3dm.Point3d(*base.tolist()), rhino3dm.Vector3d(*a.tolist()))
+        ref = rhino3dm.Extrusion.CreateCylinderExtrusion(rhino3dm.Cylinder(c, 0.01), True, True)
+        assert geo.cylinder(centre, axis, 0.015, 0.01).Encode()["data"] == ref.Encode()["data"]

@@ -123,20 +123,24 @@ class _Model:
         return a
 
     def shared(self, n: int, layer: str, name: str, **strings: object):
-        """:meth:`attrs` for ``n`` objects at once (counted ``n`` times): rhino3dm copies the
-        attributes into each object it adds, so objects with equal attributes (a part's
-        holes, its label strokes) can share one set."""
+        """:meth:`attrs` for ``n`` objects at once (counted ``n`` times; 0: each counted as
+        :meth:`again` hands the set out): rhino3dm copies the attributes into each object it
+        adds, so objects with equal attributes (a part's holes, its label strokes) can share
+        one set."""
         a = self.attrs(layer, name, **strings)
         self.counts[layer] += n - 1
         return a
 
-    def again(self, a, layer: str, name: str):
+    def again(self, a, layer: str, name: str, **strings: object):
         """The attributes ``a`` (:meth:`attrs`) for one more object on ``layer`` named
-        ``name``, their user strings kept: rhino3dm copies the attributes into each object
-        it adds, so one set serves objects whose attributes differ only in layer and name
-        (the same object attributes as a new :meth:`attrs` with the same strings)."""
+        ``name``, with the user strings ``strings`` set to new values (keys ``a`` has keep
+        their place, as a new :meth:`attrs` with the same keys in the same order would
+        give) and the others kept: rhino3dm copies the attributes into each object it adds,
+        so one set serves a run of objects whose attributes differ in a few values."""
         a.LayerIndex = self.layers[layer]
         a.Name = name
+        for k, v in strings.items():
+            a.SetUserString(k, str(v))
         self.counts[layer] += 1
         return a
 
@@ -243,12 +247,15 @@ def _strips(m: _Model, bundle, params, with_holes: bool) -> dict[str, Any]:
         js = np.clip(lam.joint_s, 0.0, s[-1])
         centres = np.stack([np.interp(js, s, C[:, c]) for c in range(3)], axis=1)
         axes = np.stack([np.interp(js, s, H[:, c]) for c in range(3)], axis=1)
-        for j, c, a in zip(lam.joints.tolist(), centres, axes):
-            hole = geo.cylinder(m.u(c), a, radius / m.units.metres_per_unit,
+        # one set of attributes for the lamella's holes, the name and joint set for each
+        # (joint_id holds its place in the strings: "-" until then; "" would remove it)
+        a = m.shared(0, "holes", "", lamella_id=int(lam.id), joint_id="-",
+                     diameter=m.fmt(2 * radius))
+        for j, c, ax in zip(lam.joints.tolist(), centres, axes):
+            hole = geo.cylinder(m.u(c), ax, radius / m.units.metres_per_unit,
                                 t / m.units.metres_per_unit)
-            m.model.Objects.AddExtrusion(hole, m.attrs("holes", f"L{lam.id} J{j} hole",
-                                                       lamella_id=int(lam.id), joint_id=j,
-                                                       diameter=m.fmt(2 * radius)))
+            m.model.Objects.AddExtrusion(hole, m.again(a, "holes", f"L{lam.id} J{j} hole",
+                                                       joint_id=j))
             n_holes += 1
     return {"strips": len(lams), "holes": n_holes, "width_m": w, "thickness_m": t}
 
@@ -370,9 +377,10 @@ def bundle_to_3dm(bundle, *, name: str = "", units: Any = None, params: Any = No
                 m.attrs("collapsed", f"L{lam.id} collapsed", state="collapsed",
                         lamella_id=int(lam.id), family=int(lam.family),
                         joints=" ".join(str(j) for j in lam.joints.tolist())))
+    a = m.shared(0, "joints", "", joint_id="-", lamellae="-")     # one set, values per joint
     for j, p in enumerate(m.u(bundle.net.joints).tolist()):
-        m.model.Objects.AddPoint(m.r.Point3d(*p), m.attrs(
-            "joints", f"J{j}", joint_id=j, lamellae=" ".join(map(str, through.get(j, [])))))
+        m.model.Objects.AddPoint(m.r.Point3d(*p), m.again(
+            a, "joints", f"J{j}", joint_id=j, lamellae=" ".join(map(str, through.get(j, [])))))
 
     sheets = _sheets(m, bundle, layout, params) if layout is not None else []
     strings = {"gridshell.kind": bundle.kind, "gridshell.units": units.name,

@@ -115,7 +115,7 @@ def cylinder(centre: np.ndarray, axis: np.ndarray, radius: float, height: float)
 
     axis = np.asarray(axis, float) / np.linalg.norm(axis)
     base = np.asarray(centre, float) - 0.5 * height * axis
-    c = rhino3dm.Circle(rhino3dm.Point3d(*base.tolist()), float(radius))
+    c = rhino3dm.Circle(float(radius))      # its plane replaced: centre and axis from here
     c.Plane = rhino3dm.Plane(rhino3dm.Point3d(*base.tolist()), rhino3dm.Vector3d(*axis.tolist()))
     return rhino3dm.Extrusion.CreateCylinderExtrusion(rhino3dm.Cylinder(c, float(height)),
                                                       True, True)
