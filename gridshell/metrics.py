@@ -513,10 +513,13 @@ def crossing_normal_curvature_on_mesh(net: Net, V: np.ndarray, F: np.ndarray,
     ``axes.obj``; joints are located on their axes by arc length (``joint_s``). ``reuse``: the
     closest-point queries may answer from earlier ones
     (:func:`gridshell.igl_adapter.closest_points`)."""
-    from .igl_adapter import closest_points, closest_points_with_normals, principal_curvature_at
+    from .igl_adapter import (ask_closest_points, closest_points, closest_points_with_normals,
+                              principal_curvature_at)
     from .net import polyline_arclength
 
     axes = [np.asarray(lam.axis, float) for lam in net.lamellae]
+    if reuse:       # the axes' and the joints' queries below in one igl query (one tree)
+        ask_closest_points([np.concatenate(axes), net.joints], V, F)
     _, N = closest_points_with_normals(np.concatenate(axes), V, F, reuse)
     normals = np.split(N, np.cumsum([len(a) for a in axes])[:-1])
     jidx = []
