@@ -196,19 +196,24 @@ def solid_rings_many(axes: list[np.ndarray], Ws: list[np.ndarray], Hs: list[np.n
     some = sizes > 0                                   # an axis without samples keeps none
     keep[first[some]] = True
     keep[(first + sizes - 1)[some]] = True
-    at = np.arange(k)
-    while k > 2:
+    # the samples still in a span that may split (a span within tol is settled for good:
+    # its samples leave, and every later level computes what it computed, for the others)
+    at = np.flatnonzero(~keep)
+    while len(at):
         idx = np.flatnonzero(keep)
-        seg = np.minimum(np.searchsorted(idx, at, side="right") - 1, len(idx) - 2)
-        d = _segment_distance(X, X[idx[seg]], X[idx[seg + 1]]).max(axis=1)
-        d[keep] = 0.0
-        worst = np.maximum.reduceat(d, idx[:-1])         # per span [idx[j], idx[j+1])
-        if not np.any(worst > tol):
+        seg = np.searchsorted(idx, at, side="right") - 1     # the span of each sample
+        d = _segment_distance(X[at], X[idx[seg]], X[idx[seg + 1]]).max(axis=1)
+        start = np.flatnonzero(np.r_[True, seg[1:] != seg[:-1]])   # runs of one span
+        worst = np.maximum.reduceat(d, start)
+        split = worst > tol
+        if not split.any():
             break
         # the first sample of each span that needs a split where its distance is the span's
-        far = (d == worst[seg]) & (worst[seg] > tol)
-        _, first_far = np.unique(seg[far], return_index=True)
-        keep[np.flatnonzero(far)[first_far]] = True
+        run = np.repeat(np.arange(len(start)), np.diff(np.r_[start, len(at)]))
+        far = (d == worst[run]) & split[run]
+        _, first_far = np.unique(run[far], return_index=True)
+        keep[at[np.flatnonzero(far)[first_far]]] = True
+        at = at[split[run] & ~keep[at]]
     idx = np.flatnonzero(keep).astype(np.int64)
     cut = np.searchsorted(idx, np.concatenate([first, [k]]))
     return [idx[cut[i]:cut[i + 1]] - first[i] for i in range(len(sizes))]
