@@ -13,6 +13,9 @@ LAYERS: dict[str, tuple[int, tuple[int, int, int]]] = {
     "ENGRAVE": (3, (0, 255, 0)),
 }
 
+#: layer -> the name of its colour, for people (legends, the previews' PNG description)
+COLOUR_NAMES: dict[str, str] = {"CUT": "red", "SCORE": "blue", "ENGRAVE": "green"}
+
 
 def hex_colour(layer: str) -> str:
     """``"#RRGGBB"`` of ``layer``."""
@@ -22,3 +25,8 @@ def hex_colour(layer: str) -> str:
 
 #: layer -> "#RRGGBB"
 COLOURS: dict[str, str] = {name: hex_colour(name) for name in LAYERS}
+
+
+def legend() -> str:
+    """``"CUT red, SCORE blue, ENGRAVE green"``: every layer with its colour's name."""
+    return ", ".join(f"{name} {COLOUR_NAMES[name]}" for name in LAYERS)

@@ -20,7 +20,7 @@ from gridshell.atomic import atomic_path
 
 from .params import FabParams
 from .part import Part
-from .layers import COLOURS
+from .layers import COLOURS, legend
 
 PX_PER_LONG_SIDE = 1200   # pixels along the sheet's long side
 DPI = 100
@@ -98,5 +98,5 @@ def write_sheet_png(path: str | FsPath, parts: list[Part], sheet: tuple[float, f
     fig = sheet_figure(parts, sheet, params, title)
     with atomic_path(path) as tmp:
         fig.savefig(tmp, format="png", dpi=DPI, pil_kwargs={"compress_level": PNG_LEVEL},
-                    metadata={"Title": title, "Description": "cut sheet preview: CUT red, "
-                              "SCORE blue, ENGRAVE black; lengths in mm"})
+                    metadata={"Title": title,
+                              "Description": f"cut sheet preview: {legend()}; lengths in mm"})

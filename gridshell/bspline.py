@@ -48,7 +48,9 @@ __all__ = [
     "basis_matrix",
     "fit_grid",
     "fit_points",
+    "local_basis",
     "open_uniform_knots",
+    "paired_params",
     "uniform_params",
 ]
 
@@ -105,7 +107,7 @@ def _check_knots(knots: np.ndarray, degree: int, name: str = "knots") -> np.ndar
     return knots
 
 
-def _local_basis(knots: np.ndarray, degree: int, t: np.ndarray,
+def local_basis(knots: np.ndarray, degree: int, t: np.ndarray,
                  deriv: int = 0) -> tuple[np.ndarray, np.ndarray]:
     """Non-zero basis functions (or derivatives) at every parameter, vectorized over ``t``.
 
@@ -200,7 +202,7 @@ def basis_matrix(knots: np.ndarray, degree: int, t: np.ndarray, deriv: int = 0) 
         raise InputError(f"deriv must be a non-negative integer, got {deriv!r}")
     t = _params(t, knots, degree)
     n_ctrl = len(knots) - degree - 1
-    first, vals = _local_basis(knots, degree, t, int(deriv))
+    first, vals = local_basis(knots, degree, t, int(deriv))
     k, w = vals.shape
     cols = first[:, None] + np.arange(w)[None, :]
     indptr = np.arange(k + 1, dtype=np.int64) * w
@@ -245,7 +247,7 @@ def _check_spread(ctrl: np.ndarray) -> None:
                          "degenerate input); re-export the surface")
 
 
-def _paired_params(surf: "BSplineSurface", u: Any, v: Any, du: int, dv: int, who: str,
+def paired_params(surf: "BSplineSurface", u: Any, v: Any, du: int, dv: int, who: str,
                    hint: str = "") -> tuple[np.ndarray, np.ndarray]:
     """Paired 1-D parameters ``u, v`` checked and clipped to the domain of ``surf``, after
     checking the derivative orders ``du, dv``; :class:`InputError` names ``who`` otherwise."""
@@ -361,11 +363,11 @@ class BSplineSurface:
             Row ``s`` is the Kronecker product of the ``u`` and ``v`` basis rows; each row has
             ``(d_u + 1)(d_v + 1)`` stored entries (a constant sparsity pattern per span).
         """
-        u, v = _paired_params(self, u, v, du, dv, "operator",
+        u, v = paired_params(self, u, v, du, dv, "operator",
                               "; use operator_grid for a tensor grid")
         nu, nv = self.shape
-        fu, bu = _local_basis(self.knots_u, self.degree_u, u, int(du))
-        fv, bv = _local_basis(self.knots_v, self.degree_v, v, int(dv))
+        fu, bu = local_basis(self.knots_u, self.degree_u, u, int(du))
+        fv, bv = local_basis(self.knots_v, self.degree_v, v, int(dv))
         k, wu = bu.shape
         wv = bv.shape[1]
         # Row-wise Kronecker product: column (fu + a) * nv + (fv + b), increasing in (a, b).

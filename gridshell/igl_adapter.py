@@ -28,6 +28,7 @@ from .errors import InputError, MeshError
 from .recent import Recent
 
 __all__ = [
+    "ask_closest_points",
     "closest_points",
     "closest_points_with_normals",
     "cotangent_laplacian",
@@ -152,6 +153,26 @@ def _once(what: str, arrays: tuple[np.ndarray, ...],
     out = tuple(np.asarray(a) for a in compute())
     _QUERIES.put(key, out)
     return out
+
+
+def ask_closest_points(Ps: list[np.ndarray], V: Any, F: np.ndarray | None = None) -> None:
+    """Answer the closest-point queries of the point sets ``Ps`` (each ``(k_i, 3)``, metres)
+    on the mesh ``(V, F)`` ahead, for the ``reuse`` queries that will ask them
+    (:func:`closest_points`, :func:`closest_points_with_normals`): the sets not answered
+    before go to igl in one query, so that it builds its AABB tree of the mesh once instead
+    of once per set (~10 ms for 20k triangles). igl answers each point from the tree alone,
+    whatever the other points of its query: each set gets the arrays its own query gives
+    (tests/test_igl_adapter.py)."""
+    Ps = [_points(P) for P in Ps]
+    V, T, _ = triangulate(V, F)
+    keys = [("closest", _content(P, V, T)) for P in Ps]
+    todo = [i for i, key in enumerate(keys) if _QUERIES.get(key) is None]
+    if len(todo) < 2:       # nothing to share: the query itself asks igl
+        return
+    out = igl.point_mesh_squared_distance(np.concatenate([Ps[i] for i in todo]), V, T)
+    cut = np.cumsum([len(Ps[i]) for i in todo])[:-1]
+    for i, *parts in zip(todo, *(np.split(np.asarray(a), cut) for a in out)):
+        _QUERIES.put(keys[i], tuple(np.ascontiguousarray(a) for a in parts))
 
 
 def closest_points(P: np.ndarray, V: Any, F: np.ndarray | None = None,

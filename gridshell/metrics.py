@@ -456,6 +456,54 @@ def geodesic_turning(net_or_axes: Net | Sequence[np.ndarray], V: np.ndarray,
             "normals": used}
 
 
+def _kn_at_joints(net: Net, axis_normals: Sequence[np.ndarray],
+                  joint_index: Sequence[np.ndarray]) -> dict[int, dict[int, float]] | None:
+    """``{joint: {family: kn}}`` (1/m) at the interior joint samples of the lamellae of at
+    least 3 samples: :func:`gridshell.diffgeo.normal_geodesic_curvature`'s ``kn`` there, the
+    same arithmetic row by row, for the joint rows of all lamellae at once instead of every
+    row of each. None when a lamella's polyline or normals are ones that function refuses
+    (not finite, a zero-length segment, a zero normal, shapes): the caller asks it, for its
+    error. tests/test_metrics.py compares with it."""
+    from .diffgeo import _dot
+
+    axes, normals, rows, keys, at = [], [], [], [], 0
+    for lam, N, jidx in zip(net.lamellae, axis_normals, joint_index):
+        P = np.asarray(lam.axis, dtype=float)
+        if len(P) < 3:
+            continue
+        N = np.asarray(N, dtype=float)
+        if P.ndim != 2 or P.shape[1] != 3 or N.shape != P.shape:
+            return None
+        for jj, vi in zip(np.asarray(lam.joints).tolist(), np.asarray(jidx).tolist()):
+            if 0 < vi < len(P) - 1:
+                rows.append(at + vi)
+                keys.append((jj, lam.family))
+        axes.append(P)
+        normals.append(N)
+        at += len(P)
+    if not axes:
+        return {}
+    P, N = np.concatenate(axes), np.concatenate(normals)
+    inner = np.ones(len(P) - 1, dtype=bool)          # segments within one lamella
+    inner[np.cumsum([len(a) for a in axes])[:-1] - 1] = False
+    seg = np.linalg.norm(np.diff(P, axis=0), axis=1)[inner]
+    if not (np.all(np.isfinite(P)) and np.all(seg != 0)
+            and np.all(np.linalg.norm(N, axis=1) > 0)):
+        return None
+    i = np.asarray(rows, dtype=np.int64)
+    a, b = P[i - 1] - P[i], P[i + 1] - P[i]
+    aa, bb = _dot(a, a), _dot(b, b)
+    cc = _dot(a - b, a - b)
+    X = np.cross(aa[:, None] * b - bb[:, None] * a, np.cross(a, b))
+    kvec = 2.0 * X / (aa * bb * cc)[:, None]
+    n = N[i]
+    n = n / np.linalg.norm(n, axis=1)[:, None]
+    kn_at: dict[int, dict[int, float]] = {}
+    for (jj, fam), k in zip(keys, _dot(kvec, n).tolist()):
+        kn_at.setdefault(jj, {})[fam] = k
+    return kn_at
+
+
 def crossing_normal_curvature(net: Net, axis_normals: Sequence[np.ndarray],
                               joint_index: Sequence[np.ndarray],
                               scale: np.ndarray) -> dict[str, Any]:
@@ -484,14 +532,16 @@ def crossing_normal_curvature(net: Net, axis_normals: Sequence[np.ndarray],
     """
     from .diffgeo import normal_geodesic_curvature
 
-    kn_at: dict[int, dict[int, float]] = {}
-    for lam, N, jidx in zip(net.lamellae, axis_normals, joint_index):
-        if len(lam.axis) < 3:
-            continue
-        kn, _ = normal_geodesic_curvature(lam.axis, N)
-        for jj, vi in zip(np.asarray(lam.joints).tolist(), np.asarray(jidx).tolist()):
-            if 0 < vi < len(lam.axis) - 1:
-                kn_at.setdefault(jj, {})[lam.family] = float(kn[vi])
+    kn_at = _kn_at_joints(net, axis_normals, joint_index)
+    if kn_at is None:        # a polyline or normals it refuses: its own error
+        kn_at = {}
+        for lam, N, jidx in zip(net.lamellae, axis_normals, joint_index):
+            if len(lam.axis) < 3:
+                continue
+            kn, _ = normal_geodesic_curvature(lam.axis, N)
+            for jj, vi in zip(np.asarray(lam.joints).tolist(), np.asarray(jidx).tolist()):
+                if 0 < vi < len(lam.axis) - 1:
+                    kn_at.setdefault(jj, {})[lam.family] = float(kn[vi])
     joints = np.array(sorted(j for j, d in kn_at.items() if len(d) == 2), np.int64)
     if len(joints) == 0:
         return {"rel": np.zeros(0), "joints": joints, "kn1": np.zeros(0), "kn3": np.zeros(0),
@@ -513,10 +563,13 @@ def crossing_normal_curvature_on_mesh(net: Net, V: np.ndarray, F: np.ndarray,
     ``axes.obj``; joints are located on their axes by arc length (``joint_s``). ``reuse``: the
     closest-point queries may answer from earlier ones
     (:func:`gridshell.igl_adapter.closest_points`)."""
-    from .igl_adapter import closest_points, closest_points_with_normals, principal_curvature_at
+    from .igl_adapter import (ask_closest_points, closest_points, closest_points_with_normals,
+                              principal_curvature_at)
     from .net import polyline_arclength
 
     axes = [np.asarray(lam.axis, float) for lam in net.lamellae]
+    if reuse:       # the axes' and the joints' queries below in one igl query (one tree)
+        ask_closest_points([np.concatenate(axes), net.joints], V, F)
     _, N = closest_points_with_normals(np.concatenate(axes), V, F, reuse)
     normals = np.split(N, np.cumsum([len(a) for a in axes])[:-1])
     jidx = []

@@ -22,8 +22,8 @@ from .errors import InputError
 from .recent import Recent
 
 __all__ = ["TANGENT_KINDS", "is_tangent", "nearest_vertex_normals", "strip_frame",
-           "strip_frames", "strip_solid", "strip_solid_faces", "solid_rings", "ring_tolerance",
-           "real_section_m", "row_norms", "packed_strip_frames"]
+           "strip_frames", "packed_strip_frames", "strip_solid", "strip_solid_faces",
+           "solid_rings", "solid_rings_many", "ring_tolerance", "real_section_m", "row_norms"]
 
 #: design kinds whose lamellae lie tangent to the surface (the others stand on it)
 TANGENT_KINDS = ("GG",)
@@ -225,29 +225,53 @@ def solid_rings(axis: np.ndarray, W: np.ndarray, H: np.ndarray, width: float,
     polyline, and the ends are always kept. ``tol``: default :func:`ring_tolerance`
     (``thickness``).
     """
-    P = np.asarray(axis, float).reshape(-1, 3)
+    return solid_rings_many([axis], [W], [H], width, thickness, tol)[0]
+
+
+def solid_rings_many(axes: list[np.ndarray], Ws: list[np.ndarray], Hs: list[np.ndarray],
+                     width: float, thickness: float, tol: float | None = None
+                     ) -> list[np.ndarray]:
+    """:func:`solid_rings` of each axis ``(k_i,3)`` (metres) with its frame ``W, H (k_i,3)``,
+    all in one vectorized pass: the same indices as one call per axis (the axes' samples
+    concatenated, the ends of every axis kept, so that no span reaches from one axis into the
+    next; each span is split as it would be alone, every step per sample the same
+    arithmetic). One pass costs the deepest axis' levels, not the sum of all."""
+    sizes = np.array([len(np.asarray(a).reshape(-1, 3)) for a in axes], dtype=np.int64)
+    if not sizes.sum():
+        return [np.zeros(0, np.int64) for _ in sizes]
+    P = np.concatenate([np.asarray(a, float).reshape(-1, 3) for a in axes])
     k = len(P)
-    if k <= 2:
-        return np.arange(k, dtype=np.int64)
     tol = ring_tolerance(thickness) if tol is None else float(tol)
-    w, h = 0.5 * float(width) * np.asarray(W, float), 0.5 * float(thickness) * np.asarray(H, float)
+    w = 0.5 * float(width) * np.concatenate([np.asarray(x, float).reshape(-1, 3) for x in Ws])
+    h = 0.5 * float(thickness) * np.concatenate([np.asarray(x, float).reshape(-1, 3)
+                                                  for x in Hs])
     X = np.stack([P - w - h, P + w - h, P + w + h, P - w + h], axis=1)      # (k,4,3)
+    first = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64)
     keep = np.zeros(k, bool)
-    keep[[0, -1]] = True
-    at = np.arange(k)
-    while True:
+    some = sizes > 0                                   # an axis without samples keeps none
+    keep[first[some]] = True
+    keep[(first + sizes - 1)[some]] = True
+    # the samples still in a span that may split (a span within tol is settled for good:
+    # its samples leave, and every later level computes what it computed, for the others)
+    at = np.flatnonzero(~keep)
+    while len(at):
         idx = np.flatnonzero(keep)
-        seg = np.minimum(np.searchsorted(idx, at, side="right") - 1, len(idx) - 2)
-        d = _segment_distance(X, X[idx[seg]], X[idx[seg + 1]]).max(axis=1)
-        d[keep] = 0.0
-        worst = np.maximum.reduceat(d, idx[:-1])         # per span [idx[j], idx[j+1])
-        split = np.flatnonzero(worst > tol)
-        if not len(split):
-            return idx.astype(np.int64)
+        seg = np.searchsorted(idx, at, side="right") - 1     # the span of each sample
+        d = _segment_distance(X[at], X[idx[seg]], X[idx[seg + 1]]).max(axis=1)
+        start = np.flatnonzero(np.r_[True, seg[1:] != seg[:-1]])   # runs of one span
+        worst = np.maximum.reduceat(d, start)
+        split = worst > tol
+        if not split.any():
+            break
         # the first sample of each span that needs a split where its distance is the span's
-        far = (d == worst[seg]) & (worst[seg] > tol)
-        _, first = np.unique(seg[far], return_index=True)
-        keep[np.flatnonzero(far)[first]] = True
+        run = np.repeat(np.arange(len(start)), np.diff(np.r_[start, len(at)]))
+        far = (d == worst[run]) & split[run]
+        _, first_far = np.unique(run[far], return_index=True)
+        keep[at[np.flatnonzero(far)[first_far]]] = True
+        at = at[split[run] & ~keep[at]]
+    idx = np.flatnonzero(keep).astype(np.int64)
+    cut = np.searchsorted(idx, np.concatenate([first, [k]]))
+    return [idx[cut[i]:cut[i + 1]] - first[i] for i in range(len(sizes))]
 
 
 def real_section_m(width_mm: float, thickness_mm: float, scale: float) -> tuple[float, float]:

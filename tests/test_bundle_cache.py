@@ -115,6 +115,39 @@ def test_closest_point_queries_asked_with_reuse_are_answered_once(monkeypatch):
         ia.closest_points(P, V, F)                           # without reuse: always asked
 
 
+def test_closest_points_asked_ahead_together_equal_their_own_queries(monkeypatch):
+    """ask_closest_points answers several point sets with one igl query (one AABB tree):
+    afterwards each set's reuse queries (closest points, with normals) give, bit for bit,
+    what its own query gives, without asking igl again; a set asked before is not asked."""
+    import gridshell.igl_adapter as ia
+    from gridshell.grid import grid_quads
+
+    rng = np.random.default_rng(11)
+    t = np.linspace(-1, 1, 15)
+    X, Y = np.meshgrid(t, t, indexing="ij")
+    V = np.stack([X, Y, 0.3 * X * X - 0.1 * Y], -1).reshape(-1, 3)
+    F = grid_quads(15, 15)
+    sets = [rng.uniform(-1.2, 1.2, (k, 3)) for k in (40, 1, 0, 300)]    # 8 results: kept
+    own = [ia.closest_points(P, V, F) for P in sets]
+    own_n = [ia.closest_points_with_normals(P, V, F) for P in sets]
+    asked = []
+    real = ia.igl.point_mesh_squared_distance
+    monkeypatch.setattr(ia.igl, "point_mesh_squared_distance",
+                        lambda P, *a: asked.append(len(P)) or real(P, *a))
+    ia.closest_points(sets[3], V, F, reuse=True)             # answered before: not asked again
+    ia.ask_closest_points(sets, V, F)
+    assert asked == [300, 41]
+    monkeypatch.setattr(ia.igl, "point_mesh_squared_distance",
+                        lambda *a: (_ for _ in ()).throw(AssertionError("asked igl again")))
+    for P, a, a_n in zip(sets, own, own_n):
+        b = ia.closest_points(P, V, F, reuse=True)
+        b_n = ia.closest_points_with_normals(P, V, F, reuse=True)
+        for x, y in zip(a + a_n, b + b_n):
+            assert x.dtype == y.dtype and x.shape == y.shape
+            assert np.array_equal(x.view(np.uint8), y.view(np.uint8))
+    ia.ask_closest_points(sets[:2], V, F)                    # all answered: no query
+
+
 def test_verification_after_a_read_gives_what_it_gives_alone(tmp_path):
     """verify_bundle on the arrays read_bundle parsed (and on reused closest points) gives
     the result it gives from the files alone, in a new process, pass and fail alike."""

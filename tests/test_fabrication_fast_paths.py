@@ -230,3 +230,29 @@ def test_hole_circles_buffered_at_once_equal_one_by_one():
         once = shapely.union_all(shapely.buffer(shapely.points(np.asarray(p.holes, float)),
                                                 params.hole / 2, quad_segs=32))
         assert one.wkb == once.wkb
+
+
+def test_sheet_preview_description_names_the_colours_drawn(tmp_path):
+    """The preview's PNG ``Description`` names each layer's colour, and that colour (the
+    layer table's RGB, read as a colour name by matplotlib's CSS table) is in the picture:
+    it once said ENGRAVE black while engraving was drawn green."""
+    from matplotlib.colors import to_rgb
+    from PIL import Image
+
+    from fabrication import preview
+    from fabrication.layers import LAYERS
+
+    parts, params = _parts("GG", 4, 5)
+    layout = nesting.nest(parts, params)
+    preview.write_sheet_png(tmp_path / "s.png", layout.on_sheet(0), layout.sheet, params, "t")
+    img = Image.open(tmp_path / "s.png")
+    said = dict(item.split() for item in
+                img.info["Description"].split(": ", 1)[1].split(";")[0].split(", "))
+    assert set(said) == set(LAYERS)
+    css = {"green": "lime"}          # CSS "green" is (0, 128, 0); ACI 3 is (0, 255, 0)
+    pixels = {tuple(p) for p in np.asarray(img.convert("RGB")).reshape(-1, 3)}
+    for layer, name in said.items():
+        rgb = LAYERS[layer][1]
+        assert tuple(round(255 * c) for c in to_rgb(css.get(name, name))) == rgb, (layer, name)
+        if layer != "SCORE":         # a GG strip has no score lines; cuts and labels it has
+            assert rgb in pixels, layer

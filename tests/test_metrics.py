@@ -206,3 +206,56 @@ def test_geodesic_turning_of_exact_geodesics_with_smooth_normals():
         geodesic_turning(axes, V, np.concatenate([F[:, :3], F[:, [0, 2, 3]]]), normals="smooth")
     with pytest.raises(InputError, match="normals must be"):
         geodesic_turning(axes, V, F, normals="exact")
+
+
+def _kn_one_by_one(net, normals, jidx):
+    """The straightforward kn at the joints: normal_geodesic_curvature of each whole axis."""
+    from gridshell.diffgeo import normal_geodesic_curvature
+
+    out = {}
+    for lam, N, ji in zip(net.lamellae, normals, jidx):
+        if len(lam.axis) < 3:
+            continue
+        kn, _ = normal_geodesic_curvature(lam.axis, N)
+        for j, vi in zip(np.asarray(lam.joints).tolist(), np.asarray(ji).tolist()):
+            if 0 < vi < len(lam.axis) - 1:
+                out.setdefault(j, {})[lam.family] = float(kn[vi])
+    return out
+
+
+def test_kn_at_joints_equals_the_whole_axes_one_by_one():
+    """crossing_normal_curvature's kn at the joint samples of all lamellae at once gives, bit
+    for bit, what normal_geodesic_curvature of each whole axis gives there (wavy axes, normals
+    of any length, joints at the ends and inside, short lamellae skipped); a polyline it
+    refuses still raises its error."""
+    from gridshell.metrics import _kn_at_joints, crossing_normal_curvature
+
+    rng = np.random.default_rng(2)
+    lams, normals, jidx = [], [], []
+    for i, k in enumerate([40, 2, 3, 17, 120, 9]):
+        s = np.linspace(0.0, 2.0, k)
+        P = np.c_[s, 0.2 * np.sin(3 * s + i) + 1e-3 * rng.standard_normal(k),
+                  0.3 * s * s + 0.1 * i]
+        N = np.c_[0.2 * rng.standard_normal((k, 2)), rng.uniform(0.5, 3.0, k)]
+        vi = np.unique(np.r_[0, k - 1, rng.integers(0, k, 4)])
+        joints = (np.arange(len(vi)) + 3 * i) % 12
+        lams.append(Lamella(id=i, family=1 if i % 2 else 3, joints=joints,
+                            joint_s=np.zeros(len(vi)), axis=P))
+        normals.append(N)
+        jidx.append(vi)
+    net = Net(joints=rng.standard_normal((12, 3)), loops=np.zeros((0, 4), np.int64),
+              lamellae=lams)
+    ref = _kn_one_by_one(net, normals, jidx)
+    got = _kn_at_joints(net, normals, jidx)
+    assert got == ref and len(ref) >= 6
+    res = crossing_normal_curvature(net, normals, jidx, np.full(12, 0.1))
+    assert len(res["joints"]) == sum(len(d) == 2 for d in ref.values())
+    bad = [N.copy() for N in normals]
+    bad[4][7] = 0.0                                  # a zero normal: its own error
+    assert _kn_at_joints(net, bad, jidx) is None
+    with pytest.raises(InputError, match="zero vectors"):
+        crossing_normal_curvature(net, bad, jidx, np.full(12, 0.1))
+    lams[0].axis[5] = lams[0].axis[4]               # a repeated point: its own error
+    assert _kn_at_joints(net, normals, jidx) is None
+    with pytest.raises(InputError, match="zero-length"):
+        crossing_normal_curvature(net, normals, jidx, np.full(12, 0.1))

@@ -137,3 +137,85 @@ def test_strips_faces_are_each_strips_solid_sides(tangent):
             for g, (X, Y) in enumerate(((A, M), (M, B))):
                 want = np.stack([X[:-1], Y[:-1], Y[1:], X[1:]], axis=1)
                 assert np.allclose(G[2 * s + g], want, atol=1e-12)
+
+
+def _padded_reference(painter: Painter, ax, linewidth: float = 0.2) -> None:
+    """The drawing :meth:`Painter.draw` stands for, one padded array: every polygon padded to
+    the most corners (:meth:`Painter.sorted_polygons`), grown by :func:`grow_polygons` as a
+    whole, outlined ones filled and then their ring."""
+    from matplotlib.collections import PathCollection
+    from matplotlib.path import Path as MplPath
+
+    P, face, edge = painter.sorted_polygons()
+    M = ax.transData.get_matrix()[:2, :2]
+    half_px = 0.5 * linewidth * ax.figure.dpi / 72.0
+    X = P @ M.T
+    out = (grow_polygons(X, 1.0) - X) @ np.linalg.inv(M).T * half_px
+    paths, colours = [], []
+    for p, o, f, e in zip(P, out, face, edge):
+        if np.all(f == e):
+            paths.append(MplPath(np.concatenate([p + o, p[:1] + o[:1]]), closed=True))
+            colours.append(f)
+        else:
+            paths.append(MplPath(np.concatenate([p, p[:1]]), closed=True))
+            colours.append(f)
+            ring = np.concatenate([p + o, p[:1] + o[:1], (p - o)[::-1], p[-1:] - o[-1:]])
+            loop = [MplPath.MOVETO] + [MplPath.LINETO] * (len(p) - 1) + [MplPath.CLOSEPOLY]
+            paths.append(MplPath(ring, loop + loop))
+            colours.append(e)
+    ax.add_collection(PathCollection(paths, facecolors=colours, edgecolors="none",
+                                     linewidths=0.0), autolim=False)
+
+
+@pytest.mark.parametrize("dots", [8, 5, 0])
+def test_painter_draw_list_by_list_paints_the_padded_array(dots):
+    """Each list of polygons grown with its own corner count (the padding's notch at the last
+    corner made directly: one, two or more copies) paints exactly the pixels of the padded
+    array grown as a whole."""
+    rng = np.random.default_rng(11)
+    painter = Painter(Camera(35.0, -50.0))
+    r, u, _ = painter.camera.basis()
+    tri = rng.uniform(-1, 1, (40, 3, 3))
+    grey = np.column_stack([rng.uniform(0.3, 1, (40, 3)), np.ones(40)])
+    painter.add(tri, grey, grey)
+    quad = rng.uniform(-1, 1, (50, 1, 3)) + rng.uniform(-0.2, 0.2, (50, 4, 3))
+    blue = np.column_stack([rng.uniform(0.1, 0.9, (50, 3)), np.ones(50)])
+    painter.add(quad, blue, blue, rng.uniform(-0.1, 0.1, 50))
+    if dots:
+        ring = np.linspace(0, 2 * np.pi, dots + 1)[:-1]
+        J = rng.uniform(-1, 1, (12, 3))
+        dot = J[:, None] + 0.06 * (np.cos(ring)[None, :, None] * r +
+                                   np.sin(ring)[None, :, None] * u)
+        painter.add(dot, np.array([0.1, 0.1, 0.1, 1.0]), np.array([0.0, 0.0, 0.0, 1.0]), 0.02)
+    fast, ref = _pixels(painter.draw), _pixels(lambda ax: _padded_reference(painter, ax))
+    assert fast.std() > 10
+    assert np.array_equal(fast, ref)
+
+
+def test_linear_is_the_matrix_product_bit_for_bit():
+    """The growth's data <-> pixel scale: a diagonal matrix as products by its entries, the
+    same numbers as numpy's stacked product; any other matrix through the product."""
+    from gridshell.render.painter import _linear
+
+    rng = np.random.default_rng(3)
+    P = rng.normal(size=(500, 6, 2)) * 37.0
+    D = np.diag([779.3523568869717, 779.3523568869716])
+    for A in (D, np.linalg.inv(D).T, np.array([[2.0, 0.5], [-0.25, 3.0]])):
+        assert np.array_equal(_linear(P, A), P @ A)
+
+
+@pytest.mark.parametrize("rect", [(0.01, 0.01, 0.98, 0.91), (0.01, 0.01, 0.98, 0.98)])
+def test_picture_transform_is_the_axes_transdata(rect):
+    """render_ribbons draws without an axes: its data -> pixel map is the ``transData`` of an
+    axes at ``rect`` with the same limits, number for number."""
+    from matplotlib.figure import Figure
+
+    from gridshell.render.ribbons import _data_to_pixels
+
+    fig = Figure(figsize=(10.0, 7.5), dpi=100)
+    lo, hi = np.array([-3.123456789, -1.2345]), np.array([4.98765, 2.718281828])
+    ax = fig.add_axes(rect)
+    ax.set_xlim(lo[0], hi[0])
+    ax.set_ylim(lo[1], hi[1])
+    assert np.array_equal(_data_to_pixels(fig, rect, lo, hi).get_matrix(),
+                          ax.transData.get_matrix())

@@ -179,3 +179,65 @@ def test_solid_rings_of_an_ncp_bundle():
         r, _, _ = _check_rings(P, N, 0.2, 0.01, False)
         total, kept = total + len(P), kept + len(r)
     assert kept < 0.5 * total
+
+
+def _unit_rows(X):
+    return X / np.linalg.norm(X, axis=1, keepdims=True)
+
+
+def _rings_one_by_one(P, W, H, w, t, tol):
+    """The straightforward Ramer-Douglas-Peucker of solid_rings: each span split at its first
+    farthest sample (the largest of the four corners' distances to their chords) while that
+    exceeds ``tol``, span by span (recursion), one axis at a time."""
+    from gridshell.strips3d import _segment_distance
+
+    X = _corners(P, W, H, w, t)
+    keep = {0, len(P) - 1}
+    todo = [(0, len(P) - 1)] if len(P) > 2 else []
+    while todo:
+        a, b = todo.pop()
+        if b - a < 2:
+            continue
+        d = _segment_distance(X[a + 1:b], X[a][None], X[b][None]).max(axis=1)
+        i = int(np.argmax(d))
+        if d[i] > tol:
+            keep.add(a + 1 + i)
+            todo += [(a, a + 1 + i), (a + 1 + i, b)]
+    return np.array(sorted(keep), np.int64)
+
+
+def test_solid_rings_many_equal_one_axis_at_a_time():
+    """solid_rings_many (all axes in one vectorized pass, as the .3dm export asks) gives every
+    axis the indices solid_rings gives it alone, and both those of the straightforward
+    recursive simplification: wiggly axes of many lengths (1, 2, 3 samples too), tangent and
+    standing frames, several tolerances."""
+    from gridshell.strips3d import ring_tolerance, solid_rings, solid_rings_many
+
+    rng = np.random.default_rng(7)
+    axes = []
+    for k in [1, 2, 3, 5, 40, 200, 2, 731, 17]:
+        s = np.linspace(0.0, 3.0, k)
+        P = np.c_[s, 0.3 * np.sin(2 * s) + 1e-3 * rng.standard_normal(k),
+                  0.2 * np.cos(3 * s) + 1e-3 * rng.standard_normal(k)]
+        N = _unit_rows(np.c_[0.1 * rng.standard_normal((k, 2)), np.ones(k)])
+        axes.append((P, N))
+    for tangent in (True, False):
+        frames = [strip_frame(P, N, tangent) if len(P) >= 2 else
+                  (np.zeros((1, 3)), np.array([[0.0, 1, 0]]), np.array([[0.0, 0, 1]]))
+                  for P, N in axes]
+        for w, t, tol in ((0.2, 0.01, None), (0.05, 0.002, None), (0.2, 0.01, 1e-3),
+                          (0.2, 0.01, 0.0)):
+            many = solid_rings_many([P for P, _ in axes], [f[1] for f in frames],
+                                    [f[2] for f in frames], w, t, tol)
+            assert len(many) == len(axes)
+            for (P, _), (_, W, H), r in zip(axes, frames, many):
+                assert r.dtype == np.int64
+                np.testing.assert_array_equal(r, solid_rings(P, W, H, w, t, tol))
+                ref = _rings_one_by_one(P, W, H, w, t, ring_tolerance(t) if tol is None else tol)
+                np.testing.assert_array_equal(r, ref)
+    assert solid_rings_many([], [], [], 0.2, 0.01) == []
+    empty = solid_rings_many([np.zeros((0, 3)), axes[4][0]], [np.zeros((0, 3)), frames[4][1]],
+                             [np.zeros((0, 3)), frames[4][2]], 0.2, 0.01)
+    assert len(empty[0]) == 0
+    np.testing.assert_array_equal(empty[1], solid_rings(axes[4][0], frames[4][1],
+                                                        frames[4][2], 0.2, 0.01))

@@ -122,6 +122,28 @@ class _Model:
         self.counts[layer] += 1
         return a
 
+    def shared(self, n: int, layer: str, name: str, **strings: object):
+        """:meth:`attrs` for ``n`` objects at once (counted ``n`` times; 0: each counted as
+        :meth:`again` hands the set out): rhino3dm copies the attributes into each object it
+        adds, so objects with equal attributes (a part's holes, its label strokes) can share
+        one set."""
+        a = self.attrs(layer, name, **strings)
+        self.counts[layer] += n - 1
+        return a
+
+    def again(self, a, layer: str, name: str, **strings: object):
+        """The attributes ``a`` (:meth:`attrs`) for one more object on ``layer`` named
+        ``name``, with the user strings ``strings`` set to new values (keys ``a`` has keep
+        their place, as a new :meth:`attrs` with the same keys in the same order would
+        give) and the others kept: rhino3dm copies the attributes into each object it adds,
+        so one set serves a run of objects whose attributes differ in a few values."""
+        a.LayerIndex = self.layers[layer]
+        a.Name = name
+        for k, v in strings.items():
+            a.SetUserString(k, str(v))
+        self.counts[layer] += 1
+        return a
+
     def u(self, X):
         """Metres -> the user's unit."""
         return np.asarray(X, float) / self.units.metres_per_unit
@@ -155,11 +177,18 @@ def unwelded_sides(V: np.ndarray, F: np.ndarray) -> tuple[np.ndarray, np.ndarray
     return np.asarray(V, float)[uniq % M], inverse.reshape(-1, 3)
 
 
+def _split_frames(PNTWH: tuple[np.ndarray, ...], ends: np.ndarray) -> list[tuple]:
+    """The ``(T, W, H)`` of each lamella from :func:`gridshell.strips3d.strip_frames`' output
+    ``(P, N, T, W, H)`` of all lamellae, split at the row offsets ``ends``."""
+    _, _, T, W, H = PNTWH
+    return list(zip(np.split(T, ends), np.split(W, ends), np.split(H, ends)))
+
+
 def _strips(m: _Model, bundle, params, with_holes: bool) -> dict[str, Any]:
     """Strip solids on the family layers, axes, and the holes; returns figures."""
     from ..igl_adapter import closest_points_with_normals
     from ..net import polyline_arclength
-    from ..strips3d import (is_tangent, real_section_m, solid_rings, strip_frame,
+    from ..strips3d import (is_tangent, real_section_m, solid_rings_many, strip_frames,
                             strip_solid)
 
     tangent = is_tangent(bundle.kind)
@@ -175,24 +204,28 @@ def _strips(m: _Model, bundle, params, with_holes: bool) -> dict[str, Any]:
     # (reuse: the query the verification of the design asked, gridshell.verification)
     normals = closest_points_with_normals(np.concatenate([P for _, P in lams]),
                                           bundle.surface_V, bundle.surface_F, reuse=True)[1]
-    n_holes, at = 0, 0
-    for lam, P in lams:
-        N = normals[at:at + len(P)]
-        at += len(P)
-        frame = strip_frame(P, N, tangent)
-        _, W, H = frame
-        if tangent:      # stacked: family 1 on the normals' side of the surface, 3 below
-            C = P + (0.5 * t if lam.family == 1 else -0.5 * t) * H
-        elif params.axis == "edge":    # the axis on the edge the strip stands on
-            C = P + 0.5 * w * W
-        else:
-            C = P
-        # the solid's frame along C: the one above when C is the axis itself
-        Tc, Wc, Hc = frame if C is P else strip_frame(C, N, tangent)
-        # only the rings the solid needs: its corner edges within ring_tolerance(t) (1 % of
-        # the thickness or 0.05 mm, real size) of the full-resolution ones; the axis
-        # polyline, the holes and the user strings keep every sample
-        r = solid_rings(C, Wc, Hc, w, t)
+    # the frames of all lamellae in one pass each (strip_frames: the numbers of one
+    # strip_frame per lamella)
+    ends = np.cumsum([len(P) for _, P in lams])[:-1]
+    Ns = np.split(normals, ends)
+    frames = _split_frames(strip_frames([P for _, P in lams], Ns, tangent), ends)
+    if tangent:      # stacked: family 1 on the normals' side of the surface, 3 below
+        Cs = [P + (0.5 * t if lam.family == 1 else -0.5 * t) * H
+              for (lam, P), (_, _, H) in zip(lams, frames)]
+    elif params.axis == "edge":    # the axis on the edge the strip stands on
+        Cs = [P + 0.5 * w * W for (_, P), (_, W, _) in zip(lams, frames)]
+    else:
+        Cs = [P for _, P in lams]
+    # the solids' frames along C: the ones above when C is the axis itself
+    solid = frames if Cs[0] is lams[0][1] else \
+        _split_frames(strip_frames(Cs, Ns, tangent), ends)
+    # only the rings the solid needs: its corner edges within ring_tolerance(t) (1 % of
+    # the thickness or 0.05 mm, real size) of the full-resolution ones; the axis
+    # polyline, the holes and the user strings keep every sample (solid_rings_many: the
+    # indices of one solid_rings per lamella)
+    rings = solid_rings_many(Cs, [f[1] for f in solid], [f[2] for f in solid], w, t)
+    n_holes = 0
+    for (lam, P), N, (_, _, H), C, (Tc, Wc, Hc), r in zip(lams, Ns, frames, Cs, solid, rings):
         V, F = strip_solid(C[r], N[r], w, t, tangent, frame=(Tc[r], Wc[r], Hc[r]))
         s = polyline_arclength(P)
         strings = {"lamella_id": int(lam.id), "family": int(lam.family), "kind": bundle.kind,
@@ -205,21 +238,24 @@ def _strips(m: _Model, bundle, params, with_holes: bool) -> dict[str, Any]:
                    "width_m": f"{w:.9g}", "thickness_m": f"{t:.9g}"}
         layer = f"family {lam.family}"
         V, F = unwelded_sides(V, F)
-        m.model.Objects.AddMesh(geo.mesh(m.u(V), F, what=f"lamella {lam.id} strip"),
-                                m.attrs(layer, f"L{lam.id}", **strings))
-        m.model.Objects.AddPolyline(geo.point_list(m.u(P)), m.attrs("axes", f"L{lam.id} axis",
-                                                                    **strings))
+        a = m.attrs(layer, f"L{lam.id}", **strings)
+        m.model.Objects.AddMesh(geo.mesh(m.u(V), F, what=f"lamella {lam.id} strip"), a)
+        m.model.Objects.AddPolyline(geo.point_list(m.u(P)),
+                                    m.again(a, "axes", f"L{lam.id} axis"))
         if not with_holes or not len(lam.joints):
             continue
         js = np.clip(lam.joint_s, 0.0, s[-1])
         centres = np.stack([np.interp(js, s, C[:, c]) for c in range(3)], axis=1)
         axes = np.stack([np.interp(js, s, H[:, c]) for c in range(3)], axis=1)
-        for j, c, a in zip(lam.joints.tolist(), centres, axes):
-            hole = geo.cylinder(m.u(c), a, radius / m.units.metres_per_unit,
+        # one set of attributes for the lamella's holes, the name and joint set for each
+        # (joint_id holds its place in the strings: "-" until then; "" would remove it)
+        a = m.shared(0, "holes", "", lamella_id=int(lam.id), joint_id="-",
+                     diameter=m.fmt(2 * radius))
+        for j, c, ax in zip(lam.joints.tolist(), centres, axes):
+            hole = geo.cylinder(m.u(c), ax, radius / m.units.metres_per_unit,
                                 t / m.units.metres_per_unit)
-            m.model.Objects.AddExtrusion(hole, m.attrs("holes", f"L{lam.id} J{j} hole",
-                                                       lamella_id=int(lam.id), joint_id=j,
-                                                       diameter=m.fmt(2 * radius)))
+            m.model.Objects.AddExtrusion(hole, m.again(a, "holes", f"L{lam.id} J{j} hole",
+                                                       joint_id=j))
             n_holes += 1
     return {"strips": len(lams), "holes": n_holes, "width_m": w, "thickness_m": t}
 
@@ -261,15 +297,20 @@ def _sheets(m: _Model, bundle, layout, params) -> list[dict[str, Any]]:
             m.model.Objects.AddCurve(geo.bulge_curve(place(p.outline.V), p.outline.B,
                                                      p.outline.closed, z),
                                      m.attrs(layer, name, role="outline", **ids))
-            for c, r in zip(p.holes, p.radii):
-                m.model.Objects.AddCircle(geo.circle(place(c)[0], float(r) * to_unit, z),
-                                         m.attrs(layer, f"{name} hole", role="hole", **ids))
-            for a, b in p.scores:
-                m.model.Objects.AddCurve(geo.bulge_curve(place([a, b]), None, False, z),
-                                         m.attrs(layer, f"{name} score", role="score", **ids))
-            for L in p.engrave:
-                m.model.Objects.AddCurve(geo.bulge_curve(place(L), None, False, z),
-                                         m.attrs(layer, f"{name} label", role="engrave", **ids))
+            # one set of attributes for a part's holes, one for its scores, one for its
+            # labels (copied into each object: the same attributes as one set each)
+            if len(p.holes):
+                a = m.shared(len(p.holes), layer, f"{name} hole", role="hole", **ids)
+                for c, r in zip(place(p.holes), p.radii.tolist()):
+                    m.model.Objects.AddCircle(geo.circle(c, r * to_unit, z), a)
+            if len(p.scores):
+                a = m.shared(len(p.scores), layer, f"{name} score", role="score", **ids)
+                for ab in p.scores:
+                    m.model.Objects.AddCurve(geo.bulge_curve(place(ab), None, False, z), a)
+            if len(p.engrave):
+                a = m.shared(len(p.engrave), layer, f"{name} label", role="engrave", **ids)
+                for L in p.engrave:
+                    m.model.Objects.AddCurve(geo.bulge_curve(place(L), None, False, z), a)
         out.append({"layer": layer, "parts": len(parts),
                     "origin": [float(origin[0]), float(origin[1]), z]})
         x = x + (W + 0.05 * W) * to_unit
@@ -336,9 +377,10 @@ def bundle_to_3dm(bundle, *, name: str = "", units: Any = None, params: Any = No
                 m.attrs("collapsed", f"L{lam.id} collapsed", state="collapsed",
                         lamella_id=int(lam.id), family=int(lam.family),
                         joints=" ".join(str(j) for j in lam.joints.tolist())))
+    a = m.shared(0, "joints", "", joint_id="-", lamellae="-")     # one set, values per joint
     for j, p in enumerate(m.u(bundle.net.joints).tolist()):
-        m.model.Objects.AddPoint(m.r.Point3d(*p), m.attrs(
-            "joints", f"J{j}", joint_id=j, lamellae=" ".join(map(str, through.get(j, [])))))
+        m.model.Objects.AddPoint(m.r.Point3d(*p), m.again(
+            a, "joints", f"J{j}", joint_id=j, lamellae=" ".join(map(str, through.get(j, [])))))
 
     sheets = _sheets(m, bundle, layout, params) if layout is not None else []
     strings = {"gridshell.kind": bundle.kind, "gridshell.units": units.name,

@@ -56,8 +56,9 @@ def point_list(P: np.ndarray):
     if P.ndim == 2 and P.shape[1] == 2:
         P = np.column_stack([P, np.zeros(len(P))])
     pts = rhino3dm.Point3dList()
-    for x, y, z in P.reshape(-1, 3).tolist():
-        pts.Add(x, y, z)
+    # one Add per point through map(), the columns as arguments: the points of a loop
+    # adding them one by one, in order, at ~2/3 of its time
+    list(map(pts.Add, *P.reshape(-1, 3).T.tolist()))
     return pts
 
 
@@ -114,7 +115,7 @@ def cylinder(centre: np.ndarray, axis: np.ndarray, radius: float, height: float)
 
     axis = np.asarray(axis, float) / np.linalg.norm(axis)
     base = np.asarray(centre, float) - 0.5 * height * axis
-    c = rhino3dm.Circle(rhino3dm.Point3d(*base.tolist()), float(radius))
+    c = rhino3dm.Circle(float(radius))      # its plane replaced: centre and axis from here
     c.Plane = rhino3dm.Plane(rhino3dm.Point3d(*base.tolist()), rhino3dm.Vector3d(*axis.tolist()))
     return rhino3dm.Extrusion.CreateCylinderExtrusion(rhino3dm.Cylinder(c, float(height)),
                                                       True, True)

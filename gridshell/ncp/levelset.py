@@ -20,7 +20,7 @@ from typing import Callable, NamedTuple
 import numpy as np
 import scipy.sparse as sp
 
-from ..bspline import BSplineSurface, _local_basis, _paired_params, open_uniform_knots
+from ..bspline import BSplineSurface, local_basis, paired_params, open_uniform_knots
 from ..errors import InputError, NoNetError
 from ..net import Lamella, Net
 from ..solver import Layout, TermResult, result, term
@@ -68,9 +68,9 @@ def _patches(F: BSplineSurface, u: np.ndarray, v: np.ndarray, du: int, dv: int
     """Local data of ``xi`` at paired parameters ``(k,)``: the ``xi`` control values of each
     parameter's span ``(k, d_u + 1, d_v + 1)``, the non-zero ``u`` basis values (or ``du``-th
     derivatives) ``(k, d_u + 1)``, those in ``v``, and the checked, clipped ``u, v``."""
-    u, v = _paired_params(F, u, v, du, dv, "xi")
-    fu, bu = _local_basis(F.knots_u, F.degree_u, u, int(du))
-    fv, bv = _local_basis(F.knots_v, F.degree_v, v, int(dv))
+    u, v = paired_params(F, u, v, du, dv, "xi")
+    fu, bu = local_basis(F.knots_u, F.degree_u, u, int(du))
+    fv, bv = local_basis(F.knots_v, F.degree_v, v, int(dv))
     iu = fu[:, None, None] + np.arange(bu.shape[1])[None, :, None]
     iv = fv[:, None, None] + np.arange(bv.shape[1])[None, None, :]
     return F.ctrl[..., 2][iu, iv], bu, bv, u, v
@@ -332,8 +332,8 @@ def _grad_xi(F: BSplineSurface, uv: np.ndarray) -> tuple[np.ndarray, np.ndarray]
     """``xi (k,)`` and its gradient ``(xi_u, xi_v) (k, 2)`` at ``uv (k, 2)``: one basis
     evaluation per direction and order, shared by the value and the two derivatives."""
     C, bu, bv, u, v = _patches(F, uv[:, 0], uv[:, 1], 0, 0)
-    _, du = _local_basis(F.knots_u, F.degree_u, u, 1)
-    _, dv = _local_basis(F.knots_v, F.degree_v, v, 1)
+    _, du = local_basis(F.knots_u, F.degree_u, u, 1)
+    _, dv = local_basis(F.knots_v, F.degree_v, v, 1)
     Cv = np.einsum("kab,kb->ka", C, bv)
     z = np.einsum("ka,ka->k", bu, Cv)
     g = np.stack([np.einsum("ka,ka->k", du, Cv),
