@@ -504,6 +504,24 @@ def _kn_at_joints(net: Net, axis_normals: Sequence[np.ndarray],
     return kn_at
 
 
+def kn_at_joints_per_axis(net: Net, axis_normals: Sequence[np.ndarray],
+                          joint_index: Sequence[np.ndarray]) -> dict[int, dict[int, float]]:
+    """``{joint: {family: kn}}`` (1/m) as :func:`_kn_at_joints`, lamella by lamella through
+    :func:`gridshell.diffgeo.normal_geodesic_curvature` of each whole axis (which raises its
+    own error on a polyline or normals it refuses)."""
+    from .diffgeo import normal_geodesic_curvature
+
+    kn_at: dict[int, dict[int, float]] = {}
+    for lam, N, jidx in zip(net.lamellae, axis_normals, joint_index):
+        if len(lam.axis) < 3:
+            continue
+        kn, _ = normal_geodesic_curvature(lam.axis, N)
+        for jj, vi in zip(np.asarray(lam.joints).tolist(), np.asarray(jidx).tolist()):
+            if 0 < vi < len(lam.axis) - 1:
+                kn_at.setdefault(jj, {})[lam.family] = float(kn[vi])
+    return kn_at
+
+
 def crossing_normal_curvature(net: Net, axis_normals: Sequence[np.ndarray],
                               joint_index: Sequence[np.ndarray],
                               scale: np.ndarray) -> dict[str, Any]:
@@ -530,18 +548,9 @@ def crossing_normal_curvature(net: Net, axis_normals: Sequence[np.ndarray],
     dict
         ``rel (m,)`` (fraction), ``joints (m,)``, ``kn1, kn3 (m,)`` 1/m, ``mean``, ``max``.
     """
-    from .diffgeo import normal_geodesic_curvature
-
     kn_at = _kn_at_joints(net, axis_normals, joint_index)
     if kn_at is None:        # a polyline or normals it refuses: its own error
-        kn_at = {}
-        for lam, N, jidx in zip(net.lamellae, axis_normals, joint_index):
-            if len(lam.axis) < 3:
-                continue
-            kn, _ = normal_geodesic_curvature(lam.axis, N)
-            for jj, vi in zip(np.asarray(lam.joints).tolist(), np.asarray(jidx).tolist()):
-                if 0 < vi < len(lam.axis) - 1:
-                    kn_at.setdefault(jj, {})[lam.family] = float(kn[vi])
+        kn_at = kn_at_joints_per_axis(net, axis_normals, joint_index)
     joints = np.array(sorted(j for j, d in kn_at.items() if len(d) == 2), np.int64)
     if len(joints) == 0:
         return {"rel": np.zeros(0), "joints": joints, "kn1": np.zeros(0), "kn3": np.zeros(0),

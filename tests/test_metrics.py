@@ -210,17 +210,9 @@ def test_geodesic_turning_of_exact_geodesics_with_smooth_normals():
 
 def _kn_one_by_one(net, normals, jidx):
     """The straightforward kn at the joints: normal_geodesic_curvature of each whole axis."""
-    from gridshell.diffgeo import normal_geodesic_curvature
+    from gridshell.metrics import kn_at_joints_per_axis
 
-    out = {}
-    for lam, N, ji in zip(net.lamellae, normals, jidx):
-        if len(lam.axis) < 3:
-            continue
-        kn, _ = normal_geodesic_curvature(lam.axis, N)
-        for j, vi in zip(np.asarray(lam.joints).tolist(), np.asarray(ji).tolist()):
-            if 0 < vi < len(lam.axis) - 1:
-                out.setdefault(j, {})[lam.family] = float(kn[vi])
-    return out
+    return kn_at_joints_per_axis(net, normals, jidx)
 
 
 def test_kn_at_joints_equals_the_whole_axes_one_by_one():
