@@ -297,9 +297,13 @@ def principal_curvature_at(V: Any, F: np.ndarray | None, vertices: np.ndarray,
     vertices = np.asarray(vertices, dtype=np.int64).reshape(-1)
     if vertices.size and (vertices.min() < 0 or vertices.max() >= len(V)):
         raise InputError(f"vertex indices must lie in [0, {len(V) - 1}]")
+    r = max(int(radius), 2)     # igl takes a radius below 2 as 2
+    # one ring less when the ring's outermost normals provably face the vertex's side
+    # (_outer_ring_agrees): then the triangles round those outermost vertices do not count
+    rings = r - 1 if _outer_ring_agrees(V, T, vertices, r) else r
     near = np.zeros(len(V), dtype=bool)
     near[vertices] = True
-    for _ in range(max(int(radius), 2)):   # igl takes a radius below 2 as 2
+    for _ in range(rings):
         near[T[near[T].any(axis=1)]] = True
     faces = near[T].any(axis=1)
     keep = np.zeros(len(V), dtype=bool)
@@ -314,6 +318,49 @@ def principal_curvature_at(V: Any, F: np.ndarray | None, vertices: np.ndarray,
                                           np.ascontiguousarray(new[T[faces]]), int(radius))
     at = new[vertices]
     return d1[at], d2[at], k1[at], k2[at]
+
+
+def _outer_ring_agrees(V: np.ndarray, T: np.ndarray, vertices: np.ndarray, r: int) -> bool:
+    """Whether igl's figures at ``vertices`` are those of the part holding only the
+    triangles with a corner within their ``(r-1)``-ring (``r``: igl's k-ring radius).
+
+    igl (principal_curvature.cpp: local mode, average normal, projection-plane check) uses
+    at a vertex v: the positions of its r-ring, found breadth first over index-sorted
+    adjacency lists of the vertices within r - 1 (complete in that part, their order kept by
+    the renumbering), v's own vertex normal (all its triangles are in the part) and, for
+    each ring vertex u, only the sign of ``n(u) . n(v)``. Every vertex normal igl computes
+    is a non-negative combination of the face normals round its vertex, so that sign is
+    positive with any subset of u's triangles (and with all of them) when every triangle
+    near v lies within a quarter turn of every triangle round v. Checked here with a cone
+    round v's triangles and a margin of 1e-6 rad, far above rounding: True only then (a
+    degenerate or non-finite triangle near a vertex: False, the full part is used)."""
+    n, m, k = len(V), len(T), len(vertices)
+    fn = np.cross(V[T[:, 1]] - V[T[:, 0]], V[T[:, 2]] - V[T[:, 0]])
+    length = np.sqrt((fn * fn).sum(axis=1))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        U = fn / length[:, None]
+    VF = sp.csr_matrix((np.ones(3 * m, dtype=np.int32),
+                        (T.reshape(-1), np.repeat(np.arange(m), 3))), shape=(n, m))
+    VV = (VF @ VF.T).astype(bool).astype(np.int32)     # sharing a triangle (and itself)
+    R = sp.csr_matrix((np.ones(k, dtype=np.int32), (np.arange(k), vertices)), shape=(k, n))
+    for _ in range(r):
+        R = (R @ VV).astype(bool).astype(np.int32)
+    near = (R @ VF).tocoo()                   # (pick, triangle with a corner in its r-ring)
+    own = VF[vertices].tocoo()                # (pick, triangle round it)
+    good = (length > 0) & np.all(np.isfinite(U), axis=1)
+    if not (good[near.col].all() and good[own.col].all()):
+        return False
+    c = np.zeros((k, 3))
+    np.add.at(c, own.row, U[own.col])
+    cn = np.sqrt((c * c).sum(axis=1))
+    if not np.all(cn > 0.5):     # the triangles round a vertex are far from one side
+        return False
+    c /= cn[:, None]
+    alpha = np.zeros(k)
+    np.maximum.at(alpha, own.row,
+                  np.arccos(np.clip((c[own.row] * U[own.col]).sum(axis=1), -1.0, 1.0)))
+    beta = np.arccos(np.clip((c[near.row] * U[near.col]).sum(axis=1), -1.0, 1.0))
+    return bool(np.all(alpha[near.row] + beta < np.pi / 2 - 1e-6))
 
 
 def _principal_curvature(V: np.ndarray, T: np.ndarray,
