@@ -335,21 +335,22 @@ def _outer_ring_agrees(V: np.ndarray, T: np.ndarray, vertices: np.ndarray, r: in
     round v's triangles and a margin of 1e-6 rad, far above rounding: True only then (a
     degenerate or non-finite triangle near a vertex: False, the full part is used)."""
     n, m, k = len(V), len(T), len(vertices)
-    fn = np.cross(V[T[:, 1]] - V[T[:, 0]], V[T[:, 2]] - V[T[:, 0]])
-    length = np.sqrt((fn * fn).sum(axis=1))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        U = fn / length[:, None]
     VF = sp.csr_matrix((np.ones(3 * m, dtype=np.int32),
                         (T.reshape(-1), np.repeat(np.arange(m), 3))), shape=(n, m))
-    VV = (VF @ VF.T).astype(bool).astype(np.int32)     # sharing a triangle (and itself)
+    FV = VF.T.tocsr()
     R = sp.csr_matrix((np.ones(k, dtype=np.int32), (np.arange(k), vertices)), shape=(k, n))
-    for _ in range(r):
-        R = (R @ VV).astype(bool).astype(np.int32)
+    for _ in range(r):      # one ring more: the corners of the triangles round the ring
+        R = ((R @ VF) @ FV).astype(bool).astype(np.int32)
     near = (R @ VF).tocoo()                   # (pick, triangle with a corner in its r-ring)
     own = VF[vertices].tocoo()                # (pick, triangle round it)
-    good = (length > 0) & np.all(np.isfinite(U), axis=1)
-    if not (good[near.col].all() and good[own.col].all()):
+    U = np.zeros((m, 3))
+    used = np.union1d(near.col, own.col)
+    t = T[used]
+    fn = np.cross(V[t[:, 1]] - V[t[:, 0]], V[t[:, 2]] - V[t[:, 0]])
+    length = np.sqrt((fn * fn).sum(axis=1))
+    if not (np.all(length > 0) and np.all(np.isfinite(fn))):
         return False
+    U[used] = fn / length[:, None]
     c = np.zeros((k, 3))
     np.add.at(c, own.row, U[own.col])
     cn = np.sqrt((c * c).sum(axis=1))
