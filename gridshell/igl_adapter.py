@@ -347,9 +347,14 @@ def _outer_ring_agrees(V: np.ndarray, T: np.ndarray, vertices: np.ndarray, r: in
     near = (R @ VF).tocoo()                   # (pick, triangle with a corner in its r-ring)
     own = VF[vertices].tocoo()                # (pick, triangle round it)
     U = np.zeros((m, 3))
-    used = np.union1d(near.col, own.col)
+    used = np.zeros(m, dtype=bool)
+    used[near.col] = True          # (the triangles round each vertex are among them)
+    used = np.flatnonzero(used)
     t = T[used]
-    fn = np.cross(V[t[:, 1]] - V[t[:, 0]], V[t[:, 2]] - V[t[:, 0]])
+    e, f = V[t[:, 1]] - V[t[:, 0]], V[t[:, 2]] - V[t[:, 0]]
+    fn = np.column_stack([e[:, 1] * f[:, 2] - e[:, 2] * f[:, 1],
+                          e[:, 2] * f[:, 0] - e[:, 0] * f[:, 2],
+                          e[:, 0] * f[:, 1] - e[:, 1] * f[:, 0]])
     length = np.sqrt((fn * fn).sum(axis=1))
     if not (np.all(length > 0) and np.all(np.isfinite(fn))):
         return False
