@@ -263,3 +263,23 @@ def test_principal_curvature_at_one_ring_less_when_the_outer_normals_agree(radiu
     part = ia.principal_curvature_at(Vf, F, np.array([c]), radius=radius)
     for w, p in zip(whole, part):
         assert np.array_equal(w[[c]], p, equal_nan=True)
+
+
+def test_principal_curvature_at_one_ring_less_on_an_irregular_mesh():
+    """The same on a Delaunay mesh of random points (irregular valences, a ragged boundary):
+    where the guard lets igl have the smaller part, the figures are the whole mesh's."""
+    from scipy.spatial import Delaunay
+
+    import gridshell.igl_adapter as ia
+
+    rng = np.random.default_rng(3)
+    xy = rng.uniform(-1, 1, (3000, 2))
+    F = Delaunay(xy).simplices.astype(np.int64)
+    V = np.column_stack([xy, 0.05 * np.sin(2 * xy[:, 0]) * np.cos(3 * xy[:, 1])])
+    for radius in (1, 2, 3):
+        picks = rng.choice(len(V), 20, replace=False)
+        assert ia._outer_ring_agrees(V, F, picks, max(radius, 2))
+        whole = ia.principal_curvature(V, F, radius=radius)
+        part = ia.principal_curvature_at(V, F, picks, radius=radius)
+        for w, p in zip(whole, part):
+            assert np.array_equal(w[picks], p, equal_nan=True)
