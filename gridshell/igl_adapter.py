@@ -288,8 +288,11 @@ def principal_curvature_at(V: Any, F: np.ndarray | None, vertices: np.ndarray,
     igl fits each vertex's quadric to its ``radius``-ring (the vertices joined to it by at
     most ``radius`` edges) with the average of their normals, each normal from the faces
     round its vertex: the triangles with a corner within the ``radius``-ring of ``vertices``
-    hold all of that. They are handed to igl in their order, their vertices renumbered in
-    theirs, so that igl meets every neighbour in the same order and adds in the same order
+    hold all of that; of the outermost ring's normals igl reads only on which side of the
+    vertex's normal they lie, so when that side is certain (:func:`_outer_ring_agrees`) the
+    triangles with a corner within one ring less suffice (~half as many vertices for igl to
+    fit). They are handed to igl in their order, their vertices renumbered in theirs, so
+    that igl meets every neighbour in the same order and adds in the same order
     (tests/test_bundle_cache.py compares with the whole mesh's figures)."""
     V, T, _ = triangulate(V, F)
     if int(radius) < 1:
@@ -297,9 +300,13 @@ def principal_curvature_at(V: Any, F: np.ndarray | None, vertices: np.ndarray,
     vertices = np.asarray(vertices, dtype=np.int64).reshape(-1)
     if vertices.size and (vertices.min() < 0 or vertices.max() >= len(V)):
         raise InputError(f"vertex indices must lie in [0, {len(V) - 1}]")
+    r = max(int(radius), 2)     # igl takes a radius below 2 as 2
+    # one ring less when the ring's outermost normals provably face the vertex's side
+    # (_outer_ring_agrees): then the triangles round those outermost vertices do not count
+    rings = r - 1 if _outer_ring_agrees(V, T, vertices, r) else r
     near = np.zeros(len(V), dtype=bool)
     near[vertices] = True
-    for _ in range(max(int(radius), 2)):   # igl takes a radius below 2 as 2
+    for _ in range(rings):
         near[T[near[T].any(axis=1)]] = True
     faces = near[T].any(axis=1)
     keep = np.zeros(len(V), dtype=bool)
@@ -314,6 +321,55 @@ def principal_curvature_at(V: Any, F: np.ndarray | None, vertices: np.ndarray,
                                           np.ascontiguousarray(new[T[faces]]), int(radius))
     at = new[vertices]
     return d1[at], d2[at], k1[at], k2[at]
+
+
+def _outer_ring_agrees(V: np.ndarray, T: np.ndarray, vertices: np.ndarray, r: int) -> bool:
+    """Whether igl's figures at ``vertices`` are those of the part holding only the
+    triangles with a corner within their ``(r-1)``-ring (``r``: igl's k-ring radius).
+
+    igl (principal_curvature.cpp: local mode, average normal, projection-plane check) uses
+    at a vertex v: the positions of its r-ring, found breadth first over index-sorted
+    adjacency lists of the vertices within r - 1 (complete in that part, their order kept by
+    the renumbering), v's own vertex normal (all its triangles are in the part) and, for
+    each ring vertex u, only the sign of ``n(u) . n(v)``. Every vertex normal igl computes
+    is a non-negative combination of the face normals round its vertex, so that sign is
+    positive with any subset of u's triangles (and with all of them) when every triangle
+    near v lies within a quarter turn of every triangle round v. Checked here with a cone
+    round v's triangles and a margin of 1e-6 rad, far above rounding: True only then (a
+    degenerate or non-finite triangle near a vertex: False, the full part is used)."""
+    n, m, k = len(V), len(T), len(vertices)
+    VF = sp.csr_matrix((np.ones(3 * m, dtype=np.int32),
+                        (T.reshape(-1), np.repeat(np.arange(m), 3))), shape=(n, m))
+    FV = VF.T.tocsr()
+    R = sp.csr_matrix((np.ones(k, dtype=np.int32), (np.arange(k), vertices)), shape=(k, n))
+    for _ in range(r):      # one ring more: the corners of the triangles round the ring
+        R = ((R @ VF) @ FV).astype(bool).astype(np.int32)
+    near = (R @ VF).tocoo()                   # (pick, triangle with a corner in its r-ring)
+    own = VF[vertices].tocoo()                # (pick, triangle round it)
+    U = np.zeros((m, 3))
+    used = np.zeros(m, dtype=bool)
+    used[near.col] = True          # (the triangles round each vertex are among them)
+    used = np.flatnonzero(used)
+    t = T[used]
+    e, f = V[t[:, 1]] - V[t[:, 0]], V[t[:, 2]] - V[t[:, 0]]
+    fn = np.column_stack([e[:, 1] * f[:, 2] - e[:, 2] * f[:, 1],
+                          e[:, 2] * f[:, 0] - e[:, 0] * f[:, 2],
+                          e[:, 0] * f[:, 1] - e[:, 1] * f[:, 0]])
+    length = np.sqrt((fn * fn).sum(axis=1))
+    if not (np.all(length > 0) and np.all(np.isfinite(fn))):
+        return False
+    U[used] = fn / length[:, None]
+    c = np.zeros((k, 3))
+    np.add.at(c, own.row, U[own.col])
+    cn = np.sqrt((c * c).sum(axis=1))
+    if not np.all(cn > 0.5):     # the triangles round a vertex are far from one side
+        return False
+    c /= cn[:, None]
+    alpha = np.zeros(k)
+    np.maximum.at(alpha, own.row,
+                  np.arccos(np.clip((c[own.row] * U[own.col]).sum(axis=1), -1.0, 1.0)))
+    beta = np.arccos(np.clip((c[near.row] * U[near.col]).sum(axis=1), -1.0, 1.0))
+    return bool(np.all(alpha[near.row] + beta < np.pi / 2 - 1e-6))
 
 
 def _principal_curvature(V: np.ndarray, T: np.ndarray,

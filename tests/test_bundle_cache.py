@@ -219,3 +219,67 @@ def test_principal_curvature_at_asks_igl_about_a_part_of_the_mesh(monkeypatch):
                         lambda V, T, r: sizes.append(len(V)) or real(V, T, r))
     ia.principal_curvature_at(V, F, np.arange(0, 5000, 170), radius=3)
     assert sizes and sizes[0] < len(V) // 2
+
+
+@pytest.mark.parametrize("radius", [1, 2, 3])
+def test_principal_curvature_at_one_ring_less_when_the_outer_normals_agree(radius, monkeypatch):
+    """On a smooth mesh the outermost ring's normals face the vertex's side: igl gets the
+    part one ring smaller, and the figures are still those of the whole mesh, bit for bit;
+    on a mesh folded onto itself near a vertex the guard refuses and the full part is used
+    (the same figures again)."""
+    import gridshell.igl_adapter as ia
+    from gridshell.grid import grid_quads
+
+    rng = np.random.default_rng(7 + radius)
+    m = 50
+    t = np.linspace(-1, 1, m)
+    X, Y = np.meshgrid(t, t, indexing="ij")
+    V = np.stack([X, Y, 0.3 * np.sin(2 * X) * np.cos(3 * Y)], -1).reshape(-1, 3)
+    V = V + rng.normal(0, 0.003, V.shape)
+    F = grid_quads(m, m)
+    picks = rng.choice(np.arange(m * m), 25, replace=False)
+    Vt, T, _ = ia.triangulate(V, F)
+    assert ia._outer_ring_agrees(Vt, T, picks, max(radius, 2))
+    sizes = []
+    real = ia.igl.principal_curvature
+    monkeypatch.setattr(ia.igl, "principal_curvature",
+                        lambda V, T, r: sizes.append(len(T)) or real(V, T, r))
+    whole = ia.principal_curvature(V, F, radius=radius)
+    part = ia.principal_curvature_at(V, F, picks, radius=radius)
+    for w, p in zip(whole, part):
+        assert np.array_equal(w[picks], p, equal_nan=True)
+    near = np.zeros(len(Vt), dtype=bool)
+    near[picks] = True
+    for _ in range(max(radius, 2) - 1):
+        near[T[near[T].any(axis=1)]] = True
+    assert sizes[-1] == int(near[T].any(axis=1).sum())       # one ring less
+    # a sharp fold next to a picked vertex: its ring's outer triangles face away
+    Vf = V.copy()
+    c = (m // 2) * m + m // 2
+    Vf[c + 2 * m: c + 2 * m + 3, 2] += 5.0
+    Vft, Tf, _ = ia.triangulate(Vf, F)
+    assert not ia._outer_ring_agrees(Vft, Tf, np.array([c]), max(radius, 2))
+    whole = ia.principal_curvature(Vf, F, radius=radius)
+    part = ia.principal_curvature_at(Vf, F, np.array([c]), radius=radius)
+    for w, p in zip(whole, part):
+        assert np.array_equal(w[[c]], p, equal_nan=True)
+
+
+def test_principal_curvature_at_one_ring_less_on_an_irregular_mesh():
+    """The same on a Delaunay mesh of random points (irregular valences, a ragged boundary):
+    where the guard lets igl have the smaller part, the figures are the whole mesh's."""
+    from scipy.spatial import Delaunay
+
+    import gridshell.igl_adapter as ia
+
+    rng = np.random.default_rng(3)
+    xy = rng.uniform(-1, 1, (3000, 2))
+    F = Delaunay(xy).simplices.astype(np.int64)
+    V = np.column_stack([xy, 0.05 * np.sin(2 * xy[:, 0]) * np.cos(3 * xy[:, 1])])
+    for radius in (1, 2, 3):
+        picks = rng.choice(len(V), 20, replace=False)
+        assert ia._outer_ring_agrees(V, F, picks, max(radius, 2))
+        whole = ia.principal_curvature(V, F, radius=radius)
+        part = ia.principal_curvature_at(V, F, picks, radius=radius)
+        for w, p in zip(whole, part):
+            assert np.array_equal(w[picks], p, equal_nan=True)
