@@ -252,8 +252,7 @@ def render_ribbons(path: str | os.PathLike, axes: Sequence[np.ndarray],
 
     fig = Figure(figsize=(size[0] / dpi, size[1] / dpi), dpi=dpi)
     rect = (0.01, 0.01, 0.98, 0.91 if title else 0.98)   # the picture's box, figure fraction
-    xy = np.concatenate([p.reshape(-1, 2) for p in painter.polys])
-    lo, hi = xy.min(axis=0), xy.max(axis=0)
+    lo, hi = _extent(painter.polys)
     box = np.array([0.98 * size[0], (0.91 if title else 0.98) * size[1]])  # the box, pixels
     scale = 1.06 * float(np.max((hi - lo) / box)) or 1.0  # metres per pixel, equal both ways
     mid = 0.5 * (lo + hi)
@@ -279,6 +278,17 @@ def render_ribbons(path: str | os.PathLike, axes: Sequence[np.ndarray],
         fig.suptitle(title, fontsize=max(6.0, min(10.0, size[0] / 60.0)))
     _write_png(fig, path, dpi)
     return Path(path)
+
+
+def _extent(polys: Sequence[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """The smallest and largest ``x`` and ``y`` ``(2,)`` (the picture's plane, metres) of the
+    points of the polygon arrays ``polys (m_i, k_i, 2)``: the numbers ``min(axis=0)`` and
+    ``max(axis=0)`` of all of them stacked give (a NaN wins as there), by coordinate (a
+    reduction over ~140k rows of 2 along the rows takes numpy ~6 ms, over one strided
+    coordinate ~0.1 ms; nothing copied)."""
+    lo = np.array([np.array([p[..., i].min() for p in polys]).min() for i in range(2)])
+    hi = np.array([np.array([p[..., i].max() for p in polys]).max() for i in range(2)])
+    return lo, hi
 
 
 def _data_to_pixels(fig, rect: tuple[float, float, float, float], lo: np.ndarray,
