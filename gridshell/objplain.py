@@ -33,14 +33,14 @@ def parse_plain(data: bytes, tag: bytes) -> tuple[np.ndarray, np.ndarray, np.nda
     out as the tool writes it: comment or blank lines, one run of ``v x y z`` records, one run
     of ``tag`` records of positive plain indices, each record at the start of its line.
 
-    The same numbers as :func:`gridshell.meshfile._parse_obj` (and its regex parsers) read from such a file,
-    found with numpy on the bytes (no line-by-line Python, no regular expression over every
-    line): a line is a record or comment by its first two bytes, each record's tokens are
-    counted (3 numbers after ``v``, at least one index after ``tag``), and ``np.fromstring``
-    must read the records' text to its end, one number per token (a number ``float`` reads:
-    only digits, ``.``, ``e``, signs). None for any other file (other records, records split
-    or interleaved, indented, colours, ``i/t/n`` or negative indices, other bytes, CR not
-    followed by LF): the general parsers read it."""
+    The same numbers as :func:`gridshell.meshfile._parse_obj` (and its regex parsers) read
+    from such a file, found with numpy on the bytes (no line-by-line Python, no regular
+    expression over every line): a line is a record or comment by its first two bytes, each
+    record's tokens are counted (3 numbers after ``v``, at least one index after ``tag``),
+    and ``np.fromstring`` must read the records' text to its end, one number per token (a
+    number ``float`` reads: only digits, ``.``, ``e``, signs). None for any other file (other
+    records, records split or interleaved, indented, colours, ``i/t/n`` or negative indices,
+    other bytes, CR not followed by LF): the general parsers read it."""
     if not data or (b"\r" in data and data.count(b"\r") != data.count(b"\r\n")):
         return None
     a = np.frombuffer(data, np.uint8)

@@ -23,13 +23,15 @@ from typing import Any
 
 import numpy as np
 
-from ..strips3d import strip_frames
+from ..strips3d import row_norms, strip_frames
 
 __all__ = ["Camera", "Painter", "grow_polygons", "strip_faces", "strips_faces"]
 
 
 def _unit(X: np.ndarray) -> np.ndarray:
-    n = np.linalg.norm(X, axis=-1, keepdims=True)
+    """Rows ``X (..., 3)`` divided by their lengths (zero rows stay zero); the lengths by
+    :func:`gridshell.strips3d.row_norms`, ``np.linalg.norm``'s numbers."""
+    n = row_norms(X)[..., None]
     return np.divide(X, n, out=np.zeros_like(X), where=n > 0)
 
 
@@ -322,7 +324,8 @@ def _grow_parts(P: np.ndarray, d: float) -> tuple[np.ndarray, np.ndarray, np.nda
     s = np.where(area2 >= 0, 1.0, -1.0)[:, None]
     N = np.stack([s * U[..., 1], -s * U[..., 0]], axis=-1)  # outward normal of edge i
     Nin = np.roll(N, 1, axis=1)                              # of the edge into corner i
-    cos = np.sum(N * Nin, axis=-1, keepdims=True)
+    # np.sum(N * Nin, axis=-1) written out: a sum of two terms is one addition either way
+    cos = (N[..., 0] * Nin[..., 0] + N[..., 1] * Nin[..., 1])[..., None]
     return P + d * (N + Nin) / np.maximum(1.0 + cos, 0.5), N, Nin
 
 

@@ -25,7 +25,7 @@ import numpy as np
 
 from ..atomic import atomic_path
 from ..errors import InputError
-from ..strips3d import TANGENT_KINDS, nearest_vertex_normals, strip_frame
+from ..strips3d import TANGENT_KINDS, nearest_vertex_normals, row_norms, strip_frame
 
 __all__ = ["FAMILY_COLOURS", "TANGENT_KINDS", "nearest_vertex_normals",
            "ribbon_polygons", "view_angles", "render_ribbons", "render_bundle"]
@@ -37,7 +37,9 @@ _SURFACE_RGB = (0.80, 0.82, 0.85)
 
 
 def _unit(X: np.ndarray) -> np.ndarray:
-    n = np.linalg.norm(X, axis=-1, keepdims=True)
+    """Rows ``X (..., 3)`` divided by their lengths (zero rows stay zero); the lengths by
+    :func:`gridshell.strips3d.row_norms`, ``np.linalg.norm``'s numbers."""
+    n = row_norms(X)[..., None]
     return np.divide(X, n, out=np.zeros_like(X), where=n > 0)
 
 
@@ -207,7 +209,7 @@ def render_ribbons(path: str | os.PathLike, axes: Sequence[np.ndarray],
         k = 0.62 + 0.3 * np.abs(n @ light)
         face = np.column_stack([np.outer(k, _SURFACE_RGB), np.ones(len(S))])
         painter.add(S, face, face)  # edges as the faces: no seams, no mesh lines
-        size_faces = float(np.median(np.linalg.norm(S[:, 2] - S[:, 0], axis=1)))
+        size_faces = float(np.median(row_norms(S[:, 2] - S[:, 0])))
     else:
         size_faces = 0.0
     bias = 0.5 * size_faces + 0.5 * t
