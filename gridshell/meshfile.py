@@ -601,6 +601,14 @@ def read_polylines(path: str | os.PathLike) -> list[np.ndarray]:
         raise MeshError(f"{path.name}: polylines are read from OBJ files only; give an .obj file")
     fast = _parse_polylines_fast(path.read_bytes())
     V, lines = fast if fast is not None else _parse_obj(path, _decode(path))[::2]
+    if fast is not None and lines:
+        # every polyline at once: in range, finite and within EXTENT_RANGE, the polylines are
+        # what the loop below takes (which names the first problem otherwise)
+        flat = np.concatenate(lines)
+        if len(flat) and flat.min() >= 0 and flat.max() < len(V):
+            A = V[flat]
+            if np.all(np.isfinite(A)) and np.abs(A).max() <= EXTENT_RANGE[1]:
+                return [V[idx] for idx in lines]
     out = []
     for i, idx in enumerate(lines):
         idx = np.asarray(idx, dtype=np.int64)

@@ -166,3 +166,36 @@ def test_plain_polylines_match_the_line_parser(tmp_path):
     regex = _parse_polylines_regex(text.encode())
     _same_arrays([regex[0]], [V])
     _same_arrays(regex[1], lines)
+
+
+@pytest.mark.parametrize("text, match", [
+    ("v 0 0 0\nv 1 0 0\nv 2 0 0\nl 1 2\nl 2 4\n", "polyline 1 refers to missing vertices"),
+    ("v 0 0 0\nv 1 0 0\nv 2e9 0 0\nl 1 2\nl 2 3\n", "polyline 1 point 1"),
+    ("v 0 0 0\nv 1 0 0\nv 2e9 0 0\nl 3 2\nl 2 4\n", "polyline 0 point 0"),
+])
+def test_plain_polylines_checked_at_once_name_the_first_problem(tmp_path, text, match):
+    """read_polylines accepts the polylines of a plain file in one check; a file that fails
+    it is checked polyline by polyline, which names the first problem as before."""
+    (tmp_path / "p.obj").write_text(text)
+    assert _parse_plain(text.encode(), b"l") is not None
+    with pytest.raises(MeshError, match=match):
+        read_polylines(tmp_path / "p.obj")
+
+
+def test_polylines_are_their_own_arrays(tmp_path):
+    write_polylines(tmp_path / "a.obj", [np.eye(3), np.ones((2, 3))])
+    a, b = read_polylines(tmp_path / "a.obj")
+    assert a.flags.owndata and b.flags.owndata and a.flags.writeable
+    a[0, 0] = 7.0
+    assert b[0, 0] == 1.0
+
+
+def test_bbox_diagonal_column_by_column_is_the_rows_reduction():
+    from gridshell.quadmesh import bbox_diagonal
+
+    rng = np.random.default_rng(0)
+    for V in (rng.normal(size=(1000, 3)) * 1e3, rng.normal(size=(5, 2)), np.zeros((1, 3)),
+              np.array([[np.nan, 0.0, 0.0], [1.0, 2.0, 3.0]])):
+        want = float(np.linalg.norm(V.max(axis=0) - V.min(axis=0)))
+        got = bbox_diagonal(V)
+        assert got == want or (np.isnan(got) and np.isnan(want))
