@@ -282,10 +282,10 @@ def _topology_problem(P: np.ndarray, n: int, vertices: bool = True) -> str | Non
         return (f"{len(nm)} edges are non-manifold, shared by more than two faces (the first "
                 f"joins vertices {a} and {b}); split the mesh so each edge has at most two faces")
     # orientation: two faces on one edge must run it in opposite directions
-    directed = src * np.int64(n) + dst
-    _, dcount = np.unique(directed, return_counts=True)
-    if np.any(dcount > 1):
-        d = np.unique(directed)[dcount > 1]
+    directed = np.sort(src * np.int64(n) + dst)
+    twice = directed[1:] == directed[:-1]          # a directed edge run by two faces
+    if np.any(twice):
+        d = unique_ints(directed[1:][twice])
         return (f"{len(d)} edges are run in the same direction by both of their faces, so the "
                 f"faces are inconsistently oriented (the first joins vertices {d[0] // n} and "
                 f"{d[0] % n}); reorient the faces consistently (or the surface is non-orientable)")
