@@ -369,4 +369,4 @@ class _PolygonPaths(Sequence):
         if c < 0:
             return self._special[self._local[i]]
         V, codes, template = self._sources[c]
-        return self._make(V[self._local[i]], codes, internals_from=template)
+        return self._make(V[self._local[i]], codes, template)    # internals_from=template
