@@ -27,6 +27,7 @@ import numpy as np
 
 from .atomic import atomic_path
 from .errors import MeshError
+from .objplain import parse_plain as _parse_plain
 from .quadmesh import (EXTENT_RANGE, MESH_FORMATS, QuadMesh, TriMesh, _as_padded, _face_edges,
                        _triangulate_padded, bbox_diagonal, validate_mesh)
 
@@ -99,6 +100,23 @@ _OBJ_OTHER = re.compile(rb"^(?![ \t]*(?:v[ \t]|f[ \t]|vt[ \t]|vn[ \t]|#|o[ \t]|g
 
 
 def _parse_obj_fast(data: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """Vertices, padded faces (0-based) and face sizes of an OBJ of ``v`` and ``f`` records,
+    vectorized: :func:`_parse_plain` for the files the tool writes, else
+    :func:`_parse_obj_regex`; None when neither reads it."""
+    plain = _parse_plain(data, b"f")
+    if plain is None:
+        return _parse_obj_regex(data)
+    V, flat, sizes = plain
+    k = int(sizes.max())
+    if np.all(sizes == k):
+        return V, flat.reshape(-1, k) - 1, sizes
+    P = np.full((len(sizes), k), -1, np.int64)
+    P[np.repeat(np.arange(len(sizes)), sizes),
+      np.arange(len(flat)) - np.repeat(np.cumsum(sizes) - sizes, sizes)] = flat - 1
+    return V, P, sizes
+
+
+def _parse_obj_regex(data: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
     """Vertices, padded faces (0-based) and face sizes of a plain OBJ (``v x y z`` and ``f``
     records with positive indices, optionally ``i/t/n``), vectorized: a 200k-triangle file in
     a fraction of a second. None for anything else (``l`` or ``p`` records, negative indices,
@@ -146,6 +164,17 @@ _POLY_OTHER = re.compile(rb"^(?![ \t]*(?:v[ \t]|l[ \t]|#|o[ \t]|g[ \t]|\r?$))", 
 
 
 def _parse_polylines_fast(data: bytes) -> tuple[np.ndarray, list[np.ndarray]] | None:
+    """Vertices ``(n,3)`` and polylines (0-based ``int64`` index arrays, file order) of a
+    polyline OBJ, vectorized: :func:`_parse_plain` for the files the tool writes, else
+    :func:`_parse_polylines_regex`; None when neither reads it."""
+    plain = _parse_plain(data, b"l")
+    if plain is None:
+        return _parse_polylines_regex(data)
+    V, flat, sizes = plain
+    return V, np.split(flat - 1, np.cumsum(sizes)[:-1])
+
+
+def _parse_polylines_regex(data: bytes) -> tuple[np.ndarray, list[np.ndarray]] | None:
     """Vertices ``(n,3)`` and polylines (0-based ``int64`` index arrays, file order) of a
     plain polyline OBJ (``v x y z`` and ``l`` records with positive indices, comments,
     ``o`` / ``g``), vectorized: the same arrays as :func:`_parse_obj` gives, without its
@@ -572,6 +601,14 @@ def read_polylines(path: str | os.PathLike) -> list[np.ndarray]:
         raise MeshError(f"{path.name}: polylines are read from OBJ files only; give an .obj file")
     fast = _parse_polylines_fast(path.read_bytes())
     V, lines = fast if fast is not None else _parse_obj(path, _decode(path))[::2]
+    if fast is not None and lines:
+        # every polyline at once: in range, finite and within EXTENT_RANGE, the polylines are
+        # what the loop below takes (which names the first problem otherwise)
+        flat = np.concatenate(lines)
+        if len(flat) and flat.min() >= 0 and flat.max() < len(V):
+            A = V[flat]
+            if np.all(np.isfinite(A)) and np.abs(A).max() <= EXTENT_RANGE[1]:
+                return [V[idx] for idx in lines]
     out = []
     for i, idx in enumerate(lines):
         idx = np.asarray(idx, dtype=np.int64)

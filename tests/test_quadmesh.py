@@ -288,3 +288,21 @@ def test_read_configuration_accepts_a_collapsed_net_but_not_garbage(tmp_path):
     (tmp_path / "nan.obj").write_text("v 0 0 nan\nv 1 0 0\nv 1 1 0\nf 1 2 3\n")
     with pytest.raises(MeshError, match="NaN"):
         read_configuration(tmp_path / "nan.obj")
+
+
+def test_orientation_message_counts_and_names_as_numpys_unique():
+    """The directed edges run twice found by sorting: the count and first edge of the message
+    are those of np.unique's counts (a grid with several faces flipped)."""
+    from gridshell.quadmesh import _face_edges, _topology_problem
+
+    n = 7
+    F = np.array([[i * n + j, (i + 1) * n + j, (i + 1) * n + j + 1, i * n + j + 1]
+                  for i in range(n - 1) for j in range(n - 1)])
+    F[[3, 10, 11, 20]] = F[[3, 10, 11, 20], ::-1]
+    src, dst, _ = _face_edges(F)
+    directed = src * np.int64(n * n) + dst
+    u, c = np.unique(directed, return_counts=True)
+    d = u[c > 1]
+    msg = _topology_problem(F, n * n)
+    assert msg.startswith(f"{len(d)} edges are run in the same direction")
+    assert f"joins vertices {d[0] // (n * n)} and {d[0] % (n * n)})" in msg

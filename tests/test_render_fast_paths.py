@@ -219,3 +219,90 @@ def test_picture_transform_is_the_axes_transdata(rect):
     ax.set_ylim(lo[1], hi[1])
     assert np.array_equal(_data_to_pixels(fig, rect, lo, hi).get_matrix(),
                           ax.transData.get_matrix())
+
+
+def _strips_faces_by_groups(axes, normals, width, thickness, tangent):
+    """strips_faces as it was written first: each of the 8 groups stacked from the frames'
+    rows, the groups concatenated, then reordered axis by axis."""
+    from gridshell.strips3d import strip_frames
+
+    P, N, _, W, H = strip_frames(axes, normals, tangent)
+    sizes = np.array([len(a) for a in axes], dtype=np.int64)
+    w, h = 0.5 * float(width) * W, 0.5 * float(thickness) * H
+    corners = [-w - h, +w - h, +w + h, -w + h]
+    seg = np.ones(len(P), bool)
+    seg[np.cumsum(sizes) - 1] = False
+    i0 = np.flatnonzero(seg)
+    i1 = i0 + 1
+    nm = 0.5 * (N[i0] + N[i1])
+    quads, sides = [], []
+    for a in range(4):
+        A, B = corners[a], corners[(a + 1) % 4]
+        Mid = 0.5 * (A + B)
+        for X, Y in ((A, Mid), (Mid, B)):
+            quads.append(np.stack([P[i0] + X[i0], P[i0] + Y[i0], P[i1] + Y[i1], P[i1] + X[i1]],
+                                  axis=1))
+            sides.append(np.sum(0.25 * (X[i0] + Y[i0] + X[i1] + Y[i1]) * nm, axis=1))
+    nseg = sizes - 1
+    start = np.concatenate([[0], np.cumsum(nseg)[:-1]]).astype(np.int64)
+    lam = np.repeat(np.arange(len(sizes)), 8 * nseg)
+    within = np.arange(len(lam)) - np.repeat(8 * start, 8 * nseg)
+    g, j = within // np.repeat(nseg, 8 * nseg), within % np.repeat(nseg, 8 * nseg)
+    order = g * len(i0) + start[lam] + j
+    return (np.concatenate(quads)[order], np.concatenate(sides)[order],
+            np.tile(nm, (8, 1))[order])
+
+
+@pytest.mark.parametrize("tangent", [False, True])
+def test_strips_faces_written_in_place_are_the_stacked_groups_bit_for_bit(tangent):
+    from gridshell.render.painter import strips_faces
+
+    rng = np.random.default_rng(11)
+    axes = [np.cumsum(rng.normal(size=(int(k), 3)) * 10.0 ** rng.integers(-3, 2), axis=0)
+            for k in rng.integers(2, 120, 25)]
+    normals = [rng.normal(size=a.shape) for a in axes]
+    got = strips_faces(axes, normals, 0.2, 0.01, tangent)
+    want = _strips_faces_by_groups(axes, normals, 0.2, 0.01, tangent)
+    for x, y in zip(got, want):
+        assert x.dtype == y.dtype and x.shape == y.shape and x.tobytes() == y.tobytes()
+
+
+def test_picture_extent_is_the_stacked_min_and_max():
+    from gridshell.render.ribbons import _extent
+
+    rng = np.random.default_rng(2)
+    polys = [rng.normal(size=(50, 4, 2)), rng.normal(size=(30, 6, 2)) * 3,
+             rng.normal(size=(7, 8, 2)) - 5]
+    xy = np.concatenate([p.reshape(-1, 2) for p in polys])
+    lo, hi = _extent(polys)
+    assert lo.tobytes() == xy.min(axis=0).tobytes() and hi.tobytes() == xy.max(axis=0).tobytes()
+    polys[1][3, 2, 1] = np.nan
+    lo, hi = _extent(polys)
+    assert np.isnan(lo[1]) and np.isnan(hi[1]) and lo[0] == xy[:, 0].min()
+
+
+def test_unit_rows_by_row_norms_are_numpys_norm_bit_for_bit():
+    from gridshell.render import painter, ribbons
+
+    rng = np.random.default_rng(9)
+    for shape in [(3,), (1, 3), (2000, 3), (40, 4, 3)]:
+        for scale in (1e-9, 1.0, 1e7):
+            X = rng.normal(size=shape) * scale
+            X.reshape(-1, 3)[:1] = 0.0                     # a zero row stays zero
+            n = np.linalg.norm(X, axis=-1, keepdims=True)
+            want = np.divide(X, n, out=np.zeros_like(X), where=n > 0)
+            for unit in (painter._unit, ribbons._unit):
+                assert unit(X).tobytes() == want.tobytes()
+
+
+def test_grow_polygons_miter_cosine_is_the_summed_product():
+    """_grow_parts' corner cosine written as two products and one addition: grow_polygons of
+    random polygons equals the formula with numpy's sum over the last axis, bit for bit."""
+    from gridshell.render.painter import _grow_parts
+
+    rng = np.random.default_rng(4)
+    P = rng.normal(size=(500, 6, 2))
+    G, N, Nin = _grow_parts(P, 0.3)
+    cos = np.sum(N * Nin, axis=-1, keepdims=True)
+    want = P + 0.3 * (N + Nin) / np.maximum(1.0 + cos, 0.5)
+    assert G.tobytes() == want.tobytes()

@@ -23,13 +23,15 @@ from typing import Any
 
 import numpy as np
 
-from ..strips3d import strip_frames
+from ..strips3d import row_norms, strip_frames
 
 __all__ = ["Camera", "Painter", "grow_polygons", "strip_faces", "strips_faces"]
 
 
 def _unit(X: np.ndarray) -> np.ndarray:
-    n = np.linalg.norm(X, axis=-1, keepdims=True)
+    """Rows ``X (..., 3)`` divided by their lengths (zero rows stay zero); the lengths by
+    :func:`gridshell.strips3d.row_norms`, ``np.linalg.norm``'s numbers."""
+    n = row_norms(X)[..., None]
     return np.divide(X, n, out=np.zeros_like(X), where=n > 0)
 
 
@@ -85,15 +87,25 @@ def strips_faces(axes: list[np.ndarray], normals: list[np.ndarray], width: float
     i0 = np.flatnonzero(seg)
     i1 = i0 + 1
     nm = 0.5 * (N[i0] + N[i1])
-    quads, sides = [], []
+    # the points and corner offsets at both ends of every segment, taken once (the same
+    # numbers: an element-wise sum of rows taken is the rows taken of the sum)
+    P0, P1 = P[i0], P[i1]
+    C0 = [X[i0] for X in corners]
+    C1 = [X[i1] for X in corners]
+    quads = np.empty((8, len(i0), 4, 3))    # group-major, written in place (no stack, concat)
+    sides = np.empty((8, len(i0)))
     for a in range(4):
-        A, B = corners[a], corners[(a + 1) % 4]
-        Mid = 0.5 * (A + B)
-        for X, Y in ((A, Mid), (Mid, B)):
-            quads.append(np.stack([P[i0] + X[i0], P[i0] + Y[i0], P[i1] + Y[i1], P[i1] + X[i1]],
-                                  axis=1))
-            mid = 0.25 * (X[i0] + Y[i0] + X[i1] + Y[i1])
-            sides.append(np.sum(mid * nm, axis=1))
+        b = (a + 1) % 4
+        M0, M1 = 0.5 * (C0[a] + C0[b]), 0.5 * (C1[a] + C1[b])
+        for g, (X0, Y0, X1, Y1) in enumerate(((C0[a], M0, C1[a], M1), (M0, C0[b], M1, C1[b])),
+                                             2 * a):
+            q = quads[g]
+            np.add(P0, X0, out=q[:, 0])
+            np.add(P0, Y0, out=q[:, 1])
+            np.add(P1, Y1, out=q[:, 2])
+            np.add(P1, X1, out=q[:, 3])
+            mid = 0.25 * (X0 + Y0 + X1 + Y1)
+            sides[g] = np.sum(mid * nm, axis=1)
     # (8, S) group-major -> axis by axis, each axis's groups in order
     nseg = sizes - 1
     start = np.concatenate([[0], np.cumsum(nseg)[:-1]]).astype(np.int64)
@@ -101,8 +113,8 @@ def strips_faces(axes: list[np.ndarray], normals: list[np.ndarray], width: float
     within = np.arange(len(lam)) - np.repeat(8 * start, 8 * nseg)
     g, j = within // np.repeat(nseg, 8 * nseg), within % np.repeat(nseg, 8 * nseg)
     order = g * len(i0) + start[lam] + j
-    Q = np.concatenate(quads)[order]
-    return Q, np.concatenate(sides)[order], np.tile(nm, (8, 1))[order]
+    Q = quads.reshape(-1, 4, 3)[order]
+    return Q, sides.reshape(-1)[order], np.tile(nm, (8, 1))[order]
 
 
 @dataclass
@@ -312,7 +324,8 @@ def _grow_parts(P: np.ndarray, d: float) -> tuple[np.ndarray, np.ndarray, np.nda
     s = np.where(area2 >= 0, 1.0, -1.0)[:, None]
     N = np.stack([s * U[..., 1], -s * U[..., 0]], axis=-1)  # outward normal of edge i
     Nin = np.roll(N, 1, axis=1)                              # of the edge into corner i
-    cos = np.sum(N * Nin, axis=-1, keepdims=True)
+    # np.sum(N * Nin, axis=-1) written out: a sum of two terms is one addition either way
+    cos = (N[..., 0] * Nin[..., 0] + N[..., 1] * Nin[..., 1])[..., None]
     return P + d * (N + Nin) / np.maximum(1.0 + cos, 0.5), N, Nin
 
 
@@ -356,4 +369,4 @@ class _PolygonPaths(Sequence):
         if c < 0:
             return self._special[self._local[i]]
         V, codes, template = self._sources[c]
-        return self._make(V[self._local[i]], codes, internals_from=template)
+        return self._make(V[self._local[i]], codes, template)    # internals_from=template
