@@ -116,6 +116,24 @@ def _parse_obj_fast(data: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray] | 
     return V, P, sizes
 
 
+def _xyz_records(vrec: list[bytes]) -> np.ndarray | None:
+    """``(n,3)`` float of the ``v`` records' texts ``vrec``, each exactly three finite numbers;
+    None otherwise (a record of 2 or 4 numbers: the numbers of all records read as one stream
+    would shift into the next vertex). A NaN between records marks where each ends."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            R = np.fromstring(b" nan ".join(vrec) + b" nan", dtype=np.float64, sep=" ")
+        except ValueError:
+            return None
+    if len(R) != 4 * len(vrec):
+        return None
+    R = R.reshape(-1, 4)
+    if not (np.all(np.isnan(R[:, 3])) and np.all(np.isfinite(R[:, :3]))):
+        return None
+    return np.ascontiguousarray(R[:, :3])
+
+
 def _parse_obj_regex(data: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
     """Vertices, padded faces (0-based) and face sizes of a plain OBJ (``v x y z`` and ``f``
     records with positive indices, optionally ``i/t/n``), vectorized: a 200k-triangle file in
@@ -134,11 +152,11 @@ def _parse_obj_regex(data: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray] |
         if b"-" in ftext:
             return None
         try:  # malformed text: the line-by-line parser names it
-            V = np.fromstring(b" ".join(vrec), dtype=np.float64, sep=" ")
             flat = np.fromstring(ftext, dtype=np.int64, sep=" ")
         except ValueError:
             return None
-    if len(V) != 3 * len(vrec) or not np.all(np.isfinite(V)):
+    V = _xyz_records(vrec)
+    if V is None:
         return None
     cuts = np.flatnonzero(flat == 0)
     if len(cuts) != len(frec) - 1:
@@ -194,17 +212,17 @@ def _parse_polylines_regex(data: bytes) -> tuple[np.ndarray, list[np.ndarray]] |
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         try:  # malformed text: the line-by-line parser names it
-            V = np.fromstring(vtext, dtype=np.float64, sep=" ")
             flat = np.fromstring(ltext, dtype=np.int64, sep=" ")
         except ValueError:
             return None
-    if len(V) != 3 * len(vrec):
+    V = _xyz_records(vrec) if vrec else np.zeros((0, 3))
+    if V is None:
         return None
     cuts = np.flatnonzero(flat == 0)
     if len(cuts) != len(lrec) - 1 or np.any(np.diff(np.r_[-1, cuts, len(flat)]) < 2):
         return None
     parts = np.split(flat - 1, cuts)            # each after the first opens with the 0
-    return V.reshape(-1, 3), [parts[0]] + [p[1:] for p in parts[1:]]
+    return V, [parts[0]] + [p[1:] for p in parts[1:]]
 
 
 def _parse_off(path: Path, lines: list[str]) -> tuple[np.ndarray, list[list[int]]]:

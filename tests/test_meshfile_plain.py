@@ -199,3 +199,19 @@ def test_bbox_diagonal_column_by_column_is_the_rows_reduction():
         want = float(np.linalg.norm(V.max(axis=0) - V.min(axis=0)))
         got = bbox_diagonal(V)
         assert got == want or (np.isnan(got) and np.isnan(want))
+
+
+@pytest.mark.parametrize("kind", ["f", "l"])
+def test_records_whose_counts_add_up_are_refused_by_every_path(tmp_path, kind):
+    """``v 0 0 0 1`` then ``v 1 1``: six numbers for two vertices. Read as one stream of
+    numbers (the vectorized parser once did) the 1 of the first record became the second
+    vertex's x, silently; every path now refuses it and the line parser names the record."""
+    from gridshell.meshfile import read_mesh, read_polylines
+
+    text = f"v 0 0 0 1\nv 1 1\nv 0 1 0\nv 1 1 0\n{kind} 1 2 3\n"
+    (tmp_path / "odd.obj").write_text(text)
+    assert _parse_plain(text.encode(), kind.encode()) is None
+    regex = _parse_obj_regex if kind == "f" else _parse_polylines_regex
+    assert regex(text.encode()) is None
+    with pytest.raises(MeshError, match="line 2 .*'v 1 1'"):
+        (read_mesh if kind == "f" else read_polylines)(tmp_path / "odd.obj")
