@@ -182,20 +182,26 @@ def _irregular_mesh(rng, n=5000):
     return V, T
 
 
+def _noisy_wave(rng, m: int):
+    """An m x m quad grid of a wave z = 0.3 sin 2x cos 3y on [-1, 1]^2, points moved by
+    noise of 3 mm."""
+    from gridshell.grid import grid_quads
+
+    t = np.linspace(-1, 1, m)
+    X, Y = np.meshgrid(t, t, indexing="ij")
+    V = np.stack([X, Y, 0.3 * np.sin(2 * X) * np.cos(3 * Y)], -1).reshape(-1, 3)
+    return V + rng.normal(0, 0.003, V.shape), grid_quads(m, m)
+
+
 @pytest.mark.parametrize("case", ["grid", "irregular"])
 @pytest.mark.parametrize("radius", [1, 2, 3])
 def test_principal_curvature_at_some_vertices_is_that_of_the_whole_mesh(case, radius):
-    from gridshell.grid import grid_quads
     from gridshell.igl_adapter import principal_curvature, principal_curvature_at
 
     rng = np.random.default_rng(11 + radius)
     if case == "grid":
         m = 120
-        t = np.linspace(-1, 1, m)
-        X, Y = np.meshgrid(t, t, indexing="ij")
-        V = np.stack([X, Y, 0.3 * np.sin(2 * X) * np.cos(3 * Y)], -1).reshape(-1, 3)
-        V = V + rng.normal(0, 0.003, V.shape)
-        F = grid_quads(m, m)
+        V, F = _noisy_wave(rng, m)
         corners = [0, m - 1, m * m - 1, m * (m - 1), m, 2 * m + 1]
     else:
         V, F = _irregular_mesh(rng)
@@ -228,15 +234,10 @@ def test_principal_curvature_at_one_ring_less_when_the_outer_normals_agree(radiu
     on a mesh folded onto itself near a vertex the guard refuses and the full part is used
     (the same figures again)."""
     import gridshell.igl_adapter as ia
-    from gridshell.grid import grid_quads
 
     rng = np.random.default_rng(7 + radius)
     m = 50
-    t = np.linspace(-1, 1, m)
-    X, Y = np.meshgrid(t, t, indexing="ij")
-    V = np.stack([X, Y, 0.3 * np.sin(2 * X) * np.cos(3 * Y)], -1).reshape(-1, 3)
-    V = V + rng.normal(0, 0.003, V.shape)
-    F = grid_quads(m, m)
+    V, F = _noisy_wave(rng, m)
     picks = rng.choice(np.arange(m * m), 25, replace=False)
     Vt, T, _ = ia.triangulate(V, F)
     assert ia._outer_ring_agrees(Vt, T, picks, max(radius, 2))

@@ -8,7 +8,8 @@ import io
 import numpy as np
 import pytest
 
-from gridshell.render.painter import Camera, Painter, grow_polygons, strip_faces
+from gridshell.render.painter import (Camera, Painter, axis_major_order, grow_polygons,
+                                      strip_faces)
 
 
 def _pixels(draw) -> np.ndarray:
@@ -243,12 +244,7 @@ def _strips_faces_by_groups(axes, normals, width, thickness, tangent):
             quads.append(np.stack([P[i0] + X[i0], P[i0] + Y[i0], P[i1] + Y[i1], P[i1] + X[i1]],
                                   axis=1))
             sides.append(np.sum(0.25 * (X[i0] + Y[i0] + X[i1] + Y[i1]) * nm, axis=1))
-    nseg = sizes - 1
-    start = np.concatenate([[0], np.cumsum(nseg)[:-1]]).astype(np.int64)
-    lam = np.repeat(np.arange(len(sizes)), 8 * nseg)
-    within = np.arange(len(lam)) - np.repeat(8 * start, 8 * nseg)
-    g, j = within // np.repeat(nseg, 8 * nseg), within % np.repeat(nseg, 8 * nseg)
-    order = g * len(i0) + start[lam] + j
+    order = axis_major_order(sizes)     # (the bookkeeping, shared: not what is compared)
     return (np.concatenate(quads)[order], np.concatenate(sides)[order],
             np.tile(nm, (8, 1))[order])
 

@@ -106,15 +106,20 @@ def strips_faces(axes: list[np.ndarray], normals: list[np.ndarray], width: float
             np.add(P1, X1, out=q[:, 3])
             mid = 0.25 * (X0 + Y0 + X1 + Y1)
             sides[g] = np.sum(mid * nm, axis=1)
-    # (8, S) group-major -> axis by axis, each axis's groups in order
-    nseg = sizes - 1
-    start = np.concatenate([[0], np.cumsum(nseg)[:-1]]).astype(np.int64)
-    lam = np.repeat(np.arange(len(sizes)), 8 * nseg)
-    within = np.arange(len(lam)) - np.repeat(8 * start, 8 * nseg)
-    g, j = within // np.repeat(nseg, 8 * nseg), within % np.repeat(nseg, 8 * nseg)
-    order = g * len(i0) + start[lam] + j
+    order = axis_major_order(sizes)
     Q = quads.reshape(-1, 4, 3)[order]
     return Q, sides.reshape(-1)[order], np.tile(nm, (8, 1))[order]
+
+
+def axis_major_order(sizes: np.ndarray) -> np.ndarray:
+    """The rows of 8 group-major arrays of one row per segment of axes of ``sizes`` points
+    (``(8, S)`` flattened) axis by axis instead: each axis's 8 groups in order."""
+    nseg = np.asarray(sizes, dtype=np.int64) - 1
+    start = np.concatenate([[0], np.cumsum(nseg)[:-1]]).astype(np.int64)
+    lam = np.repeat(np.arange(len(nseg)), 8 * nseg)
+    within = np.arange(len(lam)) - np.repeat(8 * start, 8 * nseg)
+    g, j = within // np.repeat(nseg, 8 * nseg), within % np.repeat(nseg, 8 * nseg)
+    return g * int(nseg.sum()) + start[lam] + j
 
 
 @dataclass
