@@ -226,19 +226,22 @@ def _ncp_write(curves: int) -> Callable[[], Any]:
     return lambda: write(out, design, render=True)
 
 
-def _outputs(curves: int) -> Callable[[], Any]:
+def _outputs(p: int | tuple[int, bool]) -> Callable[[], Any]:
     """render.png, report.html and the .3dm of a written NCP bundle (``gridshell render
-    --report --3dm``)."""
+    --report --3dm``); ``p`` the curves per family, or ``(curves, sheets)`` with
+    ``sheets=False`` for a .3dm without the cut sheets and their design check (``--no-sheets``:
+    the content nearest to the row of 2026-11-23, whose .3dm had neither)."""
     from gridshell.export import export_3dm
     from gridshell.api import design_ncp, write
     from gridshell.render.report import write_report
     from gridshell.render.ribbons import render_bundle
 
+    curves, sheets = p if isinstance(p, tuple) else (p, True)
     out = write(_tmpdir() / "ncp", design_ncp(_pseudosphere(), mode="aa", curves=curves))
 
     def run() -> Any:
         render_bundle(out)
-        export_3dm(out, out / "ncp.3dm")
+        export_3dm(out, out / "ncp.3dm", sheets=sheets)
         return write_report(out)
     return run
 
@@ -336,7 +339,8 @@ STAGES: list[Stage] = [
                 capped="design_ncp at 40 curves takes ~74 s to build the input; the write "
                        "grows with the frames' size only; run it with --only ncp_write --full")]),
     Stage("outputs", "render.png + report.html + .3dm of an NCP bundle", _outputs,
-          [Size("paper", 10, "10 curves per family"), Size("4x", 20, "20 curves")]),
+          [Size("paper", 10, "10 curves per family"), Size("4x", 20, "20 curves"),
+           Size("4x-no-sheets", (20, False), "20 curves, .3dm without cut sheets")]),
     Stage("fabrication", "fabrication (fabricate, GG bundle, with plan)", _fabrication,
           [Size("paper", (10, 0.1), "10 lamellae per family, scale 1:10"),
            Size("4x", (20, 0.2), "20 lamellae (4x joints), scale 1:5"),
