@@ -629,9 +629,10 @@ def read_polylines(path: str | os.PathLike) -> list[np.ndarray]:
                 return [V[idx] for idx in lines]
     out = []
     for i, idx in enumerate(lines):
-        idx = np.asarray(idx, dtype=np.int64)
-        if np.any((idx < 0) | (idx >= len(V))):
+        # compared as Python ints: an index past int64 is a missing vertex, not an overflow
+        if not all(0 <= int(j) < len(V) for j in idx):
             raise _corrupt(path, f"polyline {i} refers to missing vertices")
+        idx = np.asarray(idx, dtype=np.int64)
         P = np.asarray(V[idx], dtype=np.float64)
         if not np.all(np.isfinite(P)):
             raise MeshError(f"{path.name}: polyline {i} has "

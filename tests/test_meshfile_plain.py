@@ -215,3 +215,12 @@ def test_records_whose_counts_add_up_are_refused_by_every_path(tmp_path, kind):
     assert regex(text.encode()) is None
     with pytest.raises(MeshError, match="line 2 .*'v 1 1'"):
         (read_mesh if kind == "f" else read_polylines)(tmp_path / "odd.obj")
+
+
+def test_a_polyline_index_past_int64_is_a_missing_vertex(tmp_path):
+    """The line parser's indices are Python ints: one past int64 was a bare OverflowError."""
+    from gridshell.meshfile import read_polylines
+
+    (tmp_path / "big.obj").write_text("v 0 0 0\nv 1 0 0\nvn 0 0 1\nl 1 99999999999999999999999\n")
+    with pytest.raises(MeshError, match="polyline 0 refers to missing vertices"):
+        read_polylines(tmp_path / "big.obj")
