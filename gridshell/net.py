@@ -164,7 +164,7 @@ def carried_axes(net: Net, states: list[np.ndarray] | np.ndarray
 
 def _arclengths(X: np.ndarray) -> np.ndarray:
     """:func:`polyline_arclength` of each polyline ``X[k] (p,3)``: ``(m, p)``, the same sums."""
-    from .strips3d import row_norms
+    from .vectors import row_norms
 
     seg = row_norms(np.diff(X, axis=1))
     return np.concatenate([np.zeros((len(X), 1)), np.cumsum(seg, axis=1)], axis=1)
@@ -201,7 +201,7 @@ def _carry_axis(lam: Lamella, Js: np.ndarray
     if len(X) < 2 or len(js) == 0:
         Xs = np.stack([X + (J[lam.joints[0]] - X[0] if len(js) else 0) for J in Js])
         return Xs, _arclengths(Xs), js, None
-    from .strips3d import row_norms
+    from .vectors import row_norms
 
     X = X[np.concatenate([[True], row_norms(np.diff(X, axis=0)) > 0])]
     s = _arclengths(X[None])[0]                            # polyline_arclength(X)

@@ -339,7 +339,7 @@ def test_joint_normals_of_all_states_at_once_are_state_by_state():
 
 
 def test_row_norms_are_numpys_norms():
-    from gridshell.strips3d import row_norms
+    from gridshell.vectors import row_norms
 
     rng = np.random.default_rng(12)
     for trial in range(200):

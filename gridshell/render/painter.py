@@ -23,16 +23,10 @@ from typing import Any
 
 import numpy as np
 
-from ..strips3d import row_norms, strip_frames
+from ..strips3d import strip_frames
+from ..vectors import unit_rows as _unit
 
 __all__ = ["Camera", "Painter", "grow_polygons", "strip_faces", "strips_faces"]
-
-
-def _unit(X: np.ndarray) -> np.ndarray:
-    """Rows ``X (..., 3)`` divided by their lengths (zero rows stay zero); the lengths by
-    :func:`gridshell.strips3d.row_norms`, ``np.linalg.norm``'s numbers."""
-    n = row_norms(X)[..., None]
-    return np.divide(X, n, out=np.zeros_like(X), where=n > 0)
 
 
 @dataclass(frozen=True)

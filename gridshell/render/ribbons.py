@@ -25,7 +25,8 @@ import numpy as np
 
 from ..atomic import atomic_path
 from ..errors import InputError
-from ..strips3d import TANGENT_KINDS, nearest_vertex_normals, row_norms, strip_frame
+from ..strips3d import TANGENT_KINDS, nearest_vertex_normals, strip_frame
+from ..vectors import row_norms, unit_rows as _unit
 
 __all__ = ["FAMILY_COLOURS", "TANGENT_KINDS", "nearest_vertex_normals",
            "ribbon_polygons", "view_angles", "render_ribbons", "render_bundle"]
@@ -34,13 +35,6 @@ __all__ = ["FAMILY_COLOURS", "TANGENT_KINDS", "nearest_vertex_normals",
 FAMILY_COLOURS: dict[int, tuple[float, float, float]] = {1: (0.13, 0.42, 0.70),
                                                          3: (0.86, 0.35, 0.12)}
 _SURFACE_RGB = (0.80, 0.82, 0.85)
-
-
-def _unit(X: np.ndarray) -> np.ndarray:
-    """Rows ``X (..., 3)`` divided by their lengths (zero rows stay zero); the lengths by
-    :func:`gridshell.strips3d.row_norms`, ``np.linalg.norm``'s numbers."""
-    n = row_norms(X)[..., None]
-    return np.divide(X, n, out=np.zeros_like(X), where=n > 0)
 
 
 def ribbon_polygons(axis: np.ndarray, normals: np.ndarray, width: float,

@@ -33,8 +33,9 @@ from typing import Any, Callable
 import numpy as np
 
 from ...errors import InputError
-from ...strips3d import (is_tangent, nearest_vertex_normals, packed_strip_frames, row_norms,
-                         strip_frames, strip_solid_faces)
+from ...strips3d import (is_tangent, nearest_vertex_normals, packed_strip_frames, strip_frames,
+                         strip_solid_faces)
+from ...vectors import row_norms, unit_rows as _unit
 from ..section import bundle_section
 
 __all__ = ["encode", "decode", "build_scene", "scene_json", "strip_solids_vertices",
@@ -58,11 +59,6 @@ def encode(a: np.ndarray, dtype: str) -> str:
 def decode(text: str, dtype: str) -> np.ndarray:
     """The flat array of :func:`encode`."""
     return np.frombuffer(base64.b64decode(text), dtype=np.dtype(dtype).newbyteorder("<"))
-
-
-def _unit(X: np.ndarray) -> np.ndarray:
-    n = row_norms(X)[..., None]
-    return np.divide(X, n, out=np.zeros_like(X), where=n > 0)
 
 
 def _arc(P: np.ndarray) -> np.ndarray:
