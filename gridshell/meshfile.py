@@ -107,13 +107,20 @@ def _parse_obj_fast(data: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray] | 
     if plain is None:
         return _parse_obj_regex(data)
     V, flat, sizes = plain
+    return V, _padded(flat, sizes), sizes
+
+
+def _padded(flat: np.ndarray, sizes: np.ndarray) -> np.ndarray:
+    """Faces ``(m, k) int64``, 0-based, of the 1-based indices ``flat`` of ``m`` faces of
+    ``sizes`` corners one after the other; a face of fewer than ``k = max(sizes)`` corners
+    padded with -1."""
     k = int(sizes.max())
     if np.all(sizes == k):
-        return V, flat.reshape(-1, k) - 1, sizes
+        return flat.reshape(-1, k) - 1
     P = np.full((len(sizes), k), -1, np.int64)
     P[np.repeat(np.arange(len(sizes)), sizes),
       np.arange(len(flat)) - np.repeat(np.cumsum(sizes) - sizes, sizes)] = flat - 1
-    return V, P, sizes
+    return P
 
 
 def _xyz_records(vrec: list[bytes]) -> np.ndarray | None:
@@ -166,16 +173,7 @@ def _parse_obj_regex(data: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray] |
     sizes = ends - starts
     if len(sizes) == 0 or sizes.min() < 1:
         return None
-    k = int(sizes.max())
-    if np.all(sizes == k):
-        P = flat[flat != 0].reshape(-1, k) - 1
-    else:
-        P = np.full((len(sizes), k), -1, np.int64)
-        col = np.arange(len(flat)) - np.repeat(starts, sizes + 1)[:len(flat)]
-        row = np.repeat(np.arange(len(sizes)), sizes + 1)[:len(flat)]
-        keep = flat != 0
-        P[row[keep], col[keep]] = flat[keep] - 1
-    return V.reshape(-1, 3), P, sizes
+    return V, _padded(flat[flat != 0], sizes), sizes
 
 
 _POLY_OTHER = re.compile(rb"^(?![ \t]*(?:v[ \t]|l[ \t]|#|o[ \t]|g[ \t]|\r?$))", re.M)
