@@ -16,7 +16,6 @@ bends towards the (per-vertex) normal, ``k1 <= k2``.
 """
 from __future__ import annotations
 
-import hashlib
 from typing import Any, Callable, Literal
 
 import igl
@@ -25,7 +24,7 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
 from .errors import InputError, MeshError
-from .recent import Recent
+from .recent import Recent, array_key
 
 __all__ = [
     "ask_closest_points",
@@ -122,21 +121,12 @@ def per_vertex_normals(V: Any, F: np.ndarray | None = None) -> np.ndarray:
 # ----------------------------------------------------------------------------- repeated queries
 
 #: results of the closest-point queries asked with ``reuse=True`` in this process, by the
-#: content of their arrays (:func:`_content`): the same query again (a design verified, then
-#: exported: the joints' and the axes' closest points on surface.obj) is answered without igl.
-#: A few, newest last, of at most 16 MB together. Opt-in: a loop that queries new
-#: points on one large mesh would only pay for the hashing.
+#: content of their arrays (:func:`gridshell.recent.array_key`): the same query again (a
+#: design verified, then exported: the joints' and the axes' closest points on surface.obj)
+#: is answered without igl. A few, newest last, of at most 16 MB together. Opt-in: a loop
+#: that queries new points on one large mesh would only pay for the hashing.
 _QUERIES = Recent(8, copy=lambda v: tuple(a.copy() for a in v),
                   nbytes=lambda v: sum(a.nbytes for a in v), max_bytes=16 << 20)
-
-
-def _content(*arrays: np.ndarray) -> tuple:
-    """A key equal for arrays of equal dtype, shape and bytes (BLAKE2b of the bytes)."""
-    out = []
-    for a in arrays:
-        a = np.ascontiguousarray(a)
-        out.append((a.dtype.str, a.shape, hashlib.blake2b(a.data, digest_size=20).digest()))
-    return tuple(out)
 
 
 def _once(what: str, arrays: tuple[np.ndarray, ...],
@@ -146,7 +136,7 @@ def _once(what: str, arrays: tuple[np.ndarray, ...],
     own copies)."""
     if not reuse:
         return compute()
-    key = (what, _content(*arrays))
+    key = (what, array_key(*arrays))
     hit = _QUERIES.get(key)
     if hit is not None:
         return hit
@@ -165,7 +155,7 @@ def ask_closest_points(Ps: list[np.ndarray], V: Any, F: np.ndarray | None = None
     (tests/test_igl_adapter.py)."""
     Ps = [_points(P) for P in Ps]
     V, T, _ = triangulate(V, F)
-    keys = [("closest", _content(P, V, T)) for P in Ps]
+    keys = [("closest", array_key(P, V, T)) for P in Ps]
     todo = [i for i, key in enumerate(keys) if _QUERIES.get(key) is None]
     if len(todo) < 2:       # nothing to share: the query itself asks igl
         return

@@ -1,12 +1,27 @@
 """A few recent results kept in this process, by key, newest last (least recently used
-dropped first), safe to share between threads: what :func:`gridshell.bundle.read_bundle` read
-and the closest-point queries asked again (:mod:`gridshell.igl_adapter`). Every caller gets
-its own copy of a stored value, so no caller can change what another one gets."""
+dropped first), safe to share between threads: what :func:`gridshell.bundle.read_bundle` read,
+the closest-point queries asked again (:mod:`gridshell.igl_adapter`), a surface's normals and
+search tree (:mod:`gridshell.strips3d`); :func:`array_key`, the key of arrays by content.
+Every caller gets its own copy of a stored value, so no caller can change what another one
+gets."""
 from __future__ import annotations
 
+import hashlib
 import threading
 from collections import OrderedDict
 from typing import Any, Callable, Hashable
+
+import numpy as np
+
+
+def array_key(*arrays: np.ndarray) -> tuple:
+    """A key equal for arrays of equal dtype, shape and bytes (BLAKE2b of the bytes), for the
+    results kept by content."""
+    out = []
+    for a in arrays:
+        a = np.ascontiguousarray(a)
+        out.append((a.dtype.str, a.shape, hashlib.blake2b(a.data, digest_size=20).digest()))
+    return tuple(out)
 
 
 class Recent:

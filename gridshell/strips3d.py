@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from .errors import InputError
-from .recent import Recent
+from .recent import Recent, array_key
 from .vectors import unit_rows as _unit
 
 __all__ = ["TANGENT_KINDS", "is_tangent", "nearest_vertex_normals", "strip_frame",
@@ -60,14 +60,11 @@ def _surface_lookup(V: np.ndarray, F: np.ndarray) -> tuple[np.ndarray, Any]:
     faces ``F`` and a ``cKDTree`` of those vertices; the same objects again for a surface of the
     same content (dtype, shape and bytes of ``V`` and ``F``). Both are read only: the normals
     are not writeable and a query does not change a tree."""
-    import hashlib
-
     from scipy.spatial import cKDTree
 
     from .quadmesh import area_weighted_vertex_normals, unique_ints
 
-    key = tuple((a.dtype.str, a.shape, hashlib.blake2b(np.ascontiguousarray(a).data,
-                                                        digest_size=20).digest()) for a in (V, F))
+    key = array_key(V, F)
     hit = _SURFACES.get(key)
     if hit is not None:
         return hit
