@@ -6,6 +6,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .errors import InputError
+from .vectors import row_norms
 
 
 def polyline_length(P: np.ndarray) -> float:
@@ -19,8 +20,7 @@ def polyline_length(P: np.ndarray) -> float:
 def polyline_arclength(P: np.ndarray) -> np.ndarray:
     """Cumulative arc length ``s (k,)`` at the vertices of a polyline ``P (k,3)``, ``s[0] = 0``."""
     P = np.asarray(P, dtype=float)
-    seg = np.linalg.norm(np.diff(P, axis=0), axis=1)
-    return np.concatenate([[0.0], np.cumsum(seg)])
+    return np.concatenate([[0.0], np.cumsum(row_norms(np.diff(P, axis=0)))])
 
 
 @dataclass
@@ -164,8 +164,6 @@ def carried_axes(net: Net, states: list[np.ndarray] | np.ndarray
 
 def _arclengths(X: np.ndarray) -> np.ndarray:
     """:func:`polyline_arclength` of each polyline ``X[k] (p,3)``: ``(m, p)``, the same sums."""
-    from .vectors import row_norms
-
     seg = row_norms(np.diff(X, axis=1))
     return np.concatenate([np.zeros((len(X), 1)), np.cumsum(seg, axis=1)], axis=1)
 
@@ -201,8 +199,6 @@ def _carry_axis(lam: Lamella, Js: np.ndarray
     if len(X) < 2 or len(js) == 0:
         Xs = np.stack([X + (J[lam.joints[0]] - X[0] if len(js) else 0) for J in Js])
         return Xs, _arclengths(Xs), js, None
-    from .vectors import row_norms
-
     X = X[np.concatenate([[True], row_norms(np.diff(X, axis=0)) > 0])]
     s = _arclengths(X[None])[0]                            # polyline_arclength(X)
     js = np.clip(js, 0.0, s[-1])

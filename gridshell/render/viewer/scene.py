@@ -33,6 +33,7 @@ from typing import Any, Callable
 import numpy as np
 
 from ...errors import InputError
+from ...net import polyline_arclength
 from ...strips3d import (is_tangent, nearest_vertex_normals, packed_strip_frames, strip_frames,
                          strip_solid_faces)
 from ...vectors import row_norms, unit_rows as _unit
@@ -59,10 +60,6 @@ def encode(a: np.ndarray, dtype: str) -> str:
 def decode(text: str, dtype: str) -> np.ndarray:
     """The flat array of :func:`encode`."""
     return np.frombuffer(base64.b64decode(text), dtype=np.dtype(dtype).newbyteorder("<"))
-
-
-def _arc(P: np.ndarray) -> np.ndarray:
-    return np.concatenate([[0.0], np.cumsum(row_norms(np.diff(P, axis=0)))])
 
 
 def _interp_rows(x: np.ndarray, rx: np.ndarray, xp: np.ndarray, rxp: np.ndarray
@@ -307,7 +304,7 @@ def build_scene(bundle_dir: str | os.PathLike) -> dict[str, Any]:
     diag = float(np.linalg.norm(allP.max(axis=0) - allP.min(axis=0))) or 1.0
 
     # axis samples by arc-length fraction, fixed over the states
-    arcs = [_arc(lam.axis) for lam in lams]
+    arcs = [polyline_arclength(lam.axis) for lam in lams]
     fracs, joint_fracs = [], []
     for lam, s in zip(lams, arcs):
         L = float(s[-1])
