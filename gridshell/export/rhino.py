@@ -47,6 +47,7 @@ a design that fails its figures (as ``gridshell fabricate`` refuses it) unless `
 from __future__ import annotations
 
 import os
+from contextlib import nullcontext
 from pathlib import Path
 from typing import Any, Callable
 
@@ -335,6 +336,13 @@ def bundle_to_3dm(bundle, *, name: str = "", units: Any = None, params: Any = No
     bspline : BSplineSurface, optional
         The NURBS surface of the "B-spline surface" layer.
     """
+    return _finish(_body(bundle, name=name, units=units, params=params, bspline=bspline),
+                   layout=layout, params_source=params_source)
+
+
+def _body(bundle, *, name: str, units: Any, params: Any, bspline: Any) -> dict[str, Any]:
+    """The model of :func:`bundle_to_3dm` but its cut sheets and strings, and what
+    :func:`_finish` needs to add them."""
     from fabrication.params import FabParams
 
     units = parse_units(units) if units is not None else bundle_units(bundle)
@@ -382,6 +390,16 @@ def bundle_to_3dm(bundle, *, name: str = "", units: Any = None, params: Any = No
         m.model.Objects.AddPoint(m.r.Point3d(*p), m.again(
             a, "joints", f"J{j}", joint_id=j, lamellae=" ".join(map(str, through.get(j, [])))))
 
+    return {"m": m, "bundle": bundle, "name": name, "params": params, "units": units,
+            "strips": strips, "note": note}
+
+
+def _finish(body: dict[str, Any], *, layout: Any, params_source: str
+            ) -> tuple[Any, dict[str, Any]]:
+    """The cut sheets of ``layout`` and the model's strings added to the model of
+    :func:`_body`: ``(model, info)`` of :func:`bundle_to_3dm`."""
+    m, bundle, name, params = body["m"], body["bundle"], body["name"], body["params"]
+    units, strips, note = body["units"], body["strips"], body["note"]
     sheets = _sheets(m, bundle, layout, params) if layout is not None else []
     strings = {"gridshell.kind": bundle.kind, "gridshell.units": units.name,
                "gridshell.metres_per_unit": f"{units.metres_per_unit:.12g}",
@@ -442,7 +460,8 @@ def write_3dm(bundle, path: str | os.PathLike, *, width: float | None = None,
         Draw the cut sheets of a design that fails its figures too.
     """
     from ..bundle import read_bundle, read_design_json
-    from .fabparams import export_params, plan_sheets
+    from ..aside import Aside
+    from .fabparams import export_params
 
     path = Path(path)
     if path.suffix.lower() != ".3dm":
@@ -460,28 +479,32 @@ def write_3dm(bundle, path: str | os.PathLike, *, width: float | None = None,
     fab, source = export_params(bundle_dir, params, width=width, thickness=thickness,
                                 hole=hole, scale=scale, sheet=sheet)
     notes: list[str] = []
-    layout = None
-    if sheets:
-        from ..verification import design_verdict
-
-        ok, why = design_verdict(bundle_dir if bundle_dir is not None else bundle)
-        if ok or force:
-            _say(progress, "planning the cut sheets")
-            layout, fab = plan_sheets(bundle, fab)
-            if not ok:
-                notes.append(f"cut sheets of a design that fails its figures ({why}), "
-                             "drawn because of force")
-        else:
-            notes.append(f"no cut sheets: the design fails its figures ({why}); force draws "
-                         "them anyway")
     bspline = None
     if bundle_dir is not None and (bundle_dir / "surface.json").is_file():
         from ..bspline import BSplineSurface
 
         bspline = BSplineSurface.load(bundle_dir / "surface.json")
-    _say(progress, f"writing {path}")
-    model, info = bundle_to_3dm(bundle, name=name, units=units, params=fab, layout=layout,
-                                bspline=bspline, params_source=source)
+    judged = bundle_dir if bundle_dir is not None else bundle
+    if sheets:
+        _say(progress, "checking the design's figures and planning the cut sheets")
+    # the cut sheets (design check, then plan) computed aside, in a second process, while this
+    # one builds the rest of the model: the same objects in the same order as one after the
+    # other (gridshell.aside; one process where a fork is not safe)
+    with Aside(_cut_sheets, judged, bundle, fab, force) if sheets else nullcontext() as aside:
+        _say(progress, f"writing {path}")
+        body = _body(bundle, name=name, units=units, params=fab, bspline=bspline)
+        layout = None
+        if aside is not None:
+            ok, why, layout, planned = aside.result()
+            if layout is not None and planned != fab:   # holes became marks: other strips
+                body = _body(bundle, name=name, units=units, params=planned, bspline=bspline)
+            fab = planned
+            if not ok:
+                notes.append(f"cut sheets of a design that fails its figures ({why}), drawn "
+                             "because of force" if layout is not None else
+                             f"no cut sheets: the design fails its figures ({why}); force draws "
+                             "them anyway")
+    model, info = _finish(body, layout=layout, params_source=source)
     if info["note"]:
         notes.append(info["note"])
     with atomic_path(path) as tmp:
@@ -490,6 +513,21 @@ def write_3dm(bundle, path: str | os.PathLike, *, width: float | None = None,
                               "writable")
     info.update(path=str(path), params=fab.to_json(), params_source=source, notes=notes)
     return info
+
+
+def _cut_sheets(judged, bundle, fab, force: bool) -> tuple[bool, str, Any, Any]:
+    """``(ok, why, layout, params)``: the verdict on the design (:func:`gridshell.verification.
+    design_verdict` of ``judged``, its directory or itself) and, if it holds or ``force``, its
+    cut sheets planned (:func:`.fabparams.plan_sheets`; ``layout`` None otherwise) with the
+    parameters the plan used (joints too close for holes become marks)."""
+    from ..verification import design_verdict
+    from .fabparams import plan_sheets
+
+    ok, why = design_verdict(judged)
+    if not (ok or force):
+        return ok, why, None, fab
+    layout, fab = plan_sheets(bundle, fab)
+    return ok, why, layout, fab
 
 
 def export_3dm(bundle, path: str | os.PathLike, **options: Any) -> Path:
