@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import os
 import signal
+import sys
 import threading
 
 import numpy as np
@@ -17,7 +18,16 @@ from gridshell.bundle import write_bundle
 from gridshell.errors import GridshellError, InputError
 from gridshell.export.rhino import write_3dm
 
-forks = pytest.mark.skipif(not can_fork(), reason="no fork here (not Linux, or threads)")
+@pytest.fixture
+def forking():
+    """Skip where :class:`Aside` would not fork (checked when the test runs: another test may
+    have left a thread running)."""
+    if not can_fork():
+        pytest.skip(f"no fork here ({sys.platform}, threads: "
+                    f"{[t.name for t in threading.enumerate()]})")
+
+
+forks = pytest.mark.usefixtures("forking")
 
 
 def _values(n: int, seed: int) -> tuple[np.ndarray, int]:
