@@ -475,3 +475,19 @@ def test_strip_solids_have_only_the_rings_they_need(tmp_path, kind):
     for lam in b.net.lamellae:
         assert len(_points(axes[lam.id].Geometry)) == len(_clean_polyline(lam.axis))
     assert rings < samples / 2
+
+
+def test_joints_too_close_for_holes_become_marks_with_a_note(tmp_path):
+    """At 1:200 the AA case's joints are closer than a hole needs: the cut sheets engrave
+    marks (as ``gridshell fabricate`` does), the strips carry no hole cylinders, and the
+    export says so in its notes instead of changing the joints silently."""
+    d = write_case(tmp_path / "aa", "AA")
+    info = write_3dm(d, tmp_path / "aa.3dm", force=True, scale=0.005)
+    assert info["params"]["joints"] == "marks" and "holes" not in info["layers"]
+    assert any("engraved as marks instead" in n and "1:200" in n for n in info["notes"])
+    _, names, objs = _read(tmp_path / "aa.3dm")
+    assert "holes" not in names
+    roles = {o.Attributes.GetUserString("role") for n in names if n.startswith("sheet ")
+             for o in objs[n]}
+    assert "score" in roles and "hole" not in roles
+    assert not any("marks" in n for n in write_3dm(d, tmp_path / "ok.3dm", force=True)["notes"])

@@ -80,10 +80,11 @@ def export_params(bundle_dir: str | Path | None = None, params: Any = None,
 
 
 def plan_sheets(bundle, params, progress: Callable[[str], None] | None = None):
-    """``(layout, params)``: the parts of ``bundle`` nested on sheets (mm, each sheet's own
-    frame ``[0, W] x [0, H]``), as :func:`fabrication.pipeline.plan_parts` plans them, and the
-    parameters it used (joints too close for holes become marks)."""
+    """``(layout, params, fallback)``: the parts of ``bundle`` nested on sheets (mm, each
+    sheet's own frame ``[0, W] x [0, H]``), as :func:`fabrication.pipeline.plan_parts` plans
+    them, the parameters it used, and ``fallback``: why joints too close for holes became
+    engraved marks (None when they did not)."""
     from fabrication.pipeline import plan_parts
 
     _, layout, info = plan_parts(bundle, params, progress)
-    return layout, info["params"]
+    return layout, info["params"], info["joints_fallback"]

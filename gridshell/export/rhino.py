@@ -495,7 +495,7 @@ def write_3dm(bundle, path: str | os.PathLike, *, width: float | None = None,
         body = _body(bundle, name=name, units=units, params=fab, bspline=bspline)
         layout = None
         if aside is not None:
-            ok, why, layout, planned = aside.result()
+            ok, why, layout, planned, fallback = aside.result()
             if layout is not None and planned != fab:   # holes became marks: other strips
                 body = _body(bundle, name=name, units=units, params=planned, bspline=bspline)
             fab = planned
@@ -504,6 +504,8 @@ def write_3dm(bundle, path: str | os.PathLike, *, width: float | None = None,
                              "because of force" if layout is not None else
                              f"no cut sheets: the design fails its figures ({why}); force draws "
                              "them anyway")
+            if fallback:
+                notes.append(fallback)
     model, info = _finish(body, layout=layout, params_source=source)
     if info["note"]:
         notes.append(info["note"])
@@ -515,19 +517,19 @@ def write_3dm(bundle, path: str | os.PathLike, *, width: float | None = None,
     return info
 
 
-def _cut_sheets(judged, bundle, fab, force: bool) -> tuple[bool, str, Any, Any]:
-    """``(ok, why, layout, params)``: the verdict on the design (:func:`gridshell.verification.
-    design_verdict` of ``judged``, its directory or itself) and, if it holds or ``force``, its
-    cut sheets planned (:func:`.fabparams.plan_sheets`; ``layout`` None otherwise) with the
-    parameters the plan used (joints too close for holes become marks)."""
+def _cut_sheets(judged, bundle, fab, force: bool) -> tuple[bool, str, Any, Any, str | None]:
+    """``(ok, why, layout, params, fallback)``: the verdict on the design
+    (:func:`gridshell.verification.design_verdict` of ``judged``, its directory or itself) and,
+    if it holds or ``force``, its cut sheets planned (:func:`.fabparams.plan_sheets`; ``layout``
+    None otherwise) with the parameters the plan used and why joints too close for holes
+    became marks (``fallback``, None when they did not)."""
     from ..verification import design_verdict
     from .fabparams import plan_sheets
 
     ok, why = design_verdict(judged)
     if not (ok or force):
-        return ok, why, None, fab
-    layout, fab = plan_sheets(bundle, fab)
-    return ok, why, layout, fab
+        return ok, why, None, fab, None
+    return (ok, why, *plan_sheets(bundle, fab))
 
 
 def export_3dm(bundle, path: str | os.PathLike, **options: Any) -> Path:
