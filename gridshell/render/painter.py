@@ -17,6 +17,7 @@ The projection is orthographic, the camera given as matplotlib's ``(elev, azim)`
 """
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -183,10 +184,18 @@ class Painter:
         if coll is not None:
             ax.add_collection(coll, autolim=False)
 
-    def collection(self, transform, dpi: float, linewidth: float = 0.2):
+    def collection(self, transform, dpi: float, linewidth: float = 0.2, *,
+                   agg_only: bool = False):
         """Everything, far to near, as one matplotlib collection in data coordinates drawn
         through ``transform`` (an affine data -> display pixels map, e.g. an axes'
         ``transData``) at ``dpi``; None when there is nothing to draw.
+
+        ``agg_only``: for a figure that only matplotlib's Agg canvas draws, each polygon is
+        handed over as a :class:`_Polygon`, which holds only what Agg reads of a path (its
+        vertices, codes and simplification settings, those of the matplotlib ``Path`` it
+        stands for), made in a fraction of the time of a ``Path``; the same pixels. Otherwise
+        (any backend: some call ``Path`` methods) as matplotlib ``Path`` objects. A collection
+        of one path is always made of ``Path`` objects (matplotlib then measures it).
 
         Each polygon is outlined by a line ``linewidth`` points wide in its edge colour, drawn
         as fills only (Agg's stroke takes as long as the fills; offsets by
@@ -232,8 +241,10 @@ class Painter:
             else:
                 V = _padded_layout(P, pad)
             V = np.concatenate([V, V[:, :1]], axis=1)             # closed: first corner again
+            # what a Path of these vertices would say (the rcParams now): one for all rows
             template = MplPath(V[0], closed=True)
-            sources.append((V, template.codes, template))
+            sources.append((V, _polygon_type(len(template.codes), template.should_simplify,
+                                             template.simplify_threshold)))
         special: list[Any] = []
         if np.any(outlined):
             copies = np.where(outlined, 2, 1)
@@ -258,7 +269,8 @@ class Painter:
             chunk, local = chunk[idx], local[idx]
             chunk[ring], local[ring] = -1, np.arange(len(special))
             face = np.where(ring[:, None], edge[idx], face[idx])
-        paths = _PolygonPaths(sources, chunk, local, special)
+        paths = _PolygonPaths(sources, chunk, local, special,
+                              light=agg_only and len(chunk) > 1 and transform.is_affine)
         coll = PathCollection(paths, facecolors=face, edgecolors="none", linewidths=0.0)
         coll.set_transform(transform)
         return coll
@@ -338,25 +350,52 @@ def grow_polygons(P: np.ndarray, d: float) -> np.ndarray:
     return _grow_parts(P, d)[0]
 
 
-class _PolygonPaths(Sequence):
-    """The closed paths of the drawn polygons made one at a time when asked for (Agg converts
-    them one by one): ``m`` matplotlib ``Path`` objects built and kept at once would cost as
-    much again in the garbage collector's sweeps as in their making. Path ``i`` is polygon
-    ``local[i]`` of ``sources[chunk[i]]`` (closed vertices ``(m_c, n_c, 2)``, their codes and
-    a template path), or where ``chunk[i]`` is -1 the path ``special[local[i]]`` (the
-    outlines)."""
+class _Polygon:
+    """A closed polygon as matplotlib's Agg renderer reads a path of a collection: the
+    attributes ``vertices`` (``(n, 2)`` float, the collection's data coordinates), ``codes``,
+    ``should_simplify`` and ``simplify_threshold`` (those of the matplotlib ``Path`` it stands
+    for; the last three per subclass, :func:`_polygon_type`), nothing else: no ``Path``
+    method can be called on it. Only for a collection that only Agg draws
+    (:meth:`Painter.collection` with ``agg_only``)."""
 
-    def __init__(self, sources: list[tuple[np.ndarray, np.ndarray, Any]], chunk: np.ndarray,
-                 local: np.ndarray, special: list[Any]) -> None:
+    __slots__ = ("vertices",)
+    codes: np.ndarray
+    should_simplify: bool
+    simplify_threshold: float
+
+
+@functools.lru_cache(maxsize=16)
+def _polygon_type(n: int, should_simplify: bool, simplify_threshold: float) -> type:
+    """The :class:`_Polygon` of ``n`` vertices (the last one closing it: the codes of a
+    ``Path(..., closed=True)``, read only) with these simplification settings."""
+    from matplotlib.path import Path as MplPath
+
+    codes = np.full(n, MplPath.LINETO, dtype=MplPath.code_type)
+    codes[0], codes[-1] = MplPath.MOVETO, MplPath.CLOSEPOLY
+    codes.flags.writeable = False
+    return type("_Polygon", (_Polygon,), {"__slots__": (), "codes": codes,
+                                          "should_simplify": bool(should_simplify),
+                                          "simplify_threshold": float(simplify_threshold)})
+
+
+class _PolygonPaths(Sequence):
+    """The paths of the drawn polygons, made one at a time when asked for (Agg converts them
+    one by one): ``m`` path objects made and kept at once would cost as much again in the
+    garbage collector's sweeps as in their making. Path ``i`` is polygon ``local[i]`` of
+    ``sources[chunk[i]]`` (closed vertices ``(m_c, n_c, 2)`` and their :func:`_polygon_type`):
+    that :class:`_Polygon` when ``light``, else a matplotlib ``Path`` of the same vertices and
+    codes; where ``chunk[i]`` is -1 the path ``special[local[i]]`` (the outlines)."""
+
+    def __init__(self, sources: list[tuple[np.ndarray, type]], chunk: np.ndarray,
+                 local: np.ndarray, special: list[Any], light: bool) -> None:
         from matplotlib.path import Path as MplPath
 
         self._sources = sources
         self._chunk = chunk.tolist()
         self._local = local.tolist()
         self._special = special
-        # what PolyCollection uses (a private matplotlib method, as before: the public
-        # constructor checks and reads rcParams for each of the ~35k paths)
-        self._make = MplPath._fast_from_codes_and_verts
+        self._light = light
+        self._path = MplPath
 
     def __len__(self) -> int:
         return len(self._chunk)
@@ -367,5 +406,9 @@ class _PolygonPaths(Sequence):
         c = self._chunk[i]
         if c < 0:
             return self._special[self._local[i]]
-        V, codes, template = self._sources[c]
-        return self._make(V[self._local[i]], codes, template)    # internals_from=template
+        V, kind = self._sources[c]
+        if self._light:
+            p = kind()
+            p.vertices = V[self._local[i]]
+            return p
+        return self._path(V[self._local[i]], kind.codes)
