@@ -235,12 +235,12 @@ class Painter:
         sources = []
         for c, (P, s0) in enumerate(zip(self.polys, starts)):
             pad = kmax - P.shape[1]
-            if linewidth > 0:
+            if linewidth > 0:       # closed: the first corner again at the end
                 V = _grow_as_padded(P, M, Minv_T, half_px, pad,
                                     ~out_of[s0:s0 + len(P)])
             else:
                 V = _padded_layout(P, pad)
-            V = np.concatenate([V, V[:, :1]], axis=1)             # closed: first corner again
+                V = np.concatenate([V, V[:, :1]], axis=1)
             # what a Path of these vertices would say (the rcParams now): one for all rows
             template = MplPath(V[0], closed=True)
             sources.append((V, _polygon_type(len(template.codes), template.should_simplify,
@@ -296,21 +296,38 @@ def _grow_as_padded(P: np.ndarray, M: np.ndarray, Minv_T: np.ndarray, half_px: f
     linear data -> pixel map, ``Minv_T`` its inverse transposed), as :func:`grow_polygons`
     grows the padded polygons, the same numbers with at most two copies of the last corner:
     padded, the last corner moves along the edge before it only, its last copy along the
-    closing edge only and copies between stay (:func:`_padded_layout` order)."""
+    closing edge only and copies between stay (:func:`_padded_layout` order); closed, i.e.
+    with the first corner again at the end ``(m, k + min(pad, 2) + 1, 2)``.
+
+    Each number is that of the padded arrays' formula ``Pp + (G - Xp) Minv_T half_px`` (``G``
+    the padded growth, ``Xp`` the padded pixel corners), computed in place into the one
+    output (no padded copies of ``G``, ``X`` and ``P``, no closing copy)."""
+    m, k = P.shape[:2]
+    kk = k + min(pad, 2)
     X = _linear(P, M.T)
     G, N, Nin = _grow_parts(X, 1.0)
+    D = np.empty((m, kk, 2))                 # G - Xp
+    np.subtract(G, X, out=D[:, :k])
     if pad:
         last = X[:, -1:]
-        moved = [G[:, :-1], last + 1.0 * Nin[:, -1:]]
+        np.subtract(last + Nin[:, -1:], last, out=D[:, k - 1:k])
         if pad >= 2:
-            moved.append(last)
-        G = np.concatenate(moved + [last + 1.0 * N[:, -1:]], axis=1)
-        X = _padded_layout(X, pad)
-    out = _linear(G - X, Minv_T) * half_px
-    Pp = _padded_layout(P, pad)
-    if grow.all():
-        return Pp + out
-    return np.where(grow[:, None, None], Pp + out, Pp)
+            np.subtract(last, last, out=D[:, k:k + 1])
+        np.subtract(last + N[:, -1:], last, out=D[:, kk - 1:kk])
+    if Minv_T[0, 1] == 0.0 and Minv_T[1, 0] == 0.0:     # _linear, in place
+        np.multiply(D, np.diag(Minv_T), out=D)
+    else:
+        D = D @ Minv_T
+    D *= half_px
+    V = np.empty((m, kk + 1, 2))
+    np.add(P, D[:, :k], out=V[:, :k])        # Pp + out
+    np.add(P[:, -1:], D[:, k:], out=V[:, k:kk])
+    if not grow.all():
+        keep = ~grow
+        V[keep, :k] = P[keep]
+        V[keep, k:kk] = P[keep, -1:]
+    V[:, kk] = V[:, 0]
+    return V
 
 
 def _linear(P: np.ndarray, A: np.ndarray) -> np.ndarray:
@@ -327,17 +344,23 @@ def _grow_parts(P: np.ndarray, d: float) -> tuple[np.ndarray, np.ndarray, np.nda
     """:func:`grow_polygons` of ``P (m, k, 2)`` and the outward unit normals of the edge out
     of each corner and of the edge into it ``(m, k, 2)``."""
     P = np.asarray(P, float)
-    E = np.roll(P, -1, axis=1) - P                      # edge i runs from corner i to i + 1
+    Pn = np.roll(P, -1, axis=1)                         # corner i + 1 at i
+    E = Pn - P                                          # edge i runs from corner i to i + 1
     L = np.hypot(E[..., 0], E[..., 1])[..., None]
     U = np.divide(E, L, out=np.zeros_like(E), where=L > 0)
     x, y = P[..., 0], P[..., 1]
-    area2 = np.sum(x * np.roll(y, -1, axis=1) - np.roll(x, -1, axis=1) * y, axis=1)
+    area2 = np.sum(x * Pn[..., 1] - Pn[..., 0] * y, axis=1)
     s = np.where(area2 >= 0, 1.0, -1.0)[:, None]
-    N = np.stack([s * U[..., 1], -s * U[..., 0]], axis=-1)  # outward normal of edge i
+    N = np.empty_like(U)                                # outward normal of edge i
+    np.multiply(s, U[..., 1], out=N[..., 0])
+    np.multiply(-s, U[..., 0], out=N[..., 1])
     Nin = np.roll(N, 1, axis=1)                              # of the edge into corner i
     # np.sum(N * Nin, axis=-1) written out: a sum of two terms is one addition either way
     cos = (N[..., 0] * Nin[..., 0] + N[..., 1] * Nin[..., 1])[..., None]
-    return P + d * (N + Nin) / np.maximum(1.0 + cos, 0.5), N, Nin
+    move = N + Nin
+    if d != 1.0:                      # (a product by 1 is the number itself)
+        move = d * move
+    return P + move / np.maximum(1.0 + cos, 0.5), N, Nin
 
 
 def grow_polygons(P: np.ndarray, d: float) -> np.ndarray:
