@@ -363,3 +363,38 @@ def test_grow_as_padded_in_place_is_the_padded_formula_bit_for_bit(pad):
         for d in (1.0, 0.3, -2.0):
             for got, want in zip(_grow_parts(P, d), _grow_parts_with_copies(P, d)):
                 assert got.tobytes() == want.tobytes()
+
+
+def test_outline_rings_are_each_rings_concatenation_bit_for_bit():
+    """The outlines (rings round polygons whose edge colour is not their face colour) built
+    in one array: each ring the vertices of its own concatenation (grown polygon, its first
+    corner, the shrunk one reversed, its last corner), bit for bit, as matplotlib Paths."""
+    from matplotlib.figure import Figure
+    from matplotlib.path import Path as MplPath
+
+    rng = np.random.default_rng(12)
+    painter = Painter(Camera(35.0, -50.0))
+    r, u, _ = painter.camera.basis()
+    quad = rng.uniform(-1, 1, (30, 1, 3)) + rng.uniform(-0.2, 0.2, (30, 4, 3))
+    grey = np.column_stack([rng.uniform(0.3, 1, (30, 3)), np.ones(30)])
+    painter.add(quad, grey, grey)
+    ring = np.linspace(0, 2 * np.pi, 9)[:-1]
+    J = rng.uniform(-1, 1, (12, 3))
+    dots = J[:, None] + 0.06 * (np.cos(ring)[None, :, None] * r + np.sin(ring)[None, :, None] * u)
+    painter.add(dots, np.array([0.1, 0.1, 0.1, 1.0]), np.array([0.0, 0.0, 0.0, 1.0]), 0.02)
+    fig = Figure(figsize=(4, 3), dpi=100)
+    ax = fig.add_axes((0, 0, 1, 1))
+    ax.set_xlim(-1.5, 1.5)
+    ax.set_ylim(-1.2, 1.2)
+    for agg_only in (True, False):
+        paths = painter.collection(ax.transData, fig.dpi, 0.2, agg_only=agg_only).get_paths()
+        rings = [paths[i] for i in range(len(paths)) if len(paths[i].codes) == 18]
+        assert len(rings) == 12 and all(isinstance(p, MplPath) for p in rings)
+        P, face, edge = painter.sorted_polygons()
+        Po = P[~np.all(face == edge, axis=1)]
+        M = ax.transData.get_matrix()[:2, :2]
+        X = Po @ M.T
+        out = (grow_polygons(X, 1.0) - X) @ np.linalg.inv(M).T * (0.5 * 0.2 * 100 / 72.0)
+        for path, p, o in zip(rings, Po, out):
+            want = np.concatenate([p + o, p[:1] + o[:1], (p - o)[::-1], p[-1:] - o[-1:]])
+            assert path.vertices.tobytes() == want.tobytes()

@@ -262,10 +262,13 @@ class Painter:
             out = (grow_polygons(X, 1.0) - X) @ Minv_T * half_px   # outward
             loop = [MplPath.MOVETO] + [MplPath.LINETO] * (kmax - 1) + [MplPath.CLOSEPOLY]
             ring_codes = np.array(loop + loop, dtype=MplPath.code_type)
-            # each outline: the grown polygon and, reversed, the shrunk one (a hole)
-            special = [MplPath(np.concatenate([p + o, p[:1] + o[:1], (p - o)[::-1],
-                                               p[-1:] - o[-1:]]), ring_codes)
-                       for p, o in zip(Po, out)]
+            # each outline: the grown polygon and, reversed, the shrunk one (a hole), all
+            # rings in one array (the numbers of each ring's own concatenation)
+            grown, shrunk = Po + out, Po - out
+            R = np.empty((len(Po), 2 * kmax + 2, 2))
+            R[:, :kmax], R[:, kmax] = grown, grown[:, 0]
+            R[:, kmax + 1:-1], R[:, -1] = shrunk[:, ::-1], shrunk[:, -1]
+            special = [MplPath(r, ring_codes) for r in R]
             chunk, local = chunk[idx], local[idx]
             chunk[ring], local[ring] = -1, np.arange(len(special))
             face = np.where(ring[:, None], edge[idx], face[idx])
