@@ -196,3 +196,30 @@ def test_light_polygons_draw_to_a_png_buffer_too():
     rng.bit_generator.state = state
     b = draw(False)
     assert a.std() > 10 and np.array_equal(a, b)
+
+
+def test_light_paths_index_as_the_paths():
+    """The light sequence gives, index for index (negative ones and slices too), the vertices
+    and codes of the Path sequence, and the outlines themselves."""
+    from matplotlib.path import Path as MplPath
+
+    from gridshell.render.painter import _LightPolygonPaths, _PolygonPaths
+
+    rng = np.random.default_rng(1)
+    sources = [(rng.normal(size=(5, 5, 2)), _polygon_type(5, False, 1 / 9)),
+               (rng.normal(size=(3, 9, 2)), _polygon_type(9, False, 1 / 9))]
+    chunk = np.array([1, 0, -1, 0, 1, 0, 0, -1, 1, 0])
+    local = np.array([0, 0, 0, 1, 1, 2, 3, 1, 2, 4])
+    special = [MplPath(rng.normal(size=(6, 2))), MplPath(rng.normal(size=(7, 2)))]
+    light = _LightPolygonPaths(sources, chunk, local, special)
+    paths = _PolygonPaths(sources, chunk, local, special)
+    assert len(light) == len(paths) == 10
+    for i in list(range(-10, 10)):
+        a, b = light[i], paths[i]
+        assert isinstance(a, _Polygon) == (chunk[i] >= 0) and isinstance(b, MplPath)
+        assert np.array_equal(a.vertices, b.vertices) and np.array_equal(a.codes, b.codes)
+        assert (a is b) == (chunk[i] < 0)
+    for a, b in zip(light[1:9:3], paths[1:9:3]):
+        assert np.array_equal(a.vertices, b.vertices)
+    with pytest.raises(IndexError):
+        light[10]

@@ -272,8 +272,8 @@ class Painter:
             chunk, local = chunk[idx], local[idx]
             chunk[ring], local[ring] = -1, np.arange(len(special))
             face = np.where(ring[:, None], edge[idx], face[idx])
-        paths = _PolygonPaths(sources, chunk, local, special,
-                              light=agg_only and len(chunk) > 1 and transform.is_affine)
+        light = agg_only and len(chunk) > 1 and transform.is_affine
+        paths = (_LightPolygonPaths if light else _PolygonPaths)(sources, chunk, local, special)
         coll = PathCollection(paths, facecolors=face, edgecolors="none", linewidths=0.0)
         coll.set_transform(transform)
         return coll
@@ -408,19 +408,19 @@ class _PolygonPaths(Sequence):
     """The paths of the drawn polygons, made one at a time when asked for (Agg converts them
     one by one): ``m`` path objects made and kept at once would cost as much again in the
     garbage collector's sweeps as in their making. Path ``i`` is polygon ``local[i]`` of
-    ``sources[chunk[i]]`` (closed vertices ``(m_c, n_c, 2)`` and their :func:`_polygon_type`):
-    that :class:`_Polygon` when ``light``, else a matplotlib ``Path`` of the same vertices and
-    codes; where ``chunk[i]`` is -1 the path ``special[local[i]]`` (the outlines)."""
+    ``sources[chunk[i]]`` (closed vertices ``(m_c, n_c, 2)`` and their :func:`_polygon_type`)
+    as a matplotlib ``Path`` of those vertices and codes (:class:`_LightPolygonPaths`: as
+    that :class:`_Polygon`); where ``chunk[i]`` is -1 the path ``special[local[i]]`` (the
+    outlines)."""
 
     def __init__(self, sources: list[tuple[np.ndarray, type]], chunk: np.ndarray,
-                 local: np.ndarray, special: list[Any], light: bool) -> None:
+                 local: np.ndarray, special: list[Any]) -> None:
         from matplotlib.path import Path as MplPath
 
         self._sources = sources
         self._chunk = chunk.tolist()
         self._local = local.tolist()
         self._special = special
-        self._light = light
         self._path = MplPath
 
     def __len__(self) -> int:
@@ -433,8 +433,19 @@ class _PolygonPaths(Sequence):
         if c < 0:
             return self._special[self._local[i]]
         V, kind = self._sources[c]
-        if self._light:
+        return self._path(V[self._local[i]], kind.codes)
+
+
+class _LightPolygonPaths(_PolygonPaths):
+    """:class:`_PolygonPaths` with each polygon a :class:`_Polygon` (the path of a polygon
+    asked for by its index: the ~35k calls from Agg take this one test; anything else, as
+    a slice or an outline, as :class:`_PolygonPaths` makes it)."""
+
+    def __getitem__(self, i):
+        c = self._chunk[i]
+        if c.__class__ is int and c >= 0:
+            V, kind = self._sources[c]
             p = kind()
             p.vertices = V[self._local[i]]
             return p
-        return self._path(V[self._local[i]], kind.codes)
+        return super().__getitem__(i)
