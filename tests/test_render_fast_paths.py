@@ -302,3 +302,99 @@ def test_grow_polygons_miter_cosine_is_the_summed_product():
     cos = np.sum(N * Nin, axis=-1, keepdims=True)
     want = P + 0.3 * (N + Nin) / np.maximum(1.0 + cos, 0.5)
     assert G.tobytes() == want.tobytes()
+
+
+def _grow_parts_with_copies(P, d):
+    """_grow_parts as it was written first: rolled copies of each coordinate, the normals
+    stacked, the move multiplied by ``d`` whatever it is."""
+    E = np.roll(P, -1, axis=1) - P
+    L = np.hypot(E[..., 0], E[..., 1])[..., None]
+    U = np.divide(E, L, out=np.zeros_like(E), where=L > 0)
+    x, y = P[..., 0], P[..., 1]
+    area2 = np.sum(x * np.roll(y, -1, axis=1) - np.roll(x, -1, axis=1) * y, axis=1)
+    s = np.where(area2 >= 0, 1.0, -1.0)[:, None]
+    N = np.stack([s * U[..., 1], -s * U[..., 0]], axis=-1)
+    Nin = np.roll(N, 1, axis=1)
+    cos = (N[..., 0] * Nin[..., 0] + N[..., 1] * Nin[..., 1])[..., None]
+    return P + d * (N + Nin) / np.maximum(1.0 + cos, 0.5), N, Nin
+
+
+def _grow_as_padded_with_copies(P, M, Minv_T, half_px, pad, grow):
+    """_grow_as_padded as it was written first: the growth, the pixel corners and the
+    polygons padded as arrays, the result closed by a concatenation."""
+    from gridshell.render.painter import _linear, _padded_layout
+
+    X = _linear(P, M.T)
+    G, N, Nin = _grow_parts_with_copies(X, 1.0)
+    if pad:
+        last = X[:, -1:]
+        moved = [G[:, :-1], last + 1.0 * Nin[:, -1:]]
+        if pad >= 2:
+            moved.append(last)
+        G = np.concatenate(moved + [last + 1.0 * N[:, -1:]], axis=1)
+        X = _padded_layout(X, pad)
+    out = _linear(G - X, Minv_T) * half_px
+    Pp = _padded_layout(P, pad)
+    V = Pp + out if grow.all() else np.where(grow[:, None, None], Pp + out, Pp)
+    return np.concatenate([V, V[:, :1]], axis=1)
+
+
+@pytest.mark.parametrize("pad", [0, 1, 2, 4])
+def test_grow_as_padded_in_place_is_the_padded_formula_bit_for_bit(pad):
+    """The growth written into one closed output (no padded copies, no roll per coordinate,
+    no product by 1): the numbers of the padded arrays' formula, bit for bit, for every
+    padding, grown or not, a diagonal or a general pixel map, degenerate polygons too."""
+    from gridshell.render.painter import _grow_as_padded, _grow_parts
+
+    rng = np.random.default_rng(pad)
+    for k in (3, 4, 8):
+        P = rng.normal(size=(400, k, 2)) * 10.0 ** rng.integers(-3, 3, (400, 1, 1))
+        P[:20, 1] = P[:20, 0]                        # a zero-length edge
+        P[20:40] = P[20:40, :1]                      # a polygon that is one point
+        P[40:60, 2:] = P[40:60, 1:2]                 # corners repeated at the end
+        for M in (np.diag([779.3523568869717, 779.3523568869716]),
+                  np.array([[512.0, 3.5], [-2.25, 498.0]])):
+            Minv_T = np.linalg.inv(M).T
+            for grow in (np.ones(400, bool), rng.uniform(size=400) < 0.7,
+                         np.zeros(400, bool)):
+                got = _grow_as_padded(P, M, Minv_T, 0.1389, pad, grow)
+                want = _grow_as_padded_with_copies(P, M, Minv_T, 0.1389, pad, grow)
+                assert got.shape == want.shape and got.tobytes() == want.tobytes()
+        for d in (1.0, 0.3, -2.0):
+            for got, want in zip(_grow_parts(P, d), _grow_parts_with_copies(P, d)):
+                assert got.tobytes() == want.tobytes()
+
+
+def test_outline_rings_are_each_rings_concatenation_bit_for_bit():
+    """The outlines (rings round polygons whose edge colour is not their face colour) built
+    in one array: each ring the vertices of its own concatenation (grown polygon, its first
+    corner, the shrunk one reversed, its last corner), bit for bit, as matplotlib Paths."""
+    from matplotlib.figure import Figure
+    from matplotlib.path import Path as MplPath
+
+    rng = np.random.default_rng(12)
+    painter = Painter(Camera(35.0, -50.0))
+    r, u, _ = painter.camera.basis()
+    quad = rng.uniform(-1, 1, (30, 1, 3)) + rng.uniform(-0.2, 0.2, (30, 4, 3))
+    grey = np.column_stack([rng.uniform(0.3, 1, (30, 3)), np.ones(30)])
+    painter.add(quad, grey, grey)
+    ring = np.linspace(0, 2 * np.pi, 9)[:-1]
+    J = rng.uniform(-1, 1, (12, 3))
+    dots = J[:, None] + 0.06 * (np.cos(ring)[None, :, None] * r + np.sin(ring)[None, :, None] * u)
+    painter.add(dots, np.array([0.1, 0.1, 0.1, 1.0]), np.array([0.0, 0.0, 0.0, 1.0]), 0.02)
+    fig = Figure(figsize=(4, 3), dpi=100)
+    ax = fig.add_axes((0, 0, 1, 1))
+    ax.set_xlim(-1.5, 1.5)
+    ax.set_ylim(-1.2, 1.2)
+    for agg_only in (True, False):
+        paths = painter.collection(ax.transData, fig.dpi, 0.2, agg_only=agg_only).get_paths()
+        rings = [paths[i] for i in range(len(paths)) if len(paths[i].codes) == 18]
+        assert len(rings) == 12 and all(isinstance(p, MplPath) for p in rings)
+        P, face, edge = painter.sorted_polygons()
+        Po = P[~np.all(face == edge, axis=1)]
+        M = ax.transData.get_matrix()[:2, :2]
+        X = Po @ M.T
+        out = (grow_polygons(X, 1.0) - X) @ np.linalg.inv(M).T * (0.5 * 0.2 * 100 / 72.0)
+        for path, p, o in zip(rings, Po, out):
+            want = np.concatenate([p + o, p[:1] + o[:1], (p - o)[::-1], p[-1:] - o[-1:]])
+            assert path.vertices.tobytes() == want.tobytes()

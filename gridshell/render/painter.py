@@ -17,6 +17,7 @@ The projection is orthographic, the camera given as matplotlib's ``(elev, azim)`
 """
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -183,10 +184,18 @@ class Painter:
         if coll is not None:
             ax.add_collection(coll, autolim=False)
 
-    def collection(self, transform, dpi: float, linewidth: float = 0.2):
+    def collection(self, transform, dpi: float, linewidth: float = 0.2, *,
+                   agg_only: bool = False):
         """Everything, far to near, as one matplotlib collection in data coordinates drawn
         through ``transform`` (an affine data -> display pixels map, e.g. an axes'
         ``transData``) at ``dpi``; None when there is nothing to draw.
+
+        ``agg_only``: for a figure that only matplotlib's Agg canvas draws, each polygon is
+        handed over as a :class:`_Polygon`, which holds only what Agg reads of a path (its
+        vertices, codes and simplification settings, those of the matplotlib ``Path`` it
+        stands for), made in a fraction of the time of a ``Path``; the same pixels. Otherwise
+        (any backend: some call ``Path`` methods) as matplotlib ``Path`` objects. A collection
+        of one path is always made of ``Path`` objects (matplotlib then measures it).
 
         Each polygon is outlined by a line ``linewidth`` points wide in its edge colour, drawn
         as fills only (Agg's stroke takes as long as the fills; offsets by
@@ -226,14 +235,16 @@ class Painter:
         sources = []
         for c, (P, s0) in enumerate(zip(self.polys, starts)):
             pad = kmax - P.shape[1]
-            if linewidth > 0:
+            if linewidth > 0:       # closed: the first corner again at the end
                 V = _grow_as_padded(P, M, Minv_T, half_px, pad,
                                     ~out_of[s0:s0 + len(P)])
             else:
                 V = _padded_layout(P, pad)
-            V = np.concatenate([V, V[:, :1]], axis=1)             # closed: first corner again
+                V = np.concatenate([V, V[:, :1]], axis=1)
+            # what a Path of these vertices would say (the rcParams now): one for all rows
             template = MplPath(V[0], closed=True)
-            sources.append((V, template.codes, template))
+            sources.append((V, _polygon_type(len(template.codes), template.should_simplify,
+                                             template.simplify_threshold)))
         special: list[Any] = []
         if np.any(outlined):
             copies = np.where(outlined, 2, 1)
@@ -251,14 +262,18 @@ class Painter:
             out = (grow_polygons(X, 1.0) - X) @ Minv_T * half_px   # outward
             loop = [MplPath.MOVETO] + [MplPath.LINETO] * (kmax - 1) + [MplPath.CLOSEPOLY]
             ring_codes = np.array(loop + loop, dtype=MplPath.code_type)
-            # each outline: the grown polygon and, reversed, the shrunk one (a hole)
-            special = [MplPath(np.concatenate([p + o, p[:1] + o[:1], (p - o)[::-1],
-                                               p[-1:] - o[-1:]]), ring_codes)
-                       for p, o in zip(Po, out)]
+            # each outline: the grown polygon and, reversed, the shrunk one (a hole), all
+            # rings in one array (the numbers of each ring's own concatenation)
+            grown, shrunk = Po + out, Po - out
+            R = np.empty((len(Po), 2 * kmax + 2, 2))
+            R[:, :kmax], R[:, kmax] = grown, grown[:, 0]
+            R[:, kmax + 1:-1], R[:, -1] = shrunk[:, ::-1], shrunk[:, -1]
+            special = [MplPath(r, ring_codes) for r in R]
             chunk, local = chunk[idx], local[idx]
             chunk[ring], local[ring] = -1, np.arange(len(special))
             face = np.where(ring[:, None], edge[idx], face[idx])
-        paths = _PolygonPaths(sources, chunk, local, special)
+        light = agg_only and len(chunk) > 1 and transform.is_affine
+        paths = (_LightPolygonPaths if light else _PolygonPaths)(sources, chunk, local, special)
         coll = PathCollection(paths, facecolors=face, edgecolors="none", linewidths=0.0)
         coll.set_transform(transform)
         return coll
@@ -284,21 +299,38 @@ def _grow_as_padded(P: np.ndarray, M: np.ndarray, Minv_T: np.ndarray, half_px: f
     linear data -> pixel map, ``Minv_T`` its inverse transposed), as :func:`grow_polygons`
     grows the padded polygons, the same numbers with at most two copies of the last corner:
     padded, the last corner moves along the edge before it only, its last copy along the
-    closing edge only and copies between stay (:func:`_padded_layout` order)."""
+    closing edge only and copies between stay (:func:`_padded_layout` order); closed, i.e.
+    with the first corner again at the end ``(m, k + min(pad, 2) + 1, 2)``.
+
+    Each number is that of the padded arrays' formula ``Pp + (G - Xp) Minv_T half_px`` (``G``
+    the padded growth, ``Xp`` the padded pixel corners), computed in place into the one
+    output (no padded copies of ``G``, ``X`` and ``P``, no closing copy)."""
+    m, k = P.shape[:2]
+    kk = k + min(pad, 2)
     X = _linear(P, M.T)
     G, N, Nin = _grow_parts(X, 1.0)
+    D = np.empty((m, kk, 2))                 # G - Xp
+    np.subtract(G, X, out=D[:, :k])
     if pad:
         last = X[:, -1:]
-        moved = [G[:, :-1], last + 1.0 * Nin[:, -1:]]
+        np.subtract(last + Nin[:, -1:], last, out=D[:, k - 1:k])
         if pad >= 2:
-            moved.append(last)
-        G = np.concatenate(moved + [last + 1.0 * N[:, -1:]], axis=1)
-        X = _padded_layout(X, pad)
-    out = _linear(G - X, Minv_T) * half_px
-    Pp = _padded_layout(P, pad)
-    if grow.all():
-        return Pp + out
-    return np.where(grow[:, None, None], Pp + out, Pp)
+            np.subtract(last, last, out=D[:, k:k + 1])
+        np.subtract(last + N[:, -1:], last, out=D[:, kk - 1:kk])
+    if Minv_T[0, 1] == 0.0 and Minv_T[1, 0] == 0.0:     # _linear, in place
+        np.multiply(D, np.diag(Minv_T), out=D)
+    else:
+        D = D @ Minv_T
+    D *= half_px
+    V = np.empty((m, kk + 1, 2))
+    np.add(P, D[:, :k], out=V[:, :k])        # Pp + out
+    np.add(P[:, -1:], D[:, k:], out=V[:, k:kk])
+    if not grow.all():
+        keep = ~grow
+        V[keep, :k] = P[keep]
+        V[keep, k:kk] = P[keep, -1:]
+    V[:, kk] = V[:, 0]
+    return V
 
 
 def _linear(P: np.ndarray, A: np.ndarray) -> np.ndarray:
@@ -315,17 +347,23 @@ def _grow_parts(P: np.ndarray, d: float) -> tuple[np.ndarray, np.ndarray, np.nda
     """:func:`grow_polygons` of ``P (m, k, 2)`` and the outward unit normals of the edge out
     of each corner and of the edge into it ``(m, k, 2)``."""
     P = np.asarray(P, float)
-    E = np.roll(P, -1, axis=1) - P                      # edge i runs from corner i to i + 1
+    Pn = np.roll(P, -1, axis=1)                         # corner i + 1 at i
+    E = Pn - P                                          # edge i runs from corner i to i + 1
     L = np.hypot(E[..., 0], E[..., 1])[..., None]
     U = np.divide(E, L, out=np.zeros_like(E), where=L > 0)
     x, y = P[..., 0], P[..., 1]
-    area2 = np.sum(x * np.roll(y, -1, axis=1) - np.roll(x, -1, axis=1) * y, axis=1)
+    area2 = np.sum(x * Pn[..., 1] - Pn[..., 0] * y, axis=1)
     s = np.where(area2 >= 0, 1.0, -1.0)[:, None]
-    N = np.stack([s * U[..., 1], -s * U[..., 0]], axis=-1)  # outward normal of edge i
+    N = np.empty_like(U)                                # outward normal of edge i
+    np.multiply(s, U[..., 1], out=N[..., 0])
+    np.multiply(-s, U[..., 0], out=N[..., 1])
     Nin = np.roll(N, 1, axis=1)                              # of the edge into corner i
     # np.sum(N * Nin, axis=-1) written out: a sum of two terms is one addition either way
     cos = (N[..., 0] * Nin[..., 0] + N[..., 1] * Nin[..., 1])[..., None]
-    return P + d * (N + Nin) / np.maximum(1.0 + cos, 0.5), N, Nin
+    move = N + Nin
+    if d != 1.0:                      # (a product by 1 is the number itself)
+        move = d * move
+    return P + move / np.maximum(1.0 + cos, 0.5), N, Nin
 
 
 def grow_polygons(P: np.ndarray, d: float) -> np.ndarray:
@@ -338,15 +376,44 @@ def grow_polygons(P: np.ndarray, d: float) -> np.ndarray:
     return _grow_parts(P, d)[0]
 
 
+class _Polygon:
+    """A closed polygon as matplotlib's Agg renderer reads a path of a collection: the
+    attributes ``vertices`` (``(n, 2)`` float, the collection's data coordinates), ``codes``,
+    ``should_simplify`` and ``simplify_threshold`` (those of the matplotlib ``Path`` it stands
+    for; the last three per subclass, :func:`_polygon_type`), nothing else: no ``Path``
+    method can be called on it. Only for a collection that only Agg draws
+    (:meth:`Painter.collection` with ``agg_only``)."""
+
+    __slots__ = ("vertices",)
+    codes: np.ndarray
+    should_simplify: bool
+    simplify_threshold: float
+
+
+@functools.lru_cache(maxsize=16)
+def _polygon_type(n: int, should_simplify: bool, simplify_threshold: float) -> type:
+    """The :class:`_Polygon` of ``n`` vertices (the last one closing it: the codes of a
+    ``Path(..., closed=True)``, read only) with these simplification settings."""
+    from matplotlib.path import Path as MplPath
+
+    codes = np.full(n, MplPath.LINETO, dtype=MplPath.code_type)
+    codes[0], codes[-1] = MplPath.MOVETO, MplPath.CLOSEPOLY
+    codes.flags.writeable = False
+    return type("_Polygon", (_Polygon,), {"__slots__": (), "codes": codes,
+                                          "should_simplify": bool(should_simplify),
+                                          "simplify_threshold": float(simplify_threshold)})
+
+
 class _PolygonPaths(Sequence):
-    """The closed paths of the drawn polygons made one at a time when asked for (Agg converts
-    them one by one): ``m`` matplotlib ``Path`` objects built and kept at once would cost as
-    much again in the garbage collector's sweeps as in their making. Path ``i`` is polygon
-    ``local[i]`` of ``sources[chunk[i]]`` (closed vertices ``(m_c, n_c, 2)``, their codes and
-    a template path), or where ``chunk[i]`` is -1 the path ``special[local[i]]`` (the
+    """The paths of the drawn polygons, made one at a time when asked for (Agg converts them
+    one by one): ``m`` path objects made and kept at once would cost as much again in the
+    garbage collector's sweeps as in their making. Path ``i`` is polygon ``local[i]`` of
+    ``sources[chunk[i]]`` (closed vertices ``(m_c, n_c, 2)`` and their :func:`_polygon_type`)
+    as a matplotlib ``Path`` of those vertices and codes (:class:`_LightPolygonPaths`: as
+    that :class:`_Polygon`); where ``chunk[i]`` is -1 the path ``special[local[i]]`` (the
     outlines)."""
 
-    def __init__(self, sources: list[tuple[np.ndarray, np.ndarray, Any]], chunk: np.ndarray,
+    def __init__(self, sources: list[tuple[np.ndarray, type]], chunk: np.ndarray,
                  local: np.ndarray, special: list[Any]) -> None:
         from matplotlib.path import Path as MplPath
 
@@ -354,9 +421,7 @@ class _PolygonPaths(Sequence):
         self._chunk = chunk.tolist()
         self._local = local.tolist()
         self._special = special
-        # what PolyCollection uses (a private matplotlib method, as before: the public
-        # constructor checks and reads rcParams for each of the ~35k paths)
-        self._make = MplPath._fast_from_codes_and_verts
+        self._path = MplPath
 
     def __len__(self) -> int:
         return len(self._chunk)
@@ -367,5 +432,20 @@ class _PolygonPaths(Sequence):
         c = self._chunk[i]
         if c < 0:
             return self._special[self._local[i]]
-        V, codes, template = self._sources[c]
-        return self._make(V[self._local[i]], codes, template)    # internals_from=template
+        V, kind = self._sources[c]
+        return self._path(V[self._local[i]], kind.codes)
+
+
+class _LightPolygonPaths(_PolygonPaths):
+    """:class:`_PolygonPaths` with each polygon a :class:`_Polygon` (the path of a polygon
+    asked for by its index: the ~35k calls from Agg take this one test; anything else, as
+    a slice or an outline, as :class:`_PolygonPaths` makes it)."""
+
+    def __getitem__(self, i):
+        c = self._chunk[i]
+        if c.__class__ is int and c >= 0:
+            V, kind = self._sources[c]
+            p = kind()
+            p.vertices = V[self._local[i]]
+            return p
+        return super().__getitem__(i)

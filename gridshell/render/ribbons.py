@@ -252,8 +252,10 @@ def render_ribbons(path: str | os.PathLike, axes: Sequence[np.ndarray],
     box = np.array([0.98 * size[0], (0.91 if title else 0.98) * size[1]])  # the box, pixels
     scale = 1.06 * float(np.max((hi - lo) / box)) or 1.0  # metres per pixel, equal both ways
     mid = 0.5 * (lo + hi)
+    # drawn by the Agg canvas only (_write_png): light paths (Painter.collection)
     coll = painter.collection(_data_to_pixels(fig, rect, mid - 0.5 * scale * box,
-                                              mid + 0.5 * scale * box), dpi, linewidth=0.2)
+                                              mid + 0.5 * scale * box), dpi, linewidth=0.2,
+                              agg_only=True)
     if coll is not None:
         coll.set_zorder(0)  # under everything else, as in an axes added first
         fig.add_artist(coll)
