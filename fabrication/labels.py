@@ -7,6 +7,7 @@ shrunk by 0.5 mm, clear of holes) is shrunk, then dropped (counted in the report
 from __future__ import annotations
 
 from functools import lru_cache
+from itertools import accumulate
 
 import numpy as np
 import shapely
@@ -31,26 +32,66 @@ def _font():
     return f, y0, y1 - y0
 
 
+@lru_cache(maxsize=None)
+def _glyph(char: str) -> tuple[np.ndarray, np.ndarray, list[int], float] | None:
+    """The glyph of ``char`` as ``lines_for_text`` renders it (``normalize_rendering``'s
+    scale), its strokes of two or more points (a shorter one gives no line) one after the
+    other: the x offsets of their points from the pen position, ``(x - left) * scalex``; the
+    y of their points with the labels' baseline and cap height applied, ``(yofs + y * scaley
+    - y0) / cap``; the number of points of each stroke; and the pen advance ``spacing +
+    scalex * width``. None for a character the font lacks (``lines_for_text`` skips it)."""
+    f, y0, cap = _font()
+    glyphs = list(f.glyphs_for_text(char))
+    if not glyphs:
+        return None
+    g, o = glyphs[0], f.render_options
+    sx, sy, yofs = o["scalex"], o["scaley"], o["yofs"]
+    pts = [p for s in g.strokes if len(s) >= 2 for p in s]
+    x = np.array([(px - g.left_offset) * sx for px, _ in pts], float)
+    y = (np.array([yofs + py * sy for _, py in pts], float) - y0) / cap
+    return x, y, [len(s) for s in g.strokes if len(s) >= 2], o["spacing"] + sx * g.char_width
+
+
 @lru_cache(maxsize=4096)
 def _unit_strokes(text: str) -> tuple[tuple[np.ndarray, ...], float]:
-    f, y0, cap = _font()
-    segs = np.array(list(f.lines_for_text(text)), float).reshape(-1, 2, 2)
-    if len(segs) == 0:
+    """Stroke polylines ``[(k,2)]`` of ``text`` with cap height 1, baseline at y = 0,
+    starting at x = 0, and its length: ``lines_for_text``'s segments, consecutive ones
+    joined where they meet (``np.allclose``), composed from the glyphs of :func:`_glyph`
+    with the same floating-point operations (the same numbers; test)."""
+    f, _, cap = _font()
+    xofs = f.render_options["xofs"]
+    xs, ys, counts = [], [], []
+    for char in text:
+        g = _glyph(char)
+        if g is None:
+            continue
+        if g[2]:
+            xs.append(xofs + g[0])         # as the library: xofs + (x - left) * scalex
+            ys.append(g[1])
+            counts += g[2]
+        xofs += g[3]
+    if not counts:
         return (), 0.0
-    segs[..., 1] -= y0
-    segs /= cap
-    x0, x1 = segs[..., 0].min(), segs[..., 0].max()
-    segs[..., 0] -= x0
-    lines, cur = [], segs[0].tolist()
-    for a, b in segs[1:].tolist():
-        b0 = cur[-1]                # np.allclose(a, b0), without its overhead per segment
-        if (abs(a[0] - b0[0]) <= 1e-8 + 1e-5 * abs(b0[0])
-                and abs(a[1] - b0[1]) <= 1e-8 + 1e-5 * abs(b0[1])):
-            cur.append(b)
+    P = np.empty((sum(counts), 2))
+    P[:, 0] = np.concatenate(xs) if len(xs) > 1 else xs[0]
+    P[:, 0] /= cap
+    P[:, 1] = np.concatenate(ys) if len(ys) > 1 else ys[0]
+    x0, x1 = P[:, 0].min(), P[:, 0].max()
+    P[:, 0] -= x0
+    # a stroke continues the line before it where its first point meets that line's last
+    # (consecutive segments of one stroke always do): np.allclose, without its overhead
+    ends = list(accumulate(counts))
+    first = np.array(ends[:-1], dtype=np.intp)
+    a, b0 = P[first], P[first - 1]
+    join = np.all(np.abs(a - b0) <= 1e-8 + 1e-5 * np.abs(b0), axis=1).tolist()
+    lines, line = [], [P[:ends[0]]]
+    for k, joined in enumerate(join):
+        if joined:
+            line.append(P[ends[k] + 1:ends[k + 1]])
         else:
-            lines.append(np.array(cur))
-            cur = [a, b]
-    lines.append(np.array(cur))
+            lines.append(np.concatenate(line) if len(line) > 1 else line[0])
+            line = [P[ends[k]:ends[k + 1]]]
+    lines.append(np.concatenate(line) if len(line) > 1 else line[0])
     return tuple(lines), float(x1 - x0)
 
 
@@ -148,17 +189,23 @@ def strip_labels(strip: Strip, params: FabParams,
         if a > end:
             free.append((end, a))
         end = max(end, b)
-    free.sort(key=lambda ab: ab[0] - ab[1])
+    free.sort(key=lambda ab: ab[0] - ab[1])          # longest first
+    heights = []                                     # h0, 0.75 h0, ... down to MIN_HEIGHT
+    h = h0
+    while h >= MIN_HEIGHT:
+        heights.append(h)
+        h *= 0.75
     placed = False
     for a, b in free:
-        h = h0
-        while h >= MIN_HEIGHT and not placed:
+        if text_length(text, heights[-1]) > b - a:
+            break                # too short at the smallest height, and so are the rest
+        for h in heights:
             if text_length(text, h) <= b - a:
                 lines = place_text(strip, text, h, 0.5 * (a + b), band_t)
                 if fits(lines):
                     strokes += lines
                     placed = True
-            h *= 0.75
+                    break
         if placed:
             break
     dropped += 0 if placed else 1

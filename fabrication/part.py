@@ -63,10 +63,14 @@ class Part:
     motion: Motion = field(default_factory=Motion)
 
     def moved(self, m: Motion) -> "Part":
-        return Part(self.strip, self.outline.moved(m), m.apply(self.holes).reshape(-1, 2),
-                    self.radii, m.apply(self.scores.reshape(-1, 2)).reshape(-1, 2, 2),
-                    [m.apply(L) for L in self.engrave], m.apply(self.joints).reshape(-1, 2),
-                    self.nominal.moved(m), self.labels_dropped, self.area,
+        """The part moved by ``m`` (every layer; the points as :meth:`Motion.apply` and
+        :meth:`Path.moved` move them, the rotation made once)."""
+        o, n = self.outline, self.nominal
+        V, W, holes, scores, joints, *engrave = m.apply_each(
+            [o.V, n.V, self.holes, self.scores.reshape(-1, 2), self.joints, *self.engrave])
+        return Part(self.strip, Path(V, o.B.copy(), o.closed), holes.reshape(-1, 2),
+                    self.radii, scores.reshape(-1, 2, 2), engrave, joints.reshape(-1, 2),
+                    Path(W, n.B.copy(), n.closed), self.labels_dropped, self.area,
                     self.motion.then(m))
 
     def polygon(self, tol: float = 0.05) -> Polygon:
