@@ -158,21 +158,25 @@ def strip_labels(strip: Strip, params: FabParams,
     def fits(lines):
         return bool(lines) and safe.contains(MultiLineString([L for L in lines]))
 
+    heights = []                 # the label heights tried: h0, 0.75 h0, ... to MIN_HEIGHT
+    h = h0
+    while h >= MIN_HEIGHT:
+        heights.append(h)
+        h *= 0.75
+
     for s_j, nb in zip(strip.joint_s, strip.neighbours):
         if not nb:
             continue
         text = ",".join(str(i) for i in nb)
-        h = h0
         # the next occupied stretch after the joint (occupied grows only when placed)
         limit = min([a for a, _ in occupied if a > s_j + 1e-9] + [strip.s1 - 1.0])
-        while h >= MIN_HEIGHT:
+        for h in heights:
             L = text_length(text, h)
             s_c = s_j + pad + L / 2
             if s_c + L / 2 <= limit and fits(lines := place_text(strip, text, h, s_c, band_t)):
                 strokes += lines
                 occupied.append((s_j + pad, s_c + L / 2 + 1.0))
                 break
-            h *= 0.75
         else:
             dropped += 1
     # span splices: their label on both pieces, inside the overlap, clear of the fasteners
@@ -183,8 +187,7 @@ def strip_labels(strip: Strip, params: FabParams,
         a, b = (f[0] + pad + 1.0, f[-1] - pad - 1.0) if len(f) > 1 else \
             (f[0] + pad + 1.0, note["to"] - 1.0)
         a, b = max(a, strip.s0 + 1.0), min(b, strip.s1 - 1.0)
-        h = h0
-        while h >= MIN_HEIGHT:
+        for h in heights:
             L = text_length(note["label"], h)
             if L <= b - a:
                 lines = place_text(strip, note["label"], h, 0.5 * (a + b), band_t)
@@ -192,7 +195,6 @@ def strip_labels(strip: Strip, params: FabParams,
                     strokes += lines
                     occupied.append((0.5 * (a + b - L), 0.5 * (a + b + L)))
                     break
-            h *= 0.75
         else:
             dropped += 1
     # the strip's name in the longest free stretch
@@ -204,11 +206,6 @@ def strip_labels(strip: Strip, params: FabParams,
             free.append((end, a))
         end = max(end, b)
     free.sort(key=lambda ab: ab[0] - ab[1])          # longest first
-    heights = []                                     # h0, 0.75 h0, ... down to MIN_HEIGHT
-    h = h0
-    while h >= MIN_HEIGHT:
-        heights.append(h)
-        h *= 0.75
     placed = False
     for a, b in free:
         if text_length(text, heights[-1]) > b - a:
