@@ -18,6 +18,7 @@ from .params import FabParams
 from .strip import Strip
 
 MIN_HEIGHT = 1.5  # mm; smaller single-line text does not engrave legibly
+SAFE_INSET = 0.5  # mm; labels keep this far inside the material (from edges and holes)
 
 
 FONT = "futural"   # Hershey simplex roman, one of HersheyFonts' built-in fonts
@@ -132,21 +133,41 @@ def text_length(text: str, height: float) -> float:
     return _unit_strokes(text)[1] * height
 
 
-def strip_labels(strip: Strip, params: FabParams,
-                 material: Polygon) -> tuple[list[np.ndarray], int]:
-    """Engraving strokes of the strip: its name (``L12``, ``L12-1/2``) in the widest free
-    stretch, the neighbour ids right after each joint and the label of each span splice
-    (``L12-S1``) between its fasteners. ``material``: the part's shapely
-    polygon (holes as interiors). Returns the strokes and the number of labels dropped."""
+def _band(strip: Strip, params: FabParams) -> tuple[float, float]:
+    """``(h0, t)``: the largest label height of the strip and the strip coordinate ``t`` of
+    the labels' centre line, mm."""
     w = strip.width
     band_t, band_h = strip.t_mid, w
     if params.joints == "slots":   # keep to the half the notches leave whole
         band_h = w / 2
         band_t = strip.t_mid + (-w / 4 if slot_edge(strip.family) == "hi" else w / 4)
-    h0 = min(0.3 * w, band_h - 2.0, 8.0)
+    return min(0.3 * w, band_h - 2.0, 8.0), band_t
+
+
+def labelled(strip: Strip, params: FabParams) -> bool:
+    """Whether the strip is wide enough for labels (of at least MIN_HEIGHT)."""
+    return _band(strip, params)[0] >= MIN_HEIGHT
+
+
+def safe_regions(materials: np.ndarray) -> np.ndarray:
+    """Where labels may go on each of the parts' ``materials`` (shapely polygons, holes as
+    interiors): the material shrunk by SAFE_INSET mm, made at once (``material.buffer(
+    -SAFE_INSET)`` of each: the method's defaults, the same polygons)."""
+    return shapely.buffer(materials, -SAFE_INSET, quad_segs=16)
+
+
+def strip_labels(strip: Strip, params: FabParams, material: Polygon,
+                 safe: Polygon | None = None) -> tuple[list[np.ndarray], int]:
+    """Engraving strokes of the strip: its name (``L12``, ``L12-1/2``) in the widest free
+    stretch, the neighbour ids right after each joint and the label of each span splice
+    (``L12-S1``) between its fasteners. ``material``: the part's shapely
+    polygon (holes as interiors); ``safe``: its :func:`safe_regions` if made already.
+    Returns the strokes and the number of labels dropped."""
+    h0, band_t = _band(strip, params)
     if h0 < MIN_HEIGHT:
         return [], len(strip.joint_s) + 1
-    safe = material.buffer(-0.5)
+    if safe is None:
+        safe = safe_regions(np.array([material], dtype=object))[0]
     shapely.prepare(safe)        # many containment tests against one polygon; same answers
     pad = feature_halfwidth(params) + 1.0
     strokes: list[np.ndarray] = []

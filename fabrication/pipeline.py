@@ -26,7 +26,7 @@ from gridshell.manifest import MANIFEST, refusal
 
 from .nesting import Layout, check_layout, nest
 from .params import FabParams, scale_text
-from .part import Part, build_part, joint_clearance
+from .part import Part, build_parts, joint_clearance
 from .splice import split_strip
 from .strips import strips_from_bundle
 
@@ -84,7 +84,7 @@ def plan_parts(bundle: DesignBundle, params: FabParams,
                         "instead; use a larger --scale for " + params.joints)
             say("warning: " + fallback)
             params = replace(params, joints="marks")
-    parts = [build_part(p, params) for p in pieces]
+    parts = build_parts(pieces, params)
     layout = nest(parts, params)
     check_layout(layout, params.gap)
     say(f"nested {len(parts)} pieces on {layout.n_sheets} sheet(s)")

@@ -382,3 +382,39 @@ def test_font_loaded_without_listing_the_archive_equals_the_library_default():
         assert (a[k].strokes, a[k].left_offset, a[k].char_width, a[k].draw_box) == \
             (b[k].strokes, b[k].left_offset, b[k].char_width, b[k].draw_box), k
     assert list(f.lines_for_text("L12-1/2,S3")) == list(ref.lines_for_text("L12-1/2,S3"))
+
+
+@pytest.mark.parametrize("kind,kw", [("GG", {}), ("CNC", {"kerf": 0.2}),
+                                     ("NCP", {"joints": "slots"}),
+                                     ("CNC", {"joints": "marks", "scale": 0.2})])
+def test_parts_built_at_once_equal_part_by_part(kind, kw, monkeypatch):
+    """build_parts' material polygons, areas and labels' safe regions, made for all parts
+    at once by shapely's vectorized functions, equal those of the part-by-part code (outline
+    polygon less the union of its hole circles, its area, ``buffer(-0.5)``) bit for bit."""
+    import shapely
+    from shapely.geometry import Polygon
+
+    from fabrication import part as part_mod
+
+    params = FabParams(**kw)
+    strips = strips_from_bundle(make_bundle(kind, nr=5, nc=6), params)
+    seen = []
+    label = part_mod.strip_labels
+
+    def spy(strip, params, material, safe=None):
+        seen.append((material, safe))
+        return label(strip, params, material, safe)
+
+    monkeypatch.setattr(part_mod, "strip_labels", spy)
+    parts = part_mod.build_parts(strips, params)
+    assert len(seen) == len(parts) == len(strips)
+    for p, (mat, safe) in zip(parts, seen):
+        ref = Polygon(p.nominal.flatten(params.tolerance))
+        if len(p.holes):
+            circles = shapely.buffer(shapely.points(np.asarray(p.holes, float)),
+                                     params.hole / 2, quad_segs=32)
+            ref = ref.difference(shapely.union_all(circles))
+        assert mat.wkb == ref.wkb
+        assert p.area == float(ref.area)
+        assert safe is not None and safe.wkb == ref.buffer(-0.5).wkb
+    assert any(len(p.holes) for p in parts) == (params.joints == "hole")
