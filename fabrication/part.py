@@ -2,7 +2,8 @@
 
 ``outline`` (CUT, closed, bulges for arcs), ``holes`` (CUT circles), ``scores`` (SCORE line
 segments), ``engrave`` (ENGRAVE stroke polylines). :func:`build_part` makes it from a
-:class:`~fabrication.strip.Strip`; ``Part.moved`` places it on a sheet.
+:class:`~fabrication.strip.Strip` (:func:`build_parts` the parts of many strips at once);
+``Part.moved`` places it on a sheet.
 """
 from __future__ import annotations
 
