@@ -2,7 +2,8 @@
 
 ``outline`` (CUT, closed, bulges for arcs), ``holes`` (CUT circles), ``scores`` (SCORE line
 segments), ``engrave`` (ENGRAVE stroke polylines). :func:`build_part` makes it from a
-:class:`~fabrication.strip.Strip`; ``Part.moved`` places it on a sheet.
+:class:`~fabrication.strip.Strip` (:func:`build_parts` the parts of many strips at once);
+``Part.moved`` places it on a sheet.
 """
 from __future__ import annotations
 
@@ -18,7 +19,7 @@ from gridshell.errors import InputError
 
 from .joints import hole_centres, joint_points, outline_corners, score_marks
 from .kerf import hole_radius, offset_corners
-from .labels import strip_labels
+from .labels import labelled, safe_regions, strip_labels
 from .params import FabParams
 from .path import Motion, Path
 from .strip import Strip
@@ -63,10 +64,14 @@ class Part:
     motion: Motion = field(default_factory=Motion)
 
     def moved(self, m: Motion) -> "Part":
-        return Part(self.strip, self.outline.moved(m), m.apply(self.holes).reshape(-1, 2),
-                    self.radii, m.apply(self.scores.reshape(-1, 2)).reshape(-1, 2, 2),
-                    [m.apply(L) for L in self.engrave], m.apply(self.joints).reshape(-1, 2),
-                    self.nominal.moved(m), self.labels_dropped, self.area,
+        """The part moved by ``m`` (every layer; the points as :meth:`Motion.apply` and
+        :meth:`Path.moved` move them, the rotation made once)."""
+        o, n = self.outline, self.nominal
+        V, W, holes, scores, joints, *engrave = m.apply_each(
+            [o.V, n.V, self.holes, self.scores.reshape(-1, 2), self.joints, *self.engrave])
+        return Part(self.strip, Path(V, o.B.copy(), o.closed), holes.reshape(-1, 2),
+                    self.radii, scores.reshape(-1, 2, 2), engrave, joints.reshape(-1, 2),
+                    Path(W, n.B.copy(), n.closed), self.labels_dropped, self.area,
                     self.motion.then(m))
 
     def polygon(self, tol: float = 0.05) -> Polygon:
@@ -110,6 +115,44 @@ def check_spacing(strip: Strip, params: FabParams) -> None:
 
 def build_part(strip: Strip, params: FabParams) -> Part:
     """Outline (with slots), holes, score marks and labels of ``strip``."""
+    return build_parts([strip], params)[0]
+
+
+def build_parts(strips: list[Strip], params: FabParams) -> list[Part]:
+    """:func:`build_part` of each of ``strips``. The parts' material polygons (outline less
+    the hole circles), their areas (mm^2) and the labels' safe regions are made for all
+    parts at once with shapely's vectorized functions: the same GEOS operations, one
+    geometry at a time, as part by part (the same polygons; test)."""
+    parts = [_cut(strip, params) for strip in strips]
+    tol = params.tolerance
+    mats = np.empty(len(parts), dtype=object)
+    mats[:] = [Polygon(p.nominal.flatten(tol)) for p in parts]
+    drilled = [i for i, p in enumerate(parts) if len(p.holes)]
+    if drilled:
+        # the hole circles (32 segments a quarter) buffered at once: the same polygons as
+        # Point(c).buffer(r, 32) one by one; each part's united, then cut from its outline
+        counts = [len(parts[i].holes) for i in drilled]
+        centres = np.concatenate([np.asarray(parts[i].holes, float) for i in drilled])
+        circles = shapely.buffer(shapely.points(centres), params.hole / 2, quad_segs=32)
+        rows = np.full((len(drilled), max(counts)), None, dtype=object)
+        start = 0
+        for r, k in enumerate(counts):
+            rows[r, :k] = circles[start:start + k]
+            start += k
+        mats[drilled] = shapely.difference(mats[drilled], shapely.union_all(rows, axis=1))
+    for p, area in zip(parts, shapely.area(mats).tolist()):
+        p.area = area
+    if params.labels:
+        wide = [i for i, s in enumerate(strips) if labelled(s, params)]
+        safe = dict(zip(wide, safe_regions(mats[wide]))) if wide else {}
+        for i, (p, s) in enumerate(zip(parts, strips)):
+            p.engrave, p.labels_dropped = strip_labels(s, params, mats[i], safe.get(i))
+    return parts
+
+
+def _cut(strip: Strip, params: FabParams) -> Part:
+    """The part of ``strip`` without its labels and area: outline (with slots), holes and
+    score marks (raises InputError where joint features would merge)."""
     check_spacing(strip, params)
     tol = params.tolerance
     C = outline_corners(strip, params)
@@ -129,15 +172,4 @@ def build_part(strip: Strip, params: FabParams) -> Part:
             radii = np.concatenate([radii, np.full(f, hole_radius(params.hole, params.kerf))])
         else:
             scores = np.concatenate([scores, score_marks(strip, strip.splice_s)])
-    part = Part(strip, outline, holes, radii, scores, [], joint_points(strip), nominal)
-    mat = Polygon(nominal.flatten(tol))
-    if len(holes):
-        # the hole circles (32 segments a quarter) buffered at once: the same polygons as
-        # Point(c).buffer(r, 32) one by one
-        circles = shapely.buffer(shapely.points(np.asarray(holes, float)), params.hole / 2,
-                                 quad_segs=32)
-        mat = mat.difference(shapely.union_all(circles))
-    part.area = float(mat.area)
-    if params.labels:
-        part.engrave, part.labels_dropped = strip_labels(strip, params, mat)
-    return part
+    return Part(strip, outline, holes, radii, scores, [], joint_points(strip), nominal)

@@ -19,9 +19,15 @@ class Motion:
     dy: float = 0.0
 
     def apply(self, X: np.ndarray) -> np.ndarray:
-        X = np.asarray(X, float)
+        """The points ``X (..., 2)`` moved (mm)."""
+        return self.apply_each([X])[0]
+
+    def apply_each(self, Xs: list[np.ndarray]) -> list[np.ndarray]:
+        """Each of the point arrays ``Xs`` moved, as :meth:`apply` moves it (the rotation
+        made once)."""
         c, s = np.cos(self.angle), np.sin(self.angle)
-        return X @ np.array([[c, s], [-s, c]]) + np.array([self.dx, self.dy])
+        R, t = np.array([[c, s], [-s, c]]), np.array([self.dx, self.dy])
+        return [np.asarray(X, float) @ R + t for X in Xs]
 
     def then(self, other: "Motion") -> "Motion":
         """This motion followed by ``other``."""

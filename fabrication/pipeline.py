@@ -24,10 +24,9 @@ from gridshell.bundle import DesignBundle, finite_json, read_bundle
 from gridshell.errors import InputError, OutputError
 from gridshell.manifest import MANIFEST, refusal
 
-from .cutlist import cutlist_rows, write_cutlist
 from .nesting import Layout, check_layout, nest
 from .params import FabParams, scale_text
-from .part import Part, build_part, joint_clearance
+from .part import Part, build_parts, joint_clearance
 from .splice import split_strip
 from .strips import strips_from_bundle
 
@@ -85,7 +84,7 @@ def plan_parts(bundle: DesignBundle, params: FabParams,
                         "instead; use a larger --scale for " + params.joints)
             say("warning: " + fallback)
             params = replace(params, joints="marks")
-    parts = [build_part(p, params) for p in pieces]
+    parts = build_parts(pieces, params)
     layout = nest(parts, params)
     check_layout(layout, params.gap)
     say(f"nested {len(parts)} pieces on {layout.n_sheets} sheet(s)")
@@ -122,7 +121,9 @@ def fabricate(bundle: str | Path | DesignBundle, out_dir: str | Path,
         placement (the rigid motion from strip coordinates, see :mod:`fabrication.axis`, to
         the sheet; mm and degrees).
     """
-    # the writers (ezdxf, the previews): only for writing, plan_parts does without them
+    # the writers (ezdxf, the previews, the cut list): only for writing, plan_parts does
+    # without them
+    from .cutlist import cutlist_rows, write_cutlist
     from .dxf import write_sheet_dxf
     from .plan import write_plan
     from .preview import write_sheet_png

@@ -21,21 +21,22 @@ SLACK = 0.05       # mm: a piece cut to fit the sheet (to 0.01 mm, arcs sampled)
 def fullest(lengths: np.ndarray, cap: float) -> list[int]:
     """Indices of a subset of ``lengths`` that contains the first and whose sum is largest
     but at most ``cap`` (subset sum over ROW_UNIT steps, lengths rounded up)."""
-    units = np.ceil(lengths / ROW_UNIT - 1e-9).astype(int)
+    units = np.ceil(lengths / ROW_UNIT - 1e-9).astype(int).tolist()
     c = int(np.floor(cap / ROW_UNIT + 1e-9)) - units[0]
     if c < 0:
         return []
-    reach = np.zeros(c + 1, bool)
-    reach[0] = True
+    # the sums reachable with the items so far: bit i of an int for a sum of i units
+    full = (1 << (c + 1)) - 1
+    reach = 1
     history = []
     for u in units[1:]:
-        history.append(reach.copy())
+        history.append(reach)
         if u <= c:
-            reach[u:] |= history[-1][:c + 1 - u]
-    total = int(np.flatnonzero(reach).max())
+            reach = (reach | reach << u) & full
+    total = reach.bit_length() - 1
     chosen = [0]
     for k in range(len(units) - 1, 0, -1):      # walk back through the items
-        if not history[k - 1][total]:
+        if not history[k - 1] >> total & 1:
             chosen.append(k)
             total -= units[k]
     return sorted(chosen)

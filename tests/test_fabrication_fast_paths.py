@@ -256,3 +256,165 @@ def test_sheet_preview_description_names_the_colours_drawn(tmp_path):
         assert tuple(round(255 * c) for c in to_rgb(css.get(name, name))) == rgb, (layer, name)
         if layer != "SCORE":         # a GG strip has no score lines; cuts and labels it has
             assert rgb in pixels, layer
+
+
+def _unit_strokes_by_lines(text):
+    """The stroke polylines of ``text`` the straightforward way: every segment of the
+    library's ``lines_for_text``, consecutive ones joined where ``np.allclose`` says they
+    meet (the code before the glyphs were composed)."""
+    f, y0, cap = _font()
+    segs = np.array(list(f.lines_for_text(text)), float).reshape(-1, 2, 2)
+    if len(segs) == 0:
+        return (), 0.0
+    segs[..., 1] -= y0
+    segs /= cap
+    x0, x1 = segs[..., 0].min(), segs[..., 0].max()
+    segs[..., 0] -= x0
+    lines, cur = [], segs[0].tolist()
+    for a, b in segs[1:].tolist():
+        if np.allclose(a, cur[-1]):
+            cur.append(b)
+        else:
+            lines.append(np.array(cur))
+            cur = [a, b]
+    lines.append(np.array(cur))
+    return tuple(lines), float(x1 - x0)
+
+
+def _label_texts():
+    """Texts as the labels write them (names, pieces, splices, neighbour lists) and
+    every printable character, alone, in pairs and in random strings (and characters the
+    font lacks)."""
+    rng = np.random.default_rng(7)
+    chars = [chr(c) for c in range(32, 128)]
+    texts = ["", " ", "L", "S", "-", "/", ",", "0123456789", "L0", "L12", "L12-1/2",
+             "L40-S2", "L7-S13", "3,17", "12,40,7", "1,2,3,4", "L1-2/3", "L99-10/12",
+             "é", "L1é2", "\n", "L 1", "  L1  "]
+    texts += [f"L{i}" for i in range(120)] + [f"L{i}-{j}/{k}" for i in range(0, 60, 7)
+                                              for k in (2, 3) for j in range(1, k + 1)]
+    texts += [f"L{i}-S{j}" for i in range(0, 60, 9) for j in range(1, 4)]
+    texts += [",".join(str(v) for v in rng.integers(0, 200, n)) for n in range(1, 8)
+              for _ in range(8)]
+    texts += chars + [a + b for a in "L0S,-/1" for b in chars]
+    texts += ["".join(rng.choice(chars, n)) for n in range(1, 20) for _ in range(5)]
+    return texts
+
+
+def test_glyph_composed_strokes_equal_the_library_lines():
+    """The labels' stroke polylines composed from cached glyphs equal, bit for bit (same
+    arrays, same line breaks), those from the library's ``lines_for_text`` joined
+    segment by segment with np.allclose."""
+    from fabrication.labels import _unit_strokes
+
+    for text in _label_texts():
+        lines, length = _unit_strokes(text)
+        want, want_length = _unit_strokes_by_lines(text)
+        assert length == want_length and np.float64(length).tobytes() == \
+            np.float64(want_length).tobytes(), text
+        assert len(lines) == len(want), text
+        for L, W in zip(lines, want):
+            assert L.dtype == W.dtype and L.shape == W.shape, text
+            assert L.tobytes() == W.tobytes(), text
+
+
+def _fullest_by_arrays(lengths, cap):
+    """:func:`fabrication.rows.fullest` the straightforward way: the reachable sums as a
+    boolean array per item (the code before the bit sets)."""
+    from fabrication.rows import ROW_UNIT
+
+    units = np.ceil(lengths / ROW_UNIT - 1e-9).astype(int)
+    c = int(np.floor(cap / ROW_UNIT + 1e-9)) - units[0]
+    if c < 0:
+        return []
+    reach = np.zeros(c + 1, bool)
+    reach[0] = True
+    history = []
+    for u in units[1:]:
+        history.append(reach.copy())
+        if u <= c:
+            reach[u:] |= history[-1][:c + 1 - u]
+    total = int(np.flatnonzero(reach).max())
+    chosen = [0]
+    for k in range(len(units) - 1, 0, -1):
+        if not history[k - 1][total]:
+            chosen.append(k)
+            total -= units[k]
+    return sorted(chosen)
+
+
+def test_fullest_bit_sets_choose_as_the_boolean_arrays():
+    """The row filling's subset sum over int bit sets picks the same items as over boolean
+    arrays (random strip lengths, caps from below the first to above the sum, ties)."""
+    from fabrication.rows import fullest
+
+    rng = np.random.default_rng(3)
+    cases = 0
+    for n in (1, 2, 3, 5, 8, 13, 30, 45):
+        for _ in range(12):
+            L = np.round(rng.uniform(5.0, 300.0, n), rng.integers(0, 4))
+            if rng.random() < 0.3:
+                L[rng.integers(0, n, n // 2 + 1)] = L[0]          # equal lengths
+            for cap in (L[0] - 1.0, L[0], L[0] + 0.05, 0.5 * L.sum(), L.sum(),
+                        L.sum() + 7.0, rng.uniform(L[0], 600.0)):
+                got = fullest(L, float(cap))
+                assert got == _fullest_by_arrays(L, float(cap)), (L, cap)
+                cases += bool(got)
+    assert cases > 300
+
+
+def test_font_loaded_without_listing_the_archive_equals_the_library_default():
+    """The labels' font (loaded without listing the built-in archive first) has the glyphs
+    and rendering of the library's own ``load_default_font("futural")``, and the name is
+    one of the library's built-in fonts."""
+    from HersheyFonts import HersheyFonts
+
+    from fabrication.labels import FONT
+
+    f, _, _ = _font()
+    ref = HersheyFonts()
+    assert FONT in ref.default_font_names
+    ref.load_default_font(FONT)
+    ref.normalize_rendering(1.0)
+    assert dict(f.render_options) == dict(ref.render_options)
+    a, b = f.all_glyphs, ref.all_glyphs
+    assert a.keys() == b.keys() and len(a) > 90
+    for k in a:
+        assert (a[k].strokes, a[k].left_offset, a[k].char_width, a[k].draw_box) == \
+            (b[k].strokes, b[k].left_offset, b[k].char_width, b[k].draw_box), k
+    assert list(f.lines_for_text("L12-1/2,S3")) == list(ref.lines_for_text("L12-1/2,S3"))
+
+
+@pytest.mark.parametrize("kind,kw", [("GG", {}), ("CNC", {"kerf": 0.2}),
+                                     ("NCP", {"joints": "slots"}),
+                                     ("CNC", {"joints": "marks", "scale": 0.2})])
+def test_parts_built_at_once_equal_part_by_part(kind, kw, monkeypatch):
+    """build_parts' material polygons, areas and labels' safe regions, made for all parts
+    at once by shapely's vectorized functions, equal those of the part-by-part code (outline
+    polygon less the union of its hole circles, its area, ``buffer(-0.5)``) bit for bit."""
+    import shapely
+    from shapely.geometry import Polygon
+
+    from fabrication import part as part_mod
+
+    params = FabParams(**kw)
+    strips = strips_from_bundle(make_bundle(kind, nr=5, nc=6), params)
+    seen = []
+    label = part_mod.strip_labels
+
+    def spy(strip, params, material, safe=None):
+        seen.append((material, safe))
+        return label(strip, params, material, safe)
+
+    monkeypatch.setattr(part_mod, "strip_labels", spy)
+    parts = part_mod.build_parts(strips, params)
+    assert len(seen) == len(parts) == len(strips)
+    for p, (mat, safe) in zip(parts, seen):
+        ref = Polygon(p.nominal.flatten(params.tolerance))
+        if len(p.holes):
+            circles = shapely.buffer(shapely.points(np.asarray(p.holes, float)),
+                                     params.hole / 2, quad_segs=32)
+            ref = ref.difference(shapely.union_all(circles))
+        assert mat.wkb == ref.wkb
+        assert p.area == float(ref.area)
+        assert safe is not None and safe.wkb == ref.buffer(-0.5).wkb
+    assert any(len(p.holes) for p in parts) == (params.joints == "hole")

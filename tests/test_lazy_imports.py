@@ -43,7 +43,7 @@ def test_the_export_plans_its_cut_sheets_without_the_dxf_writer():
             "plan_sheets(make_bundle(), fab)\n"
             "import fabrication\n"
             "assert 'ezdxf' not in sys.modules, 'ezdxf loaded'\n"
-            "for m in ('dxf', 'svg', 'preview', 'plan'):\n"
+            "for m in ('dxf', 'svg', 'preview', 'plan', 'cutlist'):\n"
             "    assert 'fabrication.' + m not in sys.modules, m\n"
             "fabrication.fabricate\n"
             "assert 'ezdxf' not in sys.modules, 'ezdxf loaded by fabrication.fabricate'")
