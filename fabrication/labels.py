@@ -21,26 +21,12 @@ MIN_HEIGHT = 1.5  # mm; smaller single-line text does not engrave legibly
 SAFE_INSET = 0.5  # mm; labels keep this far inside the material (from edges and holes)
 
 
-FONT = "futural"   # Hershey simplex roman, one of HersheyFonts' built-in fonts
-
-
 @lru_cache(maxsize=1)
 def _font():
-    """The font (a HersheyFonts object, rendering normalized to a height of 1), the y of
-    the baseline and the cap height of the digits and ``L`` in its units."""
     from HersheyFonts import HersheyFonts
 
-    class Font(HersheyFonts):
-        """HersheyFonts knowing its font is built in: ``load_default_font`` checks the name
-        against ``default_font_names``, which unpacks the whole built-in archive only to
-        list its members, then unpacks it again to read the font (the same font: test)."""
-
-        @property
-        def default_font_names(self) -> list[str]:
-            return [FONT]
-
-    f = Font()
-    f.load_default_font(FONT)
+    f = HersheyFonts()
+    f.load_default_font("futural")
     f.normalize_rendering(1.0)
     segs = np.array(list(f.lines_for_text("0123456789L")), float).reshape(-1, 2, 2)
     y0, y1 = segs[..., 1].min(), segs[..., 1].max()

@@ -362,28 +362,6 @@ def test_fullest_bit_sets_choose_as_the_boolean_arrays():
     assert cases > 300
 
 
-def test_font_loaded_without_listing_the_archive_equals_the_library_default():
-    """The labels' font (loaded without listing the built-in archive first) has the glyphs
-    and rendering of the library's own ``load_default_font("futural")``, and the name is
-    one of the library's built-in fonts."""
-    from HersheyFonts import HersheyFonts
-
-    from fabrication.labels import FONT
-
-    f, _, _ = _font()
-    ref = HersheyFonts()
-    assert FONT in ref.default_font_names
-    ref.load_default_font(FONT)
-    ref.normalize_rendering(1.0)
-    assert dict(f.render_options) == dict(ref.render_options)
-    a, b = f.all_glyphs, ref.all_glyphs
-    assert a.keys() == b.keys() and len(a) > 90
-    for k in a:
-        assert (a[k].strokes, a[k].left_offset, a[k].char_width, a[k].draw_box) == \
-            (b[k].strokes, b[k].left_offset, b[k].char_width, b[k].draw_box), k
-    assert list(f.lines_for_text("L12-1/2,S3")) == list(ref.lines_for_text("L12-1/2,S3"))
-
-
 @pytest.mark.parametrize("kind,kw", [("GG", {}), ("CNC", {"kerf": 0.2}),
                                      ("NCP", {"joints": "slots"}),
                                      ("CNC", {"joints": "marks", "scale": 0.2})])
