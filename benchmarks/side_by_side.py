@@ -4,8 +4,9 @@ code before a change, ``git worktree add ../base main``), alternating, in one ru
 Each (root, stage, size) runs in its own process through ``run_all.py --worker`` with
 ``PYTHONPATH`` set to that root, so both use the inputs and the measurement of this
 checkout's ``run_all.py`` and differ only in the ``gridshell`` they import. Prints wall time
-and CPU time (all threads of the process; on a loaded machine wall time grows with the load,
-CPU time much less) and the ratio, base / this.
+and CPU time (all threads of the process and the processes it waited for; on a loaded machine
+wall time grows with the load, CPU time much less) and the ratios base / this of both (work done
+in a second process, as the .3dm export's cut sheets, shortens the wall time, not the CPU time).
 
     .venv/bin/python benchmarks/side_by_side.py --base ../base phlw:0 phlw:1 ncp_e2e:0
 
@@ -97,7 +98,7 @@ def main(argv: list[str] | None = None) -> None:
         compile_tree(root)
     out = []
     print(f"{'stage':<16} {'size':>4} {'base wall':>10} {'base cpu':>9} {'this wall':>10} "
-          f"{'this cpu':>9} {'ratio':>9}")
+          f"{'this cpu':>9} {'ratio wall':>10} {'ratio cpu':>9}")
     for spec in a.runs:
         stage, _, idx = spec.partition(":")
         bs, ts = [], []
@@ -109,11 +110,13 @@ def main(argv: list[str] | None = None) -> None:
 
         def f(d: dict, k: str) -> str:
             return f"{d[k]:.2f}" if k in d else "-"
-        key = "cpu_seconds" if "cpu_seconds" in b and "cpu_seconds" in t else "seconds"
-        ratio = (f"{b[key] / t[key]:.2f}x" + ("" if key == "cpu_seconds" else " wall")
-                 if key in b and key in t and t[key] > 0 else b.get("error", t.get("error", "-")))
+        def ratio(k: str) -> str:
+            if k in b and k in t and t[k] > 0:
+                return f"{b[k] / t[k]:.2f}x"
+            return b.get("error", t.get("error", "-"))
         print(f"{stage:<16} {idx or 0:>4} {f(b, 'seconds'):>10} {f(b, 'cpu_seconds'):>9} "
-              f"{f(t, 'seconds'):>10} {f(t, 'cpu_seconds'):>9} {ratio:>9}", flush=True)
+              f"{f(t, 'seconds'):>10} {f(t, 'cpu_seconds'):>9} {ratio('seconds'):>10} "
+              f"{ratio('cpu_seconds'):>9}", flush=True)
     if a.json:
         Path(a.json).write_text(json.dumps(out, indent=1))
 

@@ -62,3 +62,34 @@ def test_trees_are_compiled_before_measuring(tmp_path):
     sbs.compile_tree(tmp_path)
     for pkg in ("gridshell", "fabrication"):
         assert (tmp_path / pkg / iu.cache_from_source("late.py")).is_file()
+
+
+def test_cpu_counts_the_processes_the_call_waited_for():
+    """measure()'s CPU seconds include a child the call forked and reaped (the .3dm export's
+    cut-sheet process): two children spinning 0.2 s each give >= 0.4 s of CPU."""
+    import os
+    import sys
+    import time
+
+    import pytest
+
+    if not hasattr(os, "fork"):
+        pytest.skip("no fork")
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    from _measure import measure
+
+    def call():
+        pids = []
+        for _ in range(2):
+            pid = os.fork()
+            if pid == 0:
+                t = time.process_time()
+                while time.process_time() - t < 0.2:
+                    pass
+                os._exit(0)
+            pids.append(pid)
+        for pid in pids:
+            os.waitpid(pid, 0)
+
+    m = measure(call)
+    assert m.cpu_seconds >= 0.38
