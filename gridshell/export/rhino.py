@@ -458,9 +458,12 @@ def write_3dm(bundle, path: str | os.PathLike, *, width: float | None = None,
         Draw the cut sheets (planned in memory as ``gridshell fabricate`` would).
     force : bool
         Draw the cut sheets of a design that fails its figures too.
+
+    The design check and the cut-sheet plan run in a second process (:mod:`gridshell.aside`,
+    forked on Linux) while this one builds the rest of the model; the file is the same.
     """
-    from ..bundle import read_bundle, read_design_json
     from ..aside import Aside
+    from ..bundle import read_bundle, read_design_json
     from .fabparams import export_params
 
     path = Path(path)
