@@ -491,3 +491,29 @@ def test_joints_too_close_for_holes_become_marks_with_a_note(tmp_path):
              for o in objs[n]}
     assert "score" in roles and "hole" not in roles
     assert not any("marks" in n for n in write_3dm(d, tmp_path / "ok.3dm", force=True)["notes"])
+
+
+@pytest.mark.parametrize("kind", ["AA", "CNC"])
+def test_design_check_finds_the_closest_points_the_export_asked_ahead(tmp_path, kind,
+                                                                       monkeypatch):
+    """The .3dm export asks the axes' and the joints' closest points before its design check
+    forks: the check of an NCP kind then asks igl nothing (it would otherwise build the
+    surface's tree again in the second process)."""
+    import gridshell.igl_adapter as ia
+    from gridshell.bundle import read_bundle
+    from gridshell.export.rhino import _ask_ahead
+    from gridshell.verification import design_verdict
+
+    monkeypatch.setattr(ia, "_QUERIES", ia.Recent(8, copy=ia._QUERIES.copy))   # empty
+    calls = []
+    real = ia.igl.point_mesh_squared_distance
+    monkeypatch.setattr(ia.igl, "point_mesh_squared_distance",
+                        lambda *a: calls.append(len(a[0])) or real(*a))
+    d = write_case(tmp_path / kind, kind)
+    design_verdict(d)                   # not asked ahead: the check asks igl
+    assert calls
+    monkeypatch.setattr(ia, "_QUERIES", ia.Recent(8, copy=ia._QUERIES.copy))
+    _ask_ahead(read_bundle(d))
+    calls.clear()
+    design_verdict(d)
+    assert calls == []

@@ -156,10 +156,35 @@ class _Model:
 def _clean_polyline(P: np.ndarray) -> np.ndarray:
     """``P (k,3)`` without consecutive repeated points."""
     P = np.asarray(P, float).reshape(-1, 3)
+    return P[_distinct(P)]
+
+
+def _distinct(P: np.ndarray) -> np.ndarray:
+    """The rows of ``P (k,3)`` that :func:`_clean_polyline` keeps (each that differs from the
+    one before), a boolean mask."""
     if len(P) < 2:
-        return P
-    keep = np.concatenate([[True], np.linalg.norm(np.diff(P, axis=0), axis=1) > 0])
-    return P[keep]
+        return np.ones(len(P), bool)
+    return np.concatenate([[True], np.linalg.norm(np.diff(P, axis=0), axis=1) > 0])
+
+
+def _axes_points(bundle) -> np.ndarray:
+    """Every lamella axis's points one after the other ``(sum k_i, 3)``, metres: the points
+    whose closest surface points the strips' frames and the design check
+    (:func:`gridshell.metrics.crossing_normal_curvature_on_mesh`) both ask."""
+    return np.concatenate([np.asarray(lam.axis, float).reshape(-1, 3)
+                           for lam in bundle.net.lamellae])
+
+
+def _ask_ahead(bundle) -> None:
+    """The closest surface points (and normals) of the axes and the closest points of the
+    joints asked now, in one igl query, and kept for reuse (:mod:`gridshell.igl_adapter`):
+    the strips ask the first, and the design check of an NCP kind asks both, in a process
+    forked after this (:mod:`gridshell.aside`) where it finds them."""
+    from ..igl_adapter import ask_closest_points, closest_points_with_normals
+
+    P, V, F = _axes_points(bundle), bundle.surface_V, bundle.surface_F
+    ask_closest_points([P, bundle.net.joints], V, F)
+    closest_points_with_normals(P, V, F, reuse=True)
 
 
 def unwelded_sides(V: np.ndarray, F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -195,16 +220,19 @@ def _strips(m: _Model, bundle, params, with_holes: bool) -> dict[str, Any]:
     tangent = is_tangent(bundle.kind)
     w, t = real_section_m(params.width, params.thickness, params.scale)
     radius = 0.5 * 1e-3 * params.hole / params.scale
-    lams = [(lam, _clean_polyline(lam.axis)) for lam in bundle.net.lamellae]
-    lams = [(lam, P) for lam, P in lams if len(P) >= 2]
+    axes = [np.asarray(lam.axis, float).reshape(-1, 3) for lam in bundle.net.lamellae]
+    keeps = [_distinct(P) for P in axes]
+    used = [k.sum() >= 2 for k in keeps]
+    lams = [(lam, P[k]) for lam, P, k, u in zip(bundle.net.lamellae, axes, keeps, used) if u]
     if not lams:
         return {"strips": 0, "holes": 0, "width_m": w, "thickness_m": t}
     # the surface normal interpolated at the closest point (smooth along the axis; the nearest
     # vertex's normal jumps from vertex to vertex and crinkles the strip: +1.7 % of area on
-    # the demo dome, 0.2 % with these)
-    # (reuse: the query the verification of the design asked, gridshell.verification)
-    normals = closest_points_with_normals(np.concatenate([P for _, P in lams]),
-                                          bundle.surface_V, bundle.surface_F, reuse=True)[1]
+    # the demo dome, 0.2 % with these), asked for every axis point (reuse: the query the
+    # verification of the design asks, gridshell.verification; igl answers each point alone)
+    normals = closest_points_with_normals(_axes_points(bundle), bundle.surface_V,
+                                          bundle.surface_F, reuse=True)[1]
+    normals = normals[np.concatenate([k & u for k, u in zip(keeps, used)])]
     # the frames of all lamellae in one pass each (strip_frames: the numbers of one
     # strip_frame per lamella)
     ends = np.cumsum([len(P) for _, P in lams])[:-1]
@@ -493,6 +521,8 @@ def write_3dm(bundle, path: str | os.PathLike, *, width: float | None = None,
     # the cut sheets (design check, then plan) computed aside, in a second process, while this
     # one builds the rest of the model: the same objects in the same order as one after the
     # other (gridshell.aside; one process where a fork is not safe)
+    if sheets:
+        _ask_ahead(bundle)
     with Aside(_cut_sheets, judged, bundle, fab, force) if sheets else nullcontext() as aside:
         _say(progress, f"writing {path}")
         body = _body(bundle, name=name, units=units, params=fab, bspline=bspline)
