@@ -134,13 +134,13 @@ def _joint_states(net: Net, states: list[np.ndarray] | np.ndarray) -> np.ndarray
 def move_joints_states(net: Net, states: list[np.ndarray] | np.ndarray) -> list[Net]:
     """:func:`move_joints` for every joint state of ``states`` (each ``(n,3)``, metres): the
     state-independent part of each axis (its joints inserted, the smooth curve through it) is
-    built once, and one displacement spline carries all states' columns at once."""
+    built once, and one displacement spline carries all states' columns at once (the splines
+    of all lamellae solved together, :func:`_carry_axes`)."""
     Js = _joint_states(net, states)
     if Js is None:
         return []
     per_lam = []
-    for lam in net.lamellae:
-        X, S, js, s_all = _carry_axis(lam, Js)
+    for lam, (X, S, js, s_all) in zip(net.lamellae, _carry_axes(net.lamellae, Js)):
         per_lam.append([Lamella(id=lam.id, family=lam.family, joints=lam.joints.copy(),
                                 joint_s=js.copy() if s_all is None else
                                 np.interp(js, s_all, S[k]), axis=X[k])
@@ -159,7 +159,7 @@ def carried_axes(net: Net, states: list[np.ndarray] | np.ndarray
     if Js is None:
         return [(np.zeros((0, len(lam.axis), 3)), np.zeros((0, len(lam.axis))))
                 for lam in net.lamellae]
-    return [_carry_axis(lam, Js)[:2] for lam in net.lamellae]
+    return [carried[:2] for carried in _carry_axes(net.lamellae, Js)]
 
 
 def _arclengths(X: np.ndarray) -> np.ndarray:
@@ -187,20 +187,18 @@ def _smooth_at(s: np.ndarray, X: np.ndarray, js: np.ndarray) -> np.ndarray:
     return CubicSpline(s, X, axis=0)(js)
 
 
-def _carry_axis(lam: Lamella, Js: np.ndarray
-                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]:
-    """``lam`` carried to each joint state ``Js (m, n, 3)``: the axes ``(m, p, 3)``, their arc
-    lengths ``(m, p)``, the joints' arc lengths ``js`` on the axis before the move and the arc
-    lengths ``s_all (p,)`` of the axis points before it (None when the axis is only shifted,
-    ``js`` then stays the joints' arc lengths), metres."""
-    from scipy.interpolate import CubicSpline
-
+def _axis_with_joints(lam: Lamella) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray,
+                                              float]:
+    """The state-independent part of :func:`_carry_axis` for an axis of two or more vertices
+    and one or more joints: the axis with its joints as vertices ``X (p,3)``, the arc lengths
+    ``s_all (p,)`` of its vertices, the joints' arc lengths ``js (k,)`` and points ``at (k,3)``
+    on it and its length, metres."""
     X, js = lam.axis, lam.joint_s
-    if len(X) < 2 or len(js) == 0:
-        Xs = np.stack([X + (J[lam.joints[0]] - X[0] if len(js) else 0) for J in Js])
-        return Xs, _arclengths(Xs), js, None
-    X = X[np.concatenate([[True], row_norms(np.diff(X, axis=0)) > 0])]
-    s = _arclengths(X[None])[0]                            # polyline_arclength(X)
+    seg = row_norms(np.diff(X, axis=0))
+    if not np.all(seg > 0):                                # repeated vertices go
+        X = X[np.concatenate([[True], seg > 0])]
+        seg = row_norms(np.diff(X, axis=0))
+    s = np.concatenate([[0.0], np.cumsum(seg)])            # polyline_arclength(X)
     js = np.clip(js, 0.0, s[-1])
     # the axis with its joints as vertices, placed on the smooth curve through the axis
     # vertices (not on a chord); vertices within a fifth of a segment of a joint give way
@@ -211,16 +209,70 @@ def _carry_axis(lam: Lamella, Js: np.ndarray
     order = np.argsort(np.concatenate([s[keep], js]), kind="stable")
     s_all = np.concatenate([s[keep], js])[order]
     X = np.concatenate([X[keep], at])[order]
-    D = Js[:, lam.joints] - at[None]                       # (m, k, 3)
+    return X, s_all, js, at, float(s[-1])
+
+
+def _carry_axis(lam: Lamella, Js: np.ndarray, joined: tuple | None = None,
+                d: np.ndarray | None = None
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]:
+    """``lam`` carried to each joint state ``Js (m, n, 3)``: the axes ``(m, p, 3)``, their arc
+    lengths ``(m, p)``, the joints' arc lengths ``js`` on the axis before the move and the arc
+    lengths ``s_all (p,)`` of the axis points before it (None when the axis is only shifted,
+    ``js`` then stays the joints' arc lengths), metres. ``joined``: :func:`_axis_with_joints`
+    of ``lam``, and ``d``: the displacements ``(p, 3m)`` at ``s_all`` by the spline, if known."""
+    X, js = lam.axis, lam.joint_s
+    if len(X) < 2 or len(js) == 0:
+        Xs = np.stack([X + (J[lam.joints[0]] - X[0] if len(js) else 0) for J in Js])
+        return Xs, _arclengths(Xs), js, None
+    X, s_all, js, at, length = _axis_with_joints(lam) if joined is None else joined
     m = len(Js)
-    if len(js) == 1 or js[-1] - js[0] <= 1e-12 * s[-1]:
+    if len(js) == 1 or js[-1] - js[0] <= 1e-12 * length:
+        D = Js[:, lam.joints] - at[None]                   # (m, k, 3)
         disp = np.broadcast_to(D.mean(axis=1)[:, None, :], (m,) + X.shape)
     else:
-        Dc = np.moveaxis(D, 0, 1).reshape(len(js), 3 * m)  # every state's columns at once
-        cs = CubicSpline(js, Dc, axis=0, bc_type="natural" if len(js) > 2 else "not-a-knot")
-        t = np.clip(s_all, js[0], js[-1])
-        slope0, slope1 = cs(js[[0, -1]], 1)                # the slopes at the end joints
-        d = cs(t) + (s_all - t)[:, None] * np.where((s_all < js[0])[:, None], slope0, slope1)
+        if d is None:
+            from scipy.interpolate import CubicSpline
+
+            D = Js[:, lam.joints] - at[None]
+            Dc = np.moveaxis(D, 0, 1).reshape(len(js), 3 * m)  # every state's columns at once
+            cs = CubicSpline(js, Dc, axis=0, bc_type="natural" if len(js) > 2 else "not-a-knot")
+            t = np.clip(s_all, js[0], js[-1])
+            slope0, slope1 = cs(js[[0, -1]], 1)            # the slopes at the end joints
+            d = cs(t) + (s_all - t)[:, None] * np.where((s_all < js[0])[:, None], slope0, slope1)
         disp = np.moveaxis(d.reshape(len(s_all), m, 3), 1, 0)
     Xs = X[None] + disp
     return Xs, _arclengths(Xs), js, s_all
+
+
+def _carry_axes(lams: list[Lamella], Js: np.ndarray
+                ) -> list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]]:
+    """:func:`_carry_axis` of each lamella of ``lams`` (metres), with the displacement splines
+    of all lamellae with two or more joints (finite, strictly increasing in arc length) built,
+    evaluated and added at once (:func:`gridshell.spline_batch.cubic_splines_at`, scipy's
+    numbers); the others go one by one, in order, as before."""
+    from .spline_batch import cubic_splines_at
+
+    out: list = [None] * len(lams)
+    batch = []
+    m = len(Js)
+    for i, lam in enumerate(lams):
+        joined = None
+        if len(lam.axis) >= 2 and len(lam.joint_s) >= 2:
+            joined = _axis_with_joints(lam)
+            _, s_all, js, at, length = joined
+            Dc = np.moveaxis(Js[:, lam.joints] - at[None], 0, 1).reshape(len(js), 3 * m)
+            # a finite length: a finite axis, finite s_all and js (clipped to it, or NaN)
+            if np.isfinite(length) and js[-1] - js[0] > 1e-12 * length \
+                    and np.all(np.diff(js) > 0) and np.all(np.isfinite(Dc)):
+                batch.append((i, joined, Dc))
+                continue
+        out[i] = _carry_axis(lam, Js, joined)
+    if not batch:
+        return out
+    idx, joined, Dc = zip(*batch)
+    d = cubic_splines_at([j[2] for j in joined], list(Dc), [j[1] for j in joined])  # (P, 3m)
+    b = 0
+    for i, j in zip(idx, joined):                          # lamella by lamella: in cache
+        a, b = b, b + len(j[1])
+        out[i] = _carry_axis(lams[i], Js, j, d[a:b])
+    return out
