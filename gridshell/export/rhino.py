@@ -230,8 +230,8 @@ def _strips(m: _Model, bundle, params, with_holes: bool) -> dict[str, Any]:
     # vertex's normal jumps from vertex to vertex and crinkles the strip: +1.7 % of area on
     # the demo dome, 0.2 % with these), asked for every axis point (reuse: the query the
     # verification of the design asks, gridshell.verification; igl answers each point alone)
-    normals = closest_points_with_normals(_axes_points(bundle), bundle.surface_V,
-                                          bundle.surface_F, reuse=True)[1]
+    normals = closest_points_with_normals(np.concatenate(axes), bundle.surface_V,
+                                          bundle.surface_F, reuse=True)[1]   # _axes_points
     normals = normals[np.concatenate([k & u for k, u in zip(keeps, used)])]
     # the frames of all lamellae in one pass each (strip_frames: the numbers of one
     # strip_frame per lamella)
