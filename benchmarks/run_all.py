@@ -227,23 +227,31 @@ def _ncp_write(curves: int) -> Callable[[], Any]:
 
 
 def _outputs(p: int | tuple[int, bool]) -> Callable[[], Any]:
-    """render.png, report.html and the .3dm of a written NCP bundle (``gridshell render
-    --report --3dm``); ``p`` the curves per family, or ``(curves, sheets)`` with
-    ``sheets=False`` for a .3dm without the cut sheets and their design check (``--no-sheets``:
-    the content nearest to the row of 2026-11-23, whose .3dm had neither)."""
-    from gridshell.export import export_3dm
+    """render.png, report.html and the .3dm of a written NCP bundle, as ``gridshell render
+    --report --3dm`` makes them (:func:`gridshell.outputs.write_outputs`: the .3dm built in a
+    second process while the pictures and the report are made); ``p`` the curves per family,
+    or ``(curves, sheets)`` with ``sheets=False`` for a .3dm without the cut sheets and their
+    design check (``--no-sheets``: the content nearest to the row of 2026-11-23, whose .3dm had
+    neither), or ``(curves, sheets, "serial")`` for the three calls one after the other
+    (render_bundle, export_3dm, write_report: the row as it was timed until 2026-12-03)."""
     from gridshell.api import design_ncp, write
-    from gridshell.render.report import write_report
-    from gridshell.render.ribbons import render_bundle
 
-    curves, sheets = p if isinstance(p, tuple) else (p, True)
+    curves, sheets, how = (*p, "outputs")[:3] if isinstance(p, tuple) else (p, True, "outputs")
     out = write(_tmpdir() / "ncp", design_ncp(_pseudosphere(), mode="aa", curves=curves))
+    if how == "serial":
+        from gridshell.export import export_3dm
+        from gridshell.render.report import write_report
+        from gridshell.render.ribbons import render_bundle
 
-    def run() -> Any:
-        render_bundle(out)
-        export_3dm(out, out / "ncp.3dm", sheets=sheets)
-        return write_report(out)
-    return run
+        def serial() -> Any:
+            render_bundle(out)
+            export_3dm(out, out / "ncp.3dm", sheets=sheets)
+            return write_report(out)
+        return serial
+    from gridshell.outputs import write_outputs
+
+    return lambda: write_outputs(out, report=True, rhino=out / "ncp.3dm",
+                                 rhino_options={"sheets": sheets})
 
 
 # ============================================================================ fabrication
@@ -340,7 +348,8 @@ STAGES: list[Stage] = [
                        "grows with the frames' size only; run it with --only ncp_write --full")]),
     Stage("outputs", "render.png + report.html + .3dm of an NCP bundle", _outputs,
           [Size("paper", 10, "10 curves per family"), Size("4x", 20, "20 curves"),
-           Size("4x-no-sheets", (20, False), "20 curves, .3dm without cut sheets")]),
+           Size("4x-no-sheets", (20, False), "20 curves, .3dm without cut sheets"),
+           Size("4x-serial", (20, True, "serial"), "20 curves, the three calls in turn")]),
     Stage("fabrication", "fabrication (fabricate, GG bundle, with plan)", _fabrication,
           [Size("paper", (10, 0.1), "10 lamellae per family, scale 1:10"),
            Size("4x", (20, 0.2), "20 lamellae (4x joints), scale 1:5"),

@@ -2,12 +2,12 @@
 
 The Python API (:mod:`gridshell.api`), loaded on first use so that ``import gridshell`` stays
 cheap: ``design_gg``, ``design_ncp``, ``optimize_phlw``, ``write``, ``read``, ``verify``,
-``fabricate``, ``export_3dm``, ``Design``, ``DesignBundle``.
+``fabricate``, ``export_3dm``, ``write_outputs``, ``Design``, ``DesignBundle``.
 """
 __version__ = "0.1.0"
 
 __all__ = ["Design", "DesignBundle", "design_gg", "design_ncp", "export_3dm", "fabricate",
-           "optimize_phlw", "read", "verify", "write"]
+           "optimize_phlw", "read", "verify", "write", "write_outputs"]
 
 
 def __getattr__(name: str):

@@ -9,6 +9,8 @@
     gs.verify("out/gg")["ok"]                   # the figures recomputed from the files
     gs.fabricate("out/gg", "out/gg/fabrication", {"width": 20, "scale": "1:10"})
     gs.export_3dm("out/gg", "out/gg/gg.3dm")    # strips, holes, surface, cut sheets for Rhino
+    gs.write_outputs("out/gg", report=True, rhino="out/gg/gg.3dm")  # render.png, report.html,
+                                                # and the .3dm built meanwhile (two cores)
 
 The functions are those of the modules that implement them (named in each docstring); the
 ``gridshell`` command calls the same ones.
@@ -24,7 +26,7 @@ from .errors import InputError
 from .verification import design_verdict, verify_bundle
 
 __all__ = ["Design", "DesignBundle", "design_gg", "design_ncp", "export_3dm", "fabricate",
-           "optimize_phlw", "read", "verify", "write"]
+           "optimize_phlw", "read", "verify", "write", "write_outputs"]
 
 Progress = Callable[[str], None] | None
 
@@ -144,3 +146,12 @@ def export_3dm(design: Any, path: str | os.PathLike, **options: Any) -> dict[str
 
     bundle = design if isinstance(design, (str, os.PathLike)) else _parts(design)[0]
     return write_3dm(bundle, path, **options)
+
+
+def write_outputs(bundle: str | os.PathLike, **options: Any) -> dict[str, Any]:
+    """render.png, alignment.gif, report.html and a .3dm of a bundle directory in one call
+    (``gridshell render``), the .3dm built in a second process meanwhile; options and result of
+    :func:`gridshell.outputs.write_outputs`."""
+    from .outputs import write_outputs as run
+
+    return run(bundle, **options)

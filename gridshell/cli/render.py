@@ -42,8 +42,8 @@ def run(args: Any) -> int:
     from ..atomic import check_output
     from ..bundle import read_design_json
     from ..errors import InputError
-    from ..render.ribbons import render_bundle
-    from ..render.sequence import render_bundle_sequence, sequence_files
+    from ..outputs import write_outputs
+    from ..render.sequence import sequence_files
     from .common import Progress, print_summary
 
     progress = Progress(args)
@@ -58,11 +58,6 @@ def run(args: Any) -> int:
         raise InputError(f"--size must be 64 to 10000 pixels each way, got {args.size}")
     written: list[str] = []
 
-    progress("rendering render.png")
-    width_m = None if args.width is None else args.width / 1000.0
-    out = render_bundle(bundle, width=width_m, size=tuple(args.size))
-    written.append(out.name)
-
     frames = sequence_files(bundle)
     gif = bundle / "alignment.gif"
     sequence = "none in the bundle"
@@ -71,24 +66,19 @@ def run(args: Any) -> int:
     elif frames and _sequence_is_current(bundle, gif) and not args.force:
         sequence = f"{len(frames)} frames, alignment.gif up to date (--force re-renders)"
     elif frames:
-        res = render_bundle_sequence(bundle, progress=progress.callback)
         sequence = f"{len(frames)} frames -> alignment.gif"
-        written += [f"sequence/frame_*.png ({len(res['frames'])})", gif.name]
-
-    report = None
-    if args.report:
-        from ..render.report import write_report
-
-        progress("writing report.html")
-        report = write_report(bundle)
+    res = write_outputs(bundle, sequence=sequence.endswith("-> alignment.gif"),
+                        report=args.report, rhino=args.rhino,
+                        width=None if args.width is None else args.width / 1000.0,
+                        size=tuple(args.size), progress=progress.callback)
+    out, report, info = res["render"], res["report"], res["rhino"]
+    written.append(out.name)
+    if res["sequence"] is not None:
+        written += [f"sequence/frame_*.png ({len(res['sequence']['frames'])})", gif.name]
+    if report is not None:
         written.append(report.name)
-
     rhino = None
-    if args.rhino:
-        from ..export.rhino import write_3dm
-
-        progress(f"exporting {args.rhino}")
-        info = write_3dm(bundle, args.rhino, progress=progress.detail)
+    if info is not None:
         rhino = info["path"]
         for note in info["notes"]:
             progress(f"note: {note}")

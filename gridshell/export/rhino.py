@@ -490,13 +490,39 @@ def write_3dm(bundle, path: str | os.PathLike, *, width: float | None = None,
     The design check and the cut-sheet plan run in a second process (:mod:`gridshell.aside`,
     forked on Linux) while this one builds the rest of the model; the file is the same.
     """
+    path = check_3dm_path(path)
+    with atomic_path(path) as tmp:
+        info = write_model(bundle, tmp, width=width, thickness=thickness, hole=hole,
+                           scale=scale, sheet=sheet, params=params, units=units, sheets=sheets,
+                           force=force, progress=progress, shown=path)
+    info["path"] = str(path)
+    return info
+
+
+def check_3dm_path(path: str | os.PathLike) -> Path:
+    """``path`` as a Path; :class:`InputError` unless it ends in ``.3dm``."""
+    path = Path(path)
+    if path.suffix.lower() != ".3dm":
+        raise InputError(f"{path.name}: a Rhino file needs the extension .3dm")
+    return path
+
+
+def write_model(bundle, tmp: str | os.PathLike, *, width: float | None = None,
+                thickness: float | None = None, hole: float | None = None,
+                scale: Any = None, sheet: Any = None, params: Any = None, units: Any = None,
+                sheets: bool = True, force: bool = False,
+                progress: Callable[[str], None] | None = None,
+                shown: str | os.PathLike | None = None) -> dict[str, Any]:
+    """The body of :func:`write_3dm` (same parameters): build the model and write it to
+    ``tmp`` as it is - no rename, no manifest: the caller publishes ``tmp``
+    (:func:`gridshell.atomic.atomic_path`; :mod:`gridshell.outputs` runs this in a second
+    process). ``shown`` is the path progress and errors name (default ``tmp``). Returns what
+    :func:`write_3dm` returns but ``path``."""
     from ..aside import Aside
     from ..bundle import read_bundle, read_design_json
     from .fabparams import export_params
 
-    path = Path(path)
-    if path.suffix.lower() != ".3dm":
-        raise InputError(f"{path.name}: a Rhino file needs the extension .3dm")
+    shown = tmp if shown is None else shown
     bundle_dir = None
     if isinstance(bundle, (str, os.PathLike)):
         bundle_dir = Path(bundle)
@@ -524,7 +550,7 @@ def write_3dm(bundle, path: str | os.PathLike, *, width: float | None = None,
     if sheets:
         _ask_ahead(bundle)
     with Aside(_cut_sheets, judged, bundle, fab, force) if sheets else nullcontext() as aside:
-        _say(progress, f"writing {path}")
+        _say(progress, f"writing {shown}")
         body = _body(bundle, name=name, units=units, params=fab, bspline=bspline)
         layout = None
         if aside is not None:
@@ -542,11 +568,9 @@ def write_3dm(bundle, path: str | os.PathLike, *, width: float | None = None,
     model, info = _finish(body, layout=layout, params_source=source)
     if info["note"]:
         notes.append(info["note"])
-    with atomic_path(path) as tmp:
-        if not model.Write(str(tmp), _FILE_VERSION):
-            raise OutputError(f"rhino3dm could not write {path}; check the location is "
-                              "writable")
-    info.update(path=str(path), params=fab.to_json(), params_source=source, notes=notes)
+    if not model.Write(str(tmp), _FILE_VERSION):
+        raise OutputError(f"rhino3dm could not write {shown}; check the location is writable")
+    info.update(params=fab.to_json(), params_source=source, notes=notes)
     return info
 
 
