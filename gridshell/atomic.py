@@ -27,9 +27,11 @@ def atomic_path(path: str | os.PathLike) -> Iterator[Path]:
     """Yield a temporary path beside ``path``; rename it onto ``path`` only if the block succeeds.
 
     A file written into an existing output directory (``render.png`` into a bundle) is added
-    to its manifest (:func:`gridshell.manifest.register`)."""
+    to its manifest (:func:`gridshell.manifest.register`). Directories made for ``path`` are
+    removed again if the block fails (and nothing else came into them)."""
     path = Path(path)
     parent = path.parent if str(path.parent) else Path(".")
+    made = [d for d in (parent, *parent.parents) if not os.path.lexists(d)]   # deepest first
     try:
         parent.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp" + path.suffix, dir=parent)
@@ -39,6 +41,7 @@ def atomic_path(path: str | os.PathLike) -> Iterator[Path]:
         raise OutputError(f"cannot write to {parent}: {exc.strerror or exc}. "
                           "Choose a writable output location.") from exc
     tmp_path = Path(tmp)
+    published = False
     try:
         yield tmp_path
         from . import finite
@@ -49,12 +52,24 @@ def atomic_path(path: str | os.PathLike) -> Iterator[Path]:
         except OSError as exc:
             raise OutputError(f"cannot write {path}: {exc.strerror or exc}. Choose a writable "
                               "output location.") from exc
+        published = True
         from . import manifest
 
         manifest.register(path)
     finally:
         if tmp_path.exists():
             tmp_path.unlink()
+        if not published:
+            _remove_empty(made)
+
+
+def _remove_empty(made: list[Path]) -> None:
+    """Remove the directories ``made`` (deepest first) while they are empty."""
+    for d in made:
+        try:
+            os.rmdir(d)
+        except OSError:         # not empty (something else came in) or gone: leave the rest
+            return
 
 
 def write_text(path: str | os.PathLike, text: str) -> None:

@@ -123,6 +123,17 @@ def test_a_failing_model_raises_its_error_after_the_pictures(tmp_path):
     assert _hidden(d) == [] and _no_children()
 
 
+def test_a_failing_model_leaves_no_directory_it_made(tmp_path):
+    d = _case(tmp_path / "case", "AA")
+    with pytest.raises(InputError):
+        outputs.write_outputs(d, png=False, rhino=tmp_path / "new" / "sub" / "m.3dm",
+                              rhino_options={"sheet": "no size"})
+    with pytest.raises(InputError):
+        write_3dm(d, tmp_path / "other" / "m.3dm", sheet="no size")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["case"]
+    assert _no_children()
+
+
 def test_bad_requests_fail_before_anything_is_written(tmp_path):
     d = _case(tmp_path / "case", "AA")
     before = sorted(p.name for p in d.iterdir())

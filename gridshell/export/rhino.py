@@ -491,10 +491,9 @@ def write_3dm(bundle, path: str | os.PathLike, *, width: float | None = None,
     forked on Linux) while this one builds the rest of the model; the file is the same.
     """
     path = check_3dm_path(path)
-    with atomic_path(path) as tmp:
-        info = write_model(bundle, tmp, width=width, thickness=thickness, hole=hole,
-                           scale=scale, sheet=sheet, params=params, units=units, sheets=sheets,
-                           force=force, progress=progress, shown=path)
+    info = write_model(bundle, path, width=width, thickness=thickness, hole=hole, scale=scale,
+                       sheet=sheet, params=params, units=units, sheets=sheets, force=force,
+                       progress=progress, publish=True)
     info["path"] = str(path)
     return info
 
@@ -507,22 +506,22 @@ def check_3dm_path(path: str | os.PathLike) -> Path:
     return path
 
 
-def write_model(bundle, tmp: str | os.PathLike, *, width: float | None = None,
+def write_model(bundle, path: str | os.PathLike, *, width: float | None = None,
                 thickness: float | None = None, hole: float | None = None,
                 scale: Any = None, sheet: Any = None, params: Any = None, units: Any = None,
                 sheets: bool = True, force: bool = False,
-                progress: Callable[[str], None] | None = None,
+                progress: Callable[[str], None] | None = None, publish: bool = False,
                 shown: str | os.PathLike | None = None) -> dict[str, Any]:
-    """The body of :func:`write_3dm` (same parameters): build the model and write it to
-    ``tmp`` as it is - no rename, no manifest: the caller publishes ``tmp``
-    (:func:`gridshell.atomic.atomic_path`; :mod:`gridshell.outputs` runs this in a second
-    process). ``shown`` is the path progress and errors name (default ``tmp``). Returns what
-    :func:`write_3dm` returns but ``path``."""
+    """The body of :func:`write_3dm` (same parameters): build the model, then write it to
+    ``path`` - atomically with ``publish`` (:func:`gridshell.atomic.atomic_path`: temporary
+    file, rename, manifest entry), else as it is, into a temporary file the caller publishes
+    (:mod:`gridshell.outputs` runs this in a second process). ``shown`` is the path progress and
+    errors name (default ``path``). Returns what :func:`write_3dm` returns but ``path``."""
     from ..aside import Aside
     from ..bundle import read_bundle, read_design_json
     from .fabparams import export_params
 
-    shown = tmp if shown is None else shown
+    shown = path if shown is None else shown
     bundle_dir = None
     if isinstance(bundle, (str, os.PathLike)):
         bundle_dir = Path(bundle)
@@ -568,8 +567,10 @@ def write_model(bundle, tmp: str | os.PathLike, *, width: float | None = None,
     model, info = _finish(body, layout=layout, params_source=source)
     if info["note"]:
         notes.append(info["note"])
-    if not model.Write(str(tmp), _FILE_VERSION):
-        raise OutputError(f"rhino3dm could not write {shown}; check the location is writable")
+    with atomic_path(path) if publish else nullcontext(path) as tmp:
+        if not model.Write(str(tmp), _FILE_VERSION):
+            raise OutputError(f"rhino3dm could not write {shown}; check the location is "
+                              "writable")
     info.update(params=fab.to_json(), params_source=source, notes=notes)
     return info
 
