@@ -52,7 +52,7 @@ def write_outputs(bundle: str | os.PathLike, *, png: bool = True, sequence: bool
         ``report`` (Path or None), ``rhino`` (what :func:`~gridshell.export.rhino.write_3dm`
         returns, or None).
     """
-    from .aside import Aside
+    from .aside import Aside, can_fork
     from .atomic import atomic_path
     from .bundle import read_bundle
 
@@ -71,7 +71,7 @@ def write_outputs(bundle: str | os.PathLike, *, png: bool = True, sequence: bool
                                 "built in another process, which prints nothing)")
             read_bundle(bundle)             # read once, before the fork: both processes have it
             tmp = stack.enter_context(atomic_path(path))
-            say(f"exporting {path} (in a second process)")
+            say(f"exporting {path}" + (" (in a second process)" if can_fork() else ""))
             job = stack.enter_context(Aside(write_model, bundle, tmp, shown=path, **options))
         if png:
             from .render.ribbons import render_bundle
