@@ -226,7 +226,7 @@ def _ncp_write(curves: int) -> Callable[[], Any]:
     return lambda: write(out, design, render=True)
 
 
-def _outputs(p: int | tuple[int, bool]) -> Callable[[], Any]:
+def _outputs(p: int | tuple) -> Callable[[], Any]:
     """render.png, report.html and the .3dm of a written NCP bundle, as ``gridshell render
     --report --3dm`` makes them (:func:`gridshell.outputs.write_outputs`: the .3dm built in a
     second process while the pictures and the report are made); ``p`` the curves per family,

@@ -38,6 +38,7 @@ def atomic_path(path: str | os.PathLike) -> Iterator[Path]:
         os.close(fd)
         _publish_mode(Path(tmp))
     except OSError as exc:
+        _remove_empty(made)
         raise OutputError(f"cannot write to {parent}: {exc.strerror or exc}. "
                           "Choose a writable output location.") from exc
     tmp_path = Path(tmp)
