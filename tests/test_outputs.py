@@ -15,6 +15,7 @@ from render_cases import make_bundle, write_case
 from test_aside import _objects
 
 from gridshell import outputs
+from gridshell.aside import can_fork
 from gridshell.bundle import write_bundle
 from gridshell.errors import InputError
 from gridshell.export.rhino import write_3dm
@@ -61,7 +62,7 @@ def test_outputs_equal_the_calls_one_after_the_other(tmp_path, monkeypatch, kind
                                                      serial):
     if serial:
         monkeypatch.setenv("GRIDSHELL_SERIAL", "1")
-    elif not outputs_fork():
+    elif not can_fork():
         pytest.skip("no fork here")
     a = _case(tmp_path / "a" / "case", kind)
     b = shutil.copytree(a, tmp_path / "b" / "case")
@@ -87,12 +88,6 @@ def test_outputs_equal_the_calls_one_after_the_other(tmp_path, monkeypatch, kind
     assert sorted(p.name for p in a.iterdir()) == sorted(p.name for p in b.iterdir())
     assert _manifest(a) == _manifest(b)
     assert _hidden(a) == [] and _no_children()
-
-
-def outputs_fork() -> bool:
-    from gridshell.aside import can_fork
-
-    return can_fork()
 
 
 def test_a_failing_render_leaves_no_model_and_no_process(tmp_path, monkeypatch):
@@ -146,7 +141,7 @@ def test_bad_requests_fail_before_anything_is_written(tmp_path):
 
 def test_the_model_is_built_in_another_process_where_it_can_fork(tmp_path, monkeypatch):
     """The parent never builds the model where it can fork; with GRIDSHELL_SERIAL=1 it does."""
-    if not outputs_fork():
+    if not can_fork():
         pytest.skip(f"no fork here ({sys.platform}, {threading.active_count()} threads)")
     import gridshell.export.rhino as rhino
 
