@@ -71,7 +71,9 @@ def write_outputs(bundle: str | os.PathLike, *, png: bool = True, sequence: bool
                                 "built in another process, which prints nothing)")
             read_bundle(bundle)             # read once, before the fork: both processes have it
             tmp = stack.enter_context(atomic_path(path))
-            say(f"exporting {path}" + (" (in a second process)" if can_fork() else ""))
+            inside = path.resolve().parent == bundle.resolve()
+            say(f"exporting {path.name if inside else path}"
+                + (" (in a second process)" if can_fork() else ""))
             job = stack.enter_context(Aside(write_model, bundle, tmp, shown=path, **options))
         if png:
             from .render.ribbons import render_bundle

@@ -76,23 +76,19 @@ def _checks(kind: str, metrics: dict) -> str:
 
 
 def _finish(d: Path, label: str, name: str, fab_params: dict, progress) -> dict[str, Any]:
-    """Render, export, cut and report a written bundle ``d``; returns the fabrication report."""
+    """Cut, check, render, export and report a written bundle ``d``; returns the fabrication
+    report. The pictures, the report and the .3dm come from one call
+    (:func:`gridshell.outputs.write_outputs`: the .3dm built beside the pictures)."""
     from fabrication import fabricate
 
-    from ..export.rhino import export_3dm
-    from ..render.report import write_report
-    from ..render.ribbons import render_bundle
+    from ..outputs import write_outputs
 
-    progress(f"{label}: rendering render.png (lamellae as strips of their real section)")
-    render_bundle(d)
     progress(f"{label}: cut files ({fab_params['scale']}, {fab_params['thickness']:g} mm "
              "polypropylene)")
     fab = fabricate(d, d / "fabrication", fab_params, progress=progress.detail)
     fab = dict(fab, structure=_structure(d, label, fab_params, progress))
-    progress(f"{label}: exporting {name}.3dm (Rhino: strips, holes, surface, cut sheets)")
-    export_3dm(d, d / f"{name}.3dm", params=fab_params, progress=progress.detail)
-    progress(f"{label}: writing report.html")
-    write_report(d)
+    write_outputs(d, report=True, rhino=d / f"{name}.3dm", rhino_options={"params": fab_params},
+                  progress=lambda msg: progress(f"{label}: {msg}"))
     return fab
 
 
