@@ -60,14 +60,14 @@ def run(args: Any) -> int:
 
     frames = sequence_files(bundle)
     gif = bundle / "alignment.gif"
-    sequence = "none in the bundle"
+    sequence, animate = "none in the bundle", False
     if frames and args.no_sequence:
         sequence = f"{len(frames)} frames, not rendered (--no-sequence)"
     elif frames and _sequence_is_current(bundle, gif) and not args.force:
         sequence = f"{len(frames)} frames, alignment.gif up to date (--force re-renders)"
     elif frames:
-        sequence = f"{len(frames)} frames -> alignment.gif"
-    res = write_outputs(bundle, sequence=sequence.endswith("-> alignment.gif"),
+        sequence, animate = f"{len(frames)} frames -> alignment.gif", True
+    res = write_outputs(bundle, sequence=animate,
                         report=args.report, rhino=args.rhino,
                         width=None if args.width is None else args.width / 1000.0,
                         size=tuple(args.size), progress=progress.callback)
