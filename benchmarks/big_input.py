@@ -28,19 +28,19 @@ from pathlib import Path
 
 #: the stages of ``gridshell gg``: (module, function, label), in pipeline order
 STAGES = [
-    ("gridshell.meshfile", "read_polygons", "read the file"),
+    ("gridshell.geometry.meshfile", "read_polygons", "read the file"),
     ("gridshell.io.read", "read_input", "clean + checks (full mesh)"),
     ("gridshell.io.working", "working_mesh", "working copy (pymeshlab)"),
     ("gridshell.gg.initial", "initial_grid", "initial grid"),
     ("gridshell.gg.design", "design_gg_surface", "surface design (LM, excl. tracing)"),
     ("gridshell.gg.pipeline", "gg_net_from_mesh", "trace the net"),
-    ("gridshell.igl_adapter", "closest_points", "closest points (igl AABB)"),
+    ("gridshell.geometry.igl_adapter", "closest_points", "closest points (igl AABB)"),
     ("gridshell.gg.pipeline", "gg_metrics", "figures (excl. closest points)"),
     ("gridshell.gg.pipeline", "gg_alignment_sequence", "alignment sequence"),
     ("gridshell.api", "write", "bundle writing"),
     ("gridshell.render.net_preview", "net_preview", "pictures"),
-    ("gridshell.render.states", "sequence_pngs", "pictures"),
-    ("gridshell.render.states", "states_png", "pictures"),
+    ("gridshell.render.state_sheet", "sequence_pngs", "pictures"),
+    ("gridshell.render.state_sheet", "states_png", "pictures"),
     ("gridshell.render.ncp_maps", "gif", "pictures"),
 ]
 
@@ -123,7 +123,7 @@ def run(target: Path, out: Path, options: list[str]) -> dict:
 def main() -> None:
     if len(sys.argv) > 2 and sys.argv[1] == "--child":
         sys.exit(_child(sys.argv[3:], sys.argv[2]))
-    from gridshell.meshfile import write_mesh
+    from gridshell.geometry.meshfile import write_mesh
 
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
     from io_cases import hill  # the tests' hill, one definition

@@ -14,7 +14,7 @@ and ``gridshell fabricate DIR -o DIR/fab`` (the defaults: 1:10, 20 x 1 mm polypr
 on 600 x 400 mm sheets).
 
 A run **succeeds** when it exits 0, every figure of design.json is within the paper's
-thresholds (:func:`gridshell.quality.design_gates`), ``verify`` says ``ok: true`` and
+thresholds (:func:`gridshell.measure.quality.design_gates`), ``verify`` says ``ok: true`` and
 ``fabricate`` exits 0. The summary gives the success rate per pipeline and mode, the runs that
 exit 0 while a figure fails (must be none), the runs that say ``ok: true`` in verify while a
 recomputed figure fails, the runs whose reports say converged while an optimizer's energy ended
@@ -50,7 +50,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from gridshell.corpus import MODES, Reference, select  # noqa: E402
-from gridshell.quality import design_gates, gate_summary, passed  # noqa: E402
+from gridshell.measure.quality import design_gates, gate_summary, passed  # noqa: E402
 
 #: extra runs: the PHLW step alone (``--phlw``)
 PHLW_MODES = {"phlw-phlw": ["phlw", "--mode", "phlw"], "phlw-cnc": ["phlw", "--mode", "cnc"],

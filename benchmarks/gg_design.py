@@ -17,7 +17,7 @@ import numpy as np
 
 from gridshell.gg.design import design_gg_surface
 from gridshell.gg.pipeline import gg_score
-from gridshell.grid import grid_quads
+from gridshell.geometry.grid import grid_quads
 from gridshell.solver.linear import default_backend
 
 

@@ -16,7 +16,7 @@ import time
 import numpy as np
 
 from gridshell.gg.pipeline import collapse_gg, design_gg, gg_metrics, gg_net_from_mesh
-from gridshell.grid import grid_quads
+from gridshell.geometry.grid import grid_quads
 
 
 def helicoid(n: int, c: float = 0.5) -> np.ndarray:

@@ -16,16 +16,16 @@ import tracemalloc
 
 import numpy as np
 
-from gridshell.bspline import BSplineSurface, fit_grid
-from gridshell.metrics import alignability_error, delta_l, delta_n
+from gridshell.geometry.bspline import BSplineSurface, fit_grid
+from gridshell.measure.metrics import alignability_error, delta_l, delta_n
 from gridshell.ncp.collapse import collapse_curve
-from gridshell.bspline import uniform_params
+from gridshell.geometry.bspline import uniform_params
 from gridshell.ncp.directions import net_directions
 from gridshell.ncp.levelset import trace
 from gridshell.api import write
 from gridshell.ncp.pipeline import design_ncp
 from gridshell.ncp.postopt import post_optimize
-from gridshell.ncp.simulate import collapse_direction, simulate_alignment
+from gridshell.ncp.alignment import collapse_direction, simulate_alignment
 
 
 def pseudosphere():

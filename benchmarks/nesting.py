@@ -2,10 +2,10 @@
 
 For each bundle (default the demo's ``out/demo/gg`` and ``out/demo/ncp``: run ``make demo``
 first) with the demo's cut-file parameters, and each gap (mm) and rotation rule, the parts are
-nested twice in one run: with :data:`fabrication.nesting.RASTER` emptied (the drop strategies
+nested twice in one run: with :data:`gridshell.fabrication.nesting.RASTER` emptied (the drop strategies
 and rows only) and as shipped. Prints the sheet count, the floor (:func:`gap_bound`), the
 15 % area bound (:func:`sheet_bound`), the material used per sheet and the CPU and wall
-seconds of :func:`fabrication.nesting.nest` (the machine may be loaded: compare CPU times).
+seconds of :func:`gridshell.fabrication.nesting.nest` (the machine may be loaded: compare CPU times).
 
     .venv/bin/python benchmarks/nesting.py [BUNDLE ...] [--gap 5 3 2] [--rotation free grain]
 """
@@ -20,9 +20,9 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from fabrication import FabParams, nesting  # noqa: E402
-from fabrication.pipeline import plan_parts  # noqa: E402
-from gridshell.bundle import read_bundle  # noqa: E402
+from gridshell.fabrication import FabParams, nesting  # noqa: E402
+from gridshell.fabrication.pipeline import plan_parts  # noqa: E402
+from gridshell.design.bundle import read_bundle  # noqa: E402
 from gridshell.cli.demo import FABRICATION  # noqa: E402
 
 

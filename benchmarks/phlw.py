@@ -12,7 +12,7 @@ import tracemalloc
 
 import numpy as np
 
-from gridshell.grid import grid_quads
+from gridshell.geometry.grid import grid_quads
 from gridshell.ncp import phlw as P
 from gridshell.ncp.reference import initial_surface
 

@@ -90,7 +90,7 @@ def _gg_design(n: int) -> Callable[[], Any]:
 
     from gridshell.gg.design import design_gg_surface
     from gridshell.gg.pipeline import gg_score
-    from gridshell.grid import grid_quads
+    from gridshell.geometry.grid import grid_quads
 
     P0 = dome_grid(n, n)
     V, F = P0.reshape(-1, 3), grid_quads(n, n)
@@ -111,7 +111,7 @@ def _gg_pipeline(n: int) -> Callable[[], Any]:
     from gg_pipeline import helicoid
 
     from gridshell.gg.pipeline import design_gg
-    from gridshell.grid import grid_quads
+    from gridshell.geometry.grid import grid_quads
 
     P = helicoid(n)
     V, F = P.reshape(-1, 3), grid_quads(n, n)
@@ -178,7 +178,7 @@ def _postopt(curves: int) -> Callable[[], Any]:
 
 def _simulation(curves: int) -> Callable[[], Any]:
     from gridshell.ncp.postopt import post_optimize
-    from gridshell.ncp.simulate import collapse_direction, simulate_alignment
+    from gridshell.ncp.alignment import collapse_direction, simulate_alignment
 
     surf, tn, col = _traced_net(curves)
     post = post_optimize(surf, tn.net, tn.joint_uv, col)
@@ -194,7 +194,7 @@ def _ncp_e2e(n: int) -> Callable[[], Any]:
     from phlw import saddle
 
     from gridshell.cli.main import main
-    from gridshell.meshfile import write_mesh
+    from gridshell.geometry.meshfile import write_mesh
 
     V, F = saddle(n)
     tmp = _tmpdir()
@@ -228,7 +228,7 @@ def _ncp_write(curves: int) -> Callable[[], Any]:
 
 def _outputs(p: int | tuple) -> Callable[[], Any]:
     """render.png, report.html and the .3dm of a written NCP bundle, as ``gridshell render
-    --report --3dm`` makes them (:func:`gridshell.outputs.write_outputs`: the .3dm built in a
+    --report --3dm`` makes them (:func:`gridshell.workflow.outputs.write_outputs`: the .3dm built in a
     second process while the pictures and the report are made); ``p`` the curves per family,
     or ``(curves, sheets)`` with ``sheets=False`` for a .3dm without the cut sheets and their
     design check (``--no-sheets``: the content nearest to the row of 2026-11-23, whose .3dm had
@@ -248,7 +248,7 @@ def _outputs(p: int | tuple) -> Callable[[], Any]:
             export_3dm(out, out / "ncp.3dm", sheets=sheets)
             return write_report(out)
         return serial
-    from gridshell.outputs import write_outputs
+    from gridshell.workflow.outputs import write_outputs
 
     return lambda: write_outputs(out, report=True, rhino=out / "ncp.3dm",
                                  rhino_options={"sheets": sheets})
@@ -258,14 +258,14 @@ def _outputs(p: int | tuple) -> Callable[[], Any]:
 
 def _fabrication(p: tuple[int, float]) -> Callable[[], Any]:
     """``fabricate`` of a GG bundle. The DXF writer (ezdxf, ~0.2 s to import) is imported in
-    the set-up, as ``fabrication.pipeline`` itself imported it until 2026-12-02 (it is lazy
+    the set-up, as ``gridshell.fabrication.pipeline`` itself imported it until 2026-12-02 (it is lazy
     since, for the .3dm export): the row times fabricating, not importing."""
-    import fabrication.dxf  # noqa: F401
-    from fabrication.pipeline import fabricate
+    import gridshell.fabrication.dxf  # noqa: F401
+    from gridshell.fabrication.pipeline import fabricate
     from gg_pipeline import helicoid
 
     from gridshell.gg.pipeline import design_gg
-    from gridshell.grid import grid_quads
+    from gridshell.geometry.grid import grid_quads
 
     n_lamellae, scale = p
     P = helicoid(30)
@@ -283,7 +283,7 @@ def _fabrication(p: tuple[int, float]) -> Callable[[], Any]:
 
 def _max_samples() -> int:
     try:
-        from gridshell.bspline import MAX_SAMPLES
+        from gridshell.geometry.bspline import MAX_SAMPLES
     except ImportError:
         return 5_000_000
     return int(MAX_SAMPLES)
@@ -325,7 +325,7 @@ STAGES: list[Stage] = [
           [Size("paper", 1200, "1200x1200 samples"),
            Size("3.5x", _M, f"{_M}x{_M} samples (the library's limit)"),
            Size("16x", 4800, "4800x4800 samples",
-                capped=f"gridshell.bspline refuses more than {_MAX_SAMPLES} samples (4x would be "
+                capped=f"gridshell.geometry.bspline refuses more than {_MAX_SAMPLES} samples (4x would be "
                        "2400x2400); 4800x4800 took 9.4 s and 279 MB before that limit")]),
     Stage("ncp_postopt", "NCP post-optimization", _postopt,
           [Size("paper", 10, "10 curves per family"), Size("4x", 20, "20 curves (4x joints)"),

@@ -179,8 +179,8 @@ def gg_round_problem(n: int) -> tuple[Problem, np.ndarray]:
     """Round 1 of ``design_gg_surface`` on the dome grid of ``gg_design.py``: the same terms
     and default weights (geodesic, lengths, gliding on the target's tangent planes, fairness
     1e-4, elastic 3, proximity 1e-2; boundary gliding left out), from the grid itself."""
-    from gridshell.grid import grid_quads
-    from gridshell.igl_adapter import closest_points_with_normals, triangulate
+    from gridshell.geometry.grid import grid_quads
+    from gridshell.geometry.igl_adapter import closest_points_with_normals, triangulate
 
     x, y = np.meshgrid(np.linspace(-1, 1, n), np.linspace(-0.8, 0.8, n), indexing="ij")
     P0 = np.stack([x, y, -(x ** 2 / 2.0 + y ** 2 / 2.2)], axis=-1)
@@ -214,8 +214,8 @@ def phlw_round_problem(n: int) -> tuple[Problem, np.ndarray]:
     bi-degree 4) on the saddle ``z = 0.3 (x^2 - y^2)`` of ``phlw.py``, with ``n`` samples
     per side: its own terms (eqs. 4.2-4.8 with auxiliary variables, E_beta, closeness,
     gliding), built by ``phlw_problem``."""
-    from gridshell.bspline import uniform_params
-    from gridshell.grid import grid_quads
+    from gridshell.geometry.bspline import uniform_params
+    from gridshell.geometry.grid import grid_quads
     from gridshell.ncp import phlw as P
     from gridshell.ncp.reference import initial_surface
 
@@ -329,7 +329,7 @@ def _simulation_frames(curves: int) -> Callable[[], Any]:
     from run_all import _traced_net
 
     from gridshell.ncp.postopt import post_optimize
-    from gridshell.ncp.simulate import collapse_direction, simulate_alignment
+    from gridshell.ncp.alignment import collapse_direction, simulate_alignment
 
     surf, tn, col = _traced_net(curves)
     post = post_optimize(surf, tn.net, tn.joint_uv, col)

@@ -19,7 +19,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from gridshell.bundle import read_bundle  # noqa: E402
+from gridshell.design.bundle import read_bundle  # noqa: E402
 from gridshell.structure import Section, get_material  # noqa: E402
 from gridshell.structure.check import check_bundle  # noqa: E402
 

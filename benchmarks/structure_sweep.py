@@ -29,7 +29,7 @@ def sweep(bundle_dir: Path, thicknesses=THICKNESSES, width: float = 20.0, scale:
           material: str = "pp", every: int = 1, loads=(True, False)) -> list[dict]:
     """Rows of figures per thickness and load case; supports: every ``every``-th boundary
     joint (1: all of them)."""
-    from gridshell.bundle import read_bundle
+    from gridshell.design.bundle import read_bundle
     from gridshell.structure import Section, get_material
     from gridshell.structure.deployed import boundary_joints
     from gridshell.structure.equilibrium import simulate

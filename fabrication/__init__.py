@@ -1,20 +1,22 @@
-"""Fabrication: flat lamellae with joint features, nested on sheets, as DXF/SVG cut files.
+"""Deprecated: the fabrication package is now :mod:`gridshell.fabrication`.
 
-Works on plain arrays and :class:`~fabrication.strip.Strip` objects; reads a design bundle
-only through :mod:`gridshell.bundle` and never imports an optimizer. Lengths in millimetres.
-
-:func:`fabricate` (and with it the nesting, shapely and, when it writes, ezdxf) is imported on
-first use, so that reading the fabrication parameters (:mod:`fabrication.params`) stays cheap.
+``import fabrication`` and ``from fabrication.nesting import ...`` keep working for one release
+(with a :class:`DeprecationWarning`); write ``from gridshell.fabrication import ...`` instead.
 """
-from .params import FabParams, parse_scale, parse_sheet
-from .strip import Strip
+import warnings
+
+import gridshell  # noqa: F401  (installs the finder of old module paths)
+from gridshell.fabrication import FabParams, Strip, parse_scale, parse_sheet  # noqa: F401
+
+warnings.warn("the top-level package 'fabrication' is now 'gridshell.fabrication'; the old name "
+              "will be removed in the next release", DeprecationWarning, stacklevel=2)
 
 __all__ = ["FabParams", "Strip", "fabricate", "parse_scale", "parse_sheet"]
 
 
 def __getattr__(name: str):
     if name == "fabricate":
-        from .pipeline import fabricate
+        from gridshell.fabrication.pipeline import fabricate
 
         return fabricate
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

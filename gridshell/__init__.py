@@ -4,7 +4,10 @@ The Python API (:mod:`gridshell.api`), loaded on first use so that ``import grid
 cheap: ``design_gg``, ``design_ncp``, ``optimize_phlw``, ``write``, ``read``, ``verify``,
 ``fabricate``, ``export_3dm``, ``write_outputs``, ``Design``, ``DesignBundle``.
 """
-__version__ = "0.1.0"
+from gridshell.core import moved as _moved
+from gridshell.core.version import __version__  # noqa: F401
+
+_moved.install()
 
 __all__ = ["Design", "DesignBundle", "design_gg", "design_ncp", "export_3dm", "fabricate",
            "optimize_phlw", "read", "verify", "write", "write_outputs"]
@@ -12,7 +15,7 @@ __all__ = ["Design", "DesignBundle", "design_gg", "design_ncp", "export_3dm", "f
 
 def __getattr__(name: str):
     if name in __all__:
-        from . import api
+        from gridshell import api
 
         return getattr(api, name)
     raise AttributeError(f"module 'gridshell' has no attribute {name!r}")

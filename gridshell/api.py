@@ -21,9 +21,9 @@ import os
 from pathlib import Path
 from typing import Any, Callable
 
-from .bundle import Design, DesignBundle, read_bundle, write_bundle
-from .errors import InputError
-from .verification import design_verdict, verify_bundle
+from gridshell.design.bundle import Design, DesignBundle, read_bundle, write_bundle
+from gridshell.core.errors import InputError
+from gridshell.design.verification import require_design, verify_bundle
 
 __all__ = ["Design", "DesignBundle", "design_gg", "design_ncp", "export_3dm", "fabricate",
            "optimize_phlw", "read", "verify", "write", "write_outputs"]
@@ -37,7 +37,7 @@ Progress = Callable[[str], None] | None
 def design_gg(*args: Any, **kwargs: Any) -> Design:
     """Design a geodesic (GG) gridshell on a target surface: ``(bundle, report)``;
     parameters and results of :func:`gridshell.gg.pipeline.design_gg`."""
-    from .gg import pipeline
+    from gridshell.gg import pipeline
 
     return pipeline.design_gg(*args, **kwargs)
 
@@ -45,7 +45,7 @@ def design_gg(*args: Any, **kwargs: Any) -> Design:
 def design_ncp(*args: Any, **kwargs: Any) -> Design:
     """Design an NCP gridshell (PHLW, CNC or AA) on a reference surface: ``(bundle,
     report)``; parameters and results of :func:`gridshell.ncp.pipeline.design_ncp`."""
-    from .ncp import pipeline
+    from gridshell.ncp import pipeline
 
     return pipeline.design_ncp(*args, **kwargs)
 
@@ -53,7 +53,7 @@ def design_ncp(*args: Any, **kwargs: Any) -> Design:
 def optimize_phlw(*args: Any, **kwargs: Any) -> Any:
     """The PHLW optimization of a B-spline surface (paper 4.2.1); parameters and result of
     :func:`gridshell.ncp.phlw.optimize_phlw`."""
-    from .ncp import phlw
+    from gridshell.ncp import phlw
 
     return phlw.optimize_phlw(*args, **kwargs)
 
@@ -93,7 +93,7 @@ def write(path: str | os.PathLike, design: Design | DesignBundle, report: dict |
     """
     bundle, report = _parts(design, report)
     if bundle.kind == "GG":
-        from .gg.pipeline import gg_files
+        from gridshell.gg.pipeline import gg_files
 
         extra = gg_files(bundle, report, render=render, frames=frames, progress=progress)
     else:
@@ -101,20 +101,20 @@ def write(path: str | os.PathLike, design: Design | DesignBundle, report: dict |
             raise InputError(f"an {bundle.kind} design is written with the report of "
                              "design_ncp (it holds the B-spline and the rotation axes): "
                              "write(path, design_ncp(...))")
-        from .ncp.pipeline import ncp_files
+        from gridshell.ncp.pipeline import ncp_files
 
         extra = ncp_files(bundle, report, render=render, progress=progress)
     return write_bundle(path, bundle, extra=extra)
 
 
 def read(path: str | os.PathLike) -> DesignBundle:
-    """The design bundle at ``path`` (:func:`gridshell.bundle.read_bundle`), validated."""
+    """The design bundle at ``path`` (:func:`gridshell.design.bundle.read_bundle`), validated."""
     return read_bundle(path)
 
 
 def verify(path: str | os.PathLike) -> dict[str, Any]:
     """Every figure of the bundle at ``path`` recomputed from its files and gated by the
-    paper's thresholds (:func:`gridshell.verification.verify_bundle`): ``ok``, ``gates``,
+    paper's thresholds (:func:`gridshell.design.verification.verify_bundle`): ``ok``, ``gates``,
     ``checks``, ``problems`` and the figures."""
     return verify_bundle(path)
 
@@ -123,16 +123,14 @@ def fabricate(design: Any, out_dir: str | os.PathLike, params: Any = None, *,
               force: bool = False, plan: bool = True, progress: Progress = None
               ) -> dict[str, Any]:
     """Cut files (DXF, SVG, PNG per sheet), cut list and plan of a design into ``out_dir``
-    (:func:`fabrication.pipeline.fabricate`; ``params``: a FabParams or a dict of its fields,
+    (:func:`gridshell.fabrication.pipeline.fabricate`; ``params``: a FabParams or a dict of its fields,
     mm of the model). A design that fails its figures (recomputed from the files of a bundle
-    directory) is refused with :class:`~gridshell.errors.InputError` unless ``force``."""
-    from fabrication.pipeline import fabricate as _fabricate
+    directory) is refused with :class:`~gridshell.core.errors.InputError` unless ``force``."""
+    from gridshell.fabrication.pipeline import fabricate as _fabricate
 
     bundle = design if isinstance(design, (str, os.PathLike)) else _parts(design)[0]
-    ok, why = design_verdict(Path(bundle) if isinstance(bundle, (str, os.PathLike)) else bundle)
-    if not ok and not force:
-        raise InputError(f"the design fails its checks ({why}); fabricate(..., force=True) "
-                         "cuts it anyway")
+    require_design(Path(bundle) if isinstance(bundle, (str, os.PathLike)) else bundle, force,
+                   "fabricate(..., force=True) cuts it anyway")
     return _fabricate(bundle, out_dir, params, progress=progress, plan=plan)
 
 
@@ -142,7 +140,7 @@ def export_3dm(design: Any, path: str | os.PathLike, **options: Any) -> dict[str
     holes, surface, collapsed state and cut sheets, in the input's unit); returns what was
     written (``path``, ``units``, ``layers`` ...). ``options``: ``width``, ``thickness``,
     ``hole``, ``scale``, ``sheet``, ``params``, ``units``, ``sheets``, ``force``, ``progress``."""
-    from .export.rhino import write_3dm
+    from gridshell.export.rhino import write_3dm
 
     bundle = design if isinstance(design, (str, os.PathLike)) else _parts(design)[0]
     return write_3dm(bundle, path, **options)
@@ -151,7 +149,7 @@ def export_3dm(design: Any, path: str | os.PathLike, **options: Any) -> dict[str
 def write_outputs(bundle: str | os.PathLike, **options: Any) -> dict[str, Any]:
     """render.png, alignment.gif, report.html and a .3dm of a bundle directory in one call
     (``gridshell render``), the .3dm built in a second process meanwhile; options and result of
-    :func:`gridshell.outputs.write_outputs`."""
-    from .outputs import write_outputs as run
+    :func:`gridshell.workflow.outputs.write_outputs`."""
+    from gridshell.workflow.outputs import write_outputs as run
 
     return run(bundle, **options)

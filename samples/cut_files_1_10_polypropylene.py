@@ -13,7 +13,7 @@ import sys
 from pathlib import Path
 
 import gridshell as gs
-from fabrication import FabParams
+from gridshell.fabrication import FabParams
 
 HERE = Path(__file__).resolve().parent
 

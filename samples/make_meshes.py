@@ -12,8 +12,8 @@ from pathlib import Path
 
 import numpy as np
 
-from gridshell.atomic import write_text
-from gridshell.grid import grid_quads
+from gridshell.core.atomic import write_text
+from gridshell.geometry.grid import grid_quads
 
 HERE = Path(__file__).resolve().parent
 DATA = HERE.parent / "gridshell" / "data"

@@ -13,9 +13,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from gridshell.bundle import CollapseCurve, DesignBundle
-from gridshell.grid import grid_quads
-from gridshell.net import Lamella, Net, polyline_arclength
+from gridshell.design.bundle import CollapseCurve, DesignBundle
+from gridshell.geometry.grid import grid_quads
+from gridshell.geometry.net import Lamella, Net, polyline_arclength
 
 PARABOLA_A = 0.6
 
@@ -188,7 +188,7 @@ def motion_apply(m, X):
 
 
 def joints_in_strip_coordinates(b, lam, scale=100.0):
-    """Where the joints of ``lam`` lie in the strip coordinates of :mod:`fabrication.axis`
+    """Where the joints of ``lam`` lie in the strip coordinates of :mod:`gridshell.fabrication.axis`
     (mm), from the design alone: straight strips along +x from the origin; arcs from the
     origin turning left about ``(0, R)``; NCP strips in the collapse curve's own plane, at
     ``collapse_s`` on the analytic parabola."""

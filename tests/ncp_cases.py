@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from gridshell.bspline import BSplineSurface, fit_grid
+from gridshell.geometry.bspline import BSplineSurface, fit_grid
 
 DATA = Path(__file__).parent / "data"
 PHLW_SADDLE = DATA / "phlw_saddle_surface.json"

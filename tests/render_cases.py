@@ -9,10 +9,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from gridshell.bundle import DesignBundle, write_bundle
-from gridshell.grid import grid_quads
-from gridshell.net import Lamella, Net, polyline_arclength
-from gridshell.meshfile import write_mesh
+from gridshell.design.bundle import DesignBundle, write_bundle
+from gridshell.geometry.grid import grid_quads
+from gridshell.geometry.net import Lamella, Net, polyline_arclength
+from gridshell.geometry.meshfile import write_mesh
 
 N = 4  # joints per lamella
 DENSE = 7  # axis points per joint-to-joint segment

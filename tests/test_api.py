@@ -14,9 +14,9 @@ from render_cases import make_bundle, write_case
 
 import gridshell
 from gridshell import api
-from gridshell.bundle import Design, read_bundle
-from gridshell.errors import InputError
-from gridshell.grid import grid_quads
+from gridshell.design.bundle import Design, read_bundle
+from gridshell.core.errors import InputError
+from gridshell.geometry.grid import grid_quads
 
 #: what every bundle holds, whatever its kind
 COMMON = {"design.json", "net.obj", "aligned.obj", "axes.obj", "surface.obj", "report.json",

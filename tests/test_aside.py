@@ -1,4 +1,4 @@
-"""gridshell.aside: a computation in a forked process gives what it gives in this one (value,
+"""gridshell.core.aside: a computation in a forked process gives what it gives in this one (value,
 exception), never leaves a process behind, and runs in this process where a fork is not safe;
 the .3dm export that plans its cut sheets aside writes the same objects as one process does."""
 from __future__ import annotations
@@ -13,9 +13,9 @@ import pytest
 import rhino3dm
 from render_cases import make_bundle, write_case
 
-from gridshell.aside import Aside, can_fork
-from gridshell.bundle import write_bundle
-from gridshell.errors import GridshellError, InputError
+from gridshell.core.aside import Aside, can_fork
+from gridshell.design.bundle import write_bundle
+from gridshell.core.errors import GridshellError, InputError
 from gridshell.export.rhino import write_3dm
 
 @pytest.fixture

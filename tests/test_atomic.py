@@ -5,8 +5,8 @@ import os
 
 import pytest
 
-from gridshell.atomic import atomic_dir, atomic_path, write_text
-from gridshell.errors import OutputError
+from gridshell.core.atomic import atomic_dir, atomic_path, write_text
+from gridshell.core.errors import OutputError
 
 
 def test_written_files_and_directories_get_the_umask_mode(tmp_path):

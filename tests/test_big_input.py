@@ -11,8 +11,8 @@ from scipy.interpolate import CubicSpline
 from gridshell.gg.revolution import _PointSpline, rebuild_revolution
 from gridshell.io.read import check_disk
 from gridshell.io.working import working_mesh
-from gridshell.metrics import deviation, deviations
-from gridshell.quadmesh import unique_ints
+from gridshell.measure.metrics import deviation, deviations
+from gridshell.geometry.quadmesh import unique_ints
 
 
 def _bits(a) -> np.ndarray:
@@ -74,7 +74,7 @@ def test_the_working_copy_of_a_big_target_is_a_disk_on_it():
 
 
 def test_polygon_vector_areas_are_the_shoelace_sums_bit_for_bit():
-    from gridshell.quadmesh import polygon_vector_areas
+    from gridshell.geometry.quadmesh import polygon_vector_areas
 
     rng = np.random.default_rng(2)
     V = rng.normal(size=(60, 3))

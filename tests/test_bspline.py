@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 import scipy.interpolate as si
 
-from gridshell.bspline import (BSplineSurface, basis_matrix, fit_grid, fit_points,
+from gridshell.geometry.bspline import (BSplineSurface, basis_matrix, fit_grid, fit_points,
                                open_uniform_knots)
-from gridshell.errors import InputError
+from gridshell.core.errors import InputError
 
 DERIVS = {"Su": (1, 0), "Sv": (0, 1), "Suu": (2, 0), "Suv": (1, 1), "Svv": (0, 2)}
 
@@ -224,8 +224,8 @@ def test_load_unreadable_files(tmp_path):
 
 
 def test_sample_quad_mesh():
-    pytest.importorskip("gridshell.quadmesh")
-    pytest.importorskip("gridshell.grid")
+    pytest.importorskip("gridshell.geometry.quadmesh")
+    pytest.importorskip("gridshell.geometry.grid")
     surf = random_surface(3, 3)
     mesh = surf.sample(5, 4)
     V, F = np.asarray(mesh.V), np.asarray(mesh.F)

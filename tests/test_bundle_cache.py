@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 from render_cases import write_case
 
-import gridshell.meshfile as meshfile
-from gridshell.bundle import content_key, read_bundle
-from gridshell.errors import InputError
+import gridshell.geometry.meshfile as meshfile
+from gridshell.design.bundle import content_key, read_bundle
+from gridshell.core.errors import InputError
 
 
 def _no_parsing(monkeypatch):
@@ -87,13 +87,13 @@ def test_an_added_revolution_file_is_read(tmp_path):
 
 
 def test_closest_point_queries_asked_with_reuse_are_answered_once(monkeypatch):
-    import gridshell.igl_adapter as ia
+    import gridshell.geometry.igl_adapter as ia
 
     rng = np.random.default_rng(5)
     t = np.linspace(-1, 1, 12)
     X, Y = np.meshgrid(t, t, indexing="ij")
     V = np.stack([X, Y, 0.2 * X * Y], -1).reshape(-1, 3)
-    from gridshell.grid import grid_quads
+    from gridshell.geometry.grid import grid_quads
 
     F = grid_quads(12, 12)
     P = rng.uniform(-1, 1, (50, 3))
@@ -119,8 +119,8 @@ def test_closest_points_asked_ahead_together_equal_their_own_queries(monkeypatch
     """ask_closest_points answers several point sets with one igl query (one AABB tree):
     afterwards each set's reuse queries (closest points, with normals) give, bit for bit,
     what its own query gives, without asking igl again; a set asked before is not asked."""
-    import gridshell.igl_adapter as ia
-    from gridshell.grid import grid_quads
+    import gridshell.geometry.igl_adapter as ia
+    from gridshell.geometry.grid import grid_quads
 
     rng = np.random.default_rng(11)
     t = np.linspace(-1, 1, 15)
@@ -155,16 +155,16 @@ def test_verification_after_a_read_gives_what_it_gives_alone(tmp_path):
     import subprocess
     import sys
 
-    from gridshell.verification import verify_bundle
+    from gridshell.design.verification import verify_bundle
 
     d = write_case(tmp_path / "b", kind="NCP")
     code = ("import json, sys; sys.path.insert(0, 'tests')\n"
-            "from gridshell.verification import verify_bundle\n"
+            "from gridshell.design.verification import verify_bundle\n"
             f"print(json.dumps(verify_bundle({str(d)!r})))")
     alone = json.loads(subprocess.run([sys.executable, "-c", code], capture_output=True,
                                       text=True, check=True, timeout=120).stdout)
     read_bundle(d)
-    from gridshell.bundle import cached_bundle
+    from gridshell.design.bundle import cached_bundle
 
     assert cached_bundle(d) is not None
     assert json.loads(json.dumps(verify_bundle(d))) == alone
@@ -185,7 +185,7 @@ def _irregular_mesh(rng, n=5000):
 def _noisy_wave(rng, m: int):
     """An m x m quad grid of a wave z = 0.3 sin 2x cos 3y on [-1, 1]^2, points moved by
     noise of 3 mm."""
-    from gridshell.grid import grid_quads
+    from gridshell.geometry.grid import grid_quads
 
     t = np.linspace(-1, 1, m)
     X, Y = np.meshgrid(t, t, indexing="ij")
@@ -196,7 +196,7 @@ def _noisy_wave(rng, m: int):
 @pytest.mark.parametrize("case", ["grid", "irregular"])
 @pytest.mark.parametrize("radius", [1, 2, 3])
 def test_principal_curvature_at_some_vertices_is_that_of_the_whole_mesh(case, radius):
-    from gridshell.igl_adapter import principal_curvature, principal_curvature_at
+    from gridshell.geometry.igl_adapter import principal_curvature, principal_curvature_at
 
     rng = np.random.default_rng(11 + radius)
     if case == "grid":
@@ -216,7 +216,7 @@ def test_principal_curvature_at_some_vertices_is_that_of_the_whole_mesh(case, ra
 
 def test_principal_curvature_at_asks_igl_about_a_part_of_the_mesh(monkeypatch):
     """(The test above compares on meshes where only a part is handed to igl.)"""
-    import gridshell.igl_adapter as ia
+    import gridshell.geometry.igl_adapter as ia
 
     V, F = _irregular_mesh(np.random.default_rng(3))
     sizes = []
@@ -233,7 +233,7 @@ def test_principal_curvature_at_one_ring_less_when_the_outer_normals_agree(radiu
     part one ring smaller, and the figures are still those of the whole mesh, bit for bit;
     on a mesh folded onto itself near a vertex the guard refuses and the full part is used
     (the same figures again)."""
-    import gridshell.igl_adapter as ia
+    import gridshell.geometry.igl_adapter as ia
 
     rng = np.random.default_rng(7 + radius)
     m = 50
@@ -271,7 +271,7 @@ def test_principal_curvature_at_one_ring_less_on_an_irregular_mesh():
     where the guard lets igl have the smaller part, the figures are the whole mesh's."""
     from scipy.spatial import Delaunay
 
-    import gridshell.igl_adapter as ia
+    import gridshell.geometry.igl_adapter as ia
 
     rng = np.random.default_rng(3)
     xy = rng.uniform(-1, 1, (3000, 2))

@@ -6,7 +6,7 @@ import pytest
 from gg_cases import catenoid, cone, cylinder, profile, revolution_grid
 from scipy.integrate import quad
 
-from gridshell.errors import InputError
+from gridshell.core.errors import InputError
 from gridshell.gg.clairaut import clairaut_constant_for_angle, geodesic_net, trace_geodesic
 from gridshell.gg.revolution import rebuild_revolution
 

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 from render_cases import make_bundle, sequence_extra, write_case
 
-from gridshell import manifest
-from gridshell.bundle import CollapseCurve, write_bundle
+from gridshell.core import manifest
+from gridshell.design.bundle import CollapseCurve, write_bundle
 from gridshell.cli.main import main
 
 LAMELLA_KEYS = {"id", "family", "utilisation", "max_utilisation", "worst_s_m", "worst_joint",
@@ -46,7 +46,7 @@ def test_check_gg_writes_the_contract(tmp_path, capsys):
     assert r["section"]["scale"] == pytest.approx(0.1)
     assert r["material"]["name"] == "pp" and r["verdict"] in ("ok", "overstressed")
     assert isinstance(r["max_utilisation"], float) and r["states"]["frames"]
-    from gridshell.bundle import read_bundle
+    from gridshell.design.bundle import read_bundle
     b = read_bundle(d)
     for lam, rec in zip(b.net.lamellae, r["lamellae"]):
         assert LAMELLA_KEYS <= set(rec)
@@ -164,7 +164,7 @@ def test_strip_defaults_from_the_cut_files(tmp_path, capsys):
 
 
 def test_folded_sequence_states_are_listed_not_judged(tmp_path, capsys):
-    from gridshell.meshfile import write_mesh
+    from gridshell.geometry.meshfile import write_mesh
 
     b = make_bundle("GG")
     extra = sequence_extra(b, frames=3)
@@ -186,8 +186,8 @@ def test_folded_sequence_states_are_listed_not_judged(tmp_path, capsys):
                                               ("CNC", "circle", "arc")])
 def test_cut_shape_is_the_one_fabricate_cuts(kind, shape, cut):
     """The check judges the strip fabricate cuts: straight GG / AA strips, CNC arcs of the
-    collapse circle, NCP pieces of the collapse curve (one rule, gridshell.bundle)."""
-    from fabrication.strips import axis_shape, collapse_radius
+    collapse circle, NCP pieces of the collapse curve (one rule, gridshell.design.bundle)."""
+    from gridshell.fabrication.strips import axis_shape, collapse_radius
 
     from gridshell.structure import cutshape
 

@@ -7,10 +7,10 @@ import json
 
 import pytest
 
-from gridshell import manifest
+from gridshell.core import manifest
 from gridshell.cli import demo
 from gridshell.cli.main import main
-from gridshell.errors import ConvergenceError
+from gridshell.core.errors import ConvergenceError
 
 GG_FILES = ("design.json", "net.obj", "aligned.obj", "render.png", "preview.png", "states.png",
             "alignment.gif", "sequence/frame_000.obj", "sequence/frame_000.png",
@@ -51,7 +51,7 @@ def test_quick_demo_gg_alignment_sequence(quick_demo):
     # deployed net -> collapsed net (aligned.obj), lamella edges kept within 1 % in every state
     import numpy as np
 
-    from gridshell.bundle import read_bundle
+    from gridshell.design.bundle import read_bundle
     from gridshell.render.sequence import read_sequence
 
     _, out, s = quick_demo
@@ -74,7 +74,7 @@ def test_quick_demo_ncp_alignment_sequence(quick_demo):
     # aligned state, and the largest edge-length change over the states is the one reported
     import numpy as np
 
-    from gridshell.bundle import read_bundle
+    from gridshell.design.bundle import read_bundle
     from gridshell.render.sequence import read_sequence
 
     _, out, s = quick_demo

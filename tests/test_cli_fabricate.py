@@ -7,7 +7,7 @@ import json
 import pytest
 from fab_cases import make_bundle, plan_labels, read_dxf_sheet
 
-from gridshell.bundle import write_bundle
+from gridshell.design.bundle import write_bundle
 from gridshell.cli.main import main
 
 ISSUE_ARGS = ["--width", "20", "--thickness", "1", "--hole", "3", "--sheet", "600x400",

@@ -8,11 +8,11 @@ import numpy as np
 import pytest
 from gg_cases import helicoid_grid
 
-from gridshell.bundle import DesignBundle, read_bundle, write_bundle
+from gridshell.design.bundle import DesignBundle, read_bundle, write_bundle
 from gridshell.cli.main import main
-from gridshell.grid import grid_quads
-from gridshell.net import Lamella, Net
-from gridshell.meshfile import write_mesh
+from gridshell.geometry.grid import grid_quads
+from gridshell.geometry.net import Lamella, Net
+from gridshell.geometry.meshfile import write_mesh
 
 
 def _helicoid_target(tmp_path, n=12):

@@ -11,11 +11,11 @@ import pytest
 from io_cases import (hill, hill_ctrl, rhino_mesh, rhino_nurbs, soup, write_3dm, write_obj_text,
                       write_ply_soup)
 
-from gridshell.bundle import read_bundle
+from gridshell.design.bundle import read_bundle
 from gridshell.cli.main import main
-from gridshell.grid import grid_quads
-from gridshell.meshfile import write_mesh
-from gridshell.quadmesh import bbox_diagonal
+from gridshell.geometry.grid import grid_quads
+from gridshell.geometry.meshfile import write_mesh
+from gridshell.geometry.quadmesh import bbox_diagonal
 
 rhino3dm = pytest.importorskip("rhino3dm")
 

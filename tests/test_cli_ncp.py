@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 from gridshell.cli.main import main
-from gridshell.grid import grid_quads
-from gridshell.meshfile import write_mesh
+from gridshell.geometry.grid import grid_quads
+from gridshell.geometry.meshfile import write_mesh
 
 from ncp_cases import PHLW_SADDLE, pseudosphere, torus_grid
 

@@ -4,8 +4,8 @@ import json
 import numpy as np
 
 from gridshell.cli.main import main
-from gridshell.grid import grid_quads
-from gridshell.meshfile import write_mesh
+from gridshell.geometry.grid import grid_quads
+from gridshell.geometry.meshfile import write_mesh
 
 
 def _torus_obj(path, a=12, b=12, inner=False):

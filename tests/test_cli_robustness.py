@@ -19,10 +19,10 @@ import pytest
 from gg_cases import helicoid_grid
 from ncp_cases import torus_grid
 
-from gridshell.bspline import fit_grid
+from gridshell.geometry.bspline import fit_grid
 from gridshell.cli.main import main
-from gridshell.grid import grid_quads
-from gridshell.meshfile import write_mesh
+from gridshell.geometry.grid import grid_quads
+from gridshell.geometry.meshfile import write_mesh
 
 # --------------------------------------------------------------------------- small options
 
@@ -508,14 +508,14 @@ def _make_writable(d: Path) -> None:
 def read_only_dir(tmp_path, monkeypatch):
     """``make(path)``: make the directory ``path`` unwritable for the rest of the test. Where
     neither the mode nor the immutable attribute has an effect (root on a file system without
-    ``chattr``), the permission check of ``gridshell.atomic`` is told what a non-root user's
+    ``chattr``), the permission check of ``gridshell.core.atomic`` is told what a non-root user's
     would answer: not writable."""
     made: list[Path] = []
 
     def make(d: Path) -> Path:
         made.append(d)
         if not _make_read_only(d):
-            import gridshell.atomic as atomic
+            import gridshell.core.atomic as atomic
 
             real = os.access
             monkeypatch.setattr(atomic.os, "access", lambda p, mode, *a, **k: False
@@ -755,7 +755,7 @@ def _choices(command: str, option: str) -> tuple:
 
 
 def _registries():
-    from fabrication import params as fp
+    from gridshell.fabrication import params as fp
 
     from gridshell.ncp import phlw, pipeline
 

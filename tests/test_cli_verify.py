@@ -9,10 +9,10 @@ import json
 import numpy as np
 import pytest
 
-from gridshell import manifest
+from gridshell.core import manifest
 from gridshell.cli.main import main
-from gridshell.grid import grid_quads
-from gridshell.meshfile import read_configuration, write_mesh
+from gridshell.geometry.grid import grid_quads
+from gridshell.geometry.meshfile import read_configuration, write_mesh
 
 GG = ["--no-preview", "--frames", "0", "-q"]
 

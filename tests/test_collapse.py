@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from gridshell.errors import InputError
+from gridshell.core.errors import InputError
 from gridshell.ncp.collapse import (closest_on_polyline, collapse_curve, fit_circle,
                                     integrate_collapse, line_deviation)
 

@@ -8,8 +8,8 @@ import pytest
 from gridshell.corpus import COUNTS, FAMILIES, FAST, MODES, REFERENCES, build_reference, get, \
     select
 from gridshell.corpus.surfaces import make_near_sphere
-from gridshell.quadmesh import QuadMesh, TriMesh
-from gridshell.meshfile import read_mesh
+from gridshell.geometry.quadmesh import QuadMesh, TriMesh
+from gridshell.geometry.meshfile import read_mesh
 
 AB = np.meshgrid(np.linspace(0.02, 0.98, 9), np.linspace(0.02, 0.98, 9), indexing="ij")
 

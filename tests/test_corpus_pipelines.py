@@ -19,7 +19,7 @@ import pytest
 
 from gridshell.cli.main import main
 from gridshell.corpus import get
-from gridshell.quality import design_gates, gate_summary, passed
+from gridshell.measure.quality import design_gates, gate_summary, passed
 
 GG_SMALL = ["--frames", "2", "--no-preview"]
 NCP_SMALL = ["--curves", "6", "--samples", "24", "24", "--collapse-samples", "200", "200",

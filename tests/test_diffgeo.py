@@ -4,11 +4,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from gridshell.bspline import fit_grid
-from gridshell.diffgeo import (curvatures, fundamental_forms, normal_geodesic_curvature,
+from gridshell.geometry.bspline import fit_grid
+from gridshell.geometry.diffgeo import (curvatures, fundamental_forms, normal_geodesic_curvature,
                                polyline_curvature, principal_curvatures_along_params,
                                principal_directions, surface_curvature)
-from gridshell.errors import InputError
+from gridshell.core.errors import InputError
 
 #: Interior sample parameters (away from the patch boundary), paired.
 _G = np.linspace(0.1, 0.9, 13)

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 import rhino3dm
 
-from gridshell.errors import InputError
+from gridshell.core.errors import InputError
 from gridshell.export import rhino_geometry as geo
 
 
@@ -63,7 +63,7 @@ def test_bulk_mesh_rejects_faces_that_are_not_triangles_or_quads():
 def test_unwelded_sides_equal_the_row_wise_unique():
     """The integer-key unique gives what np.unique over (side, vertex) rows gives."""
     from gridshell.export.rhino import unwelded_sides
-    from gridshell.strips3d import strip_solid
+    from gridshell.geometry.strips3d import strip_solid
 
     t = np.linspace(0, 1, 17)
     P = np.column_stack([t, np.sin(2 * t), 0.1 * t])
@@ -90,7 +90,7 @@ def test_shared_attributes_equal_one_set_per_object(tmp_path):
     object gives, each object its own (distinct ids, the name it was added with); counts per
     layer as with one set each."""
     from gridshell.export.rhino import _Model
-    from gridshell.export.units import parse_units
+    from gridshell.core.units import parse_units
 
     def model(shared: bool):
         m = _Model(parse_units("mm"))

@@ -13,12 +13,12 @@ import pytest
 import rhino3dm
 from render_cases import N, make_bundle, write_case
 
-from gridshell.bundle import write_bundle
-from gridshell.errors import InputError
+from gridshell.design.bundle import write_bundle
+from gridshell.core.errors import InputError
 from gridshell.export import export_3dm
 from gridshell.export.rhino import write_3dm
-from gridshell.export.units import parse_units
-from gridshell.io.units import Units
+from gridshell.core.units import parse_units
+from gridshell.core.units import Units
 
 MM = {"name": "mm", "metres_per_unit": 0.001}
 
@@ -250,7 +250,7 @@ def test_layers_objects_and_user_strings(tmp_path):
 def test_sheets_match_the_cut_files(tmp_path):
     """The sheet layers hold what fabricate() writes: one layer per sheet, one outline per
     piece on its sheet, outlines of the flat strip's size; parameters from fabrication.json."""
-    from fabrication import fabricate
+    from gridshell.fabrication import fabricate
 
     d = write_case(tmp_path / "gg", "GG")
     fab = fabricate(d, d / "fabrication", {"width": 30, "sheet": "300x200"}, plan=False)
@@ -285,7 +285,7 @@ def test_sheets_match_the_cut_files(tmp_path):
 def test_cnc_arcs_and_bspline_surface(tmp_path):
     """CNC strips are arcs on the sheets (PolyCurves with arc spans), and surface.json comes
     in as a NURBS surface that evaluates like the B-spline (in mm)."""
-    from gridshell.bspline import BSplineSurface
+    from gridshell.geometry.bspline import BSplineSurface
 
     u = np.linspace(-1.2, 1.2, 6)
     X, Y = np.meshgrid(u, u, indexing="ij")
@@ -360,7 +360,7 @@ def test_unwelded_sides_and_edge_axis(tmp_path):
     """Each side of a strip gets its own vertices (flat shading) and the triangles stay the
     same; with the axis on the edge (standing lamellae) the strip moves half a width off it."""
     from gridshell.export.rhino import unwelded_sides
-    from gridshell.strips3d import strip_solid
+    from gridshell.geometry.strips3d import strip_solid
 
     P = np.stack([np.linspace(0, 1, 9), np.zeros(9), np.zeros(9)], axis=1)
     V, F = strip_solid(P, np.tile([0.0, 0.0, 1.0], (9, 1)), 0.2, 0.01, True)
@@ -436,8 +436,8 @@ def test_strip_solids_have_only_the_rings_they_need(tmp_path, kind):
     it) lies within ring_tolerance of the mesh's corner edge; the axis layer keeps every
     sample. The axes are the test bundle's, 8 times as densely sampled."""
     from gridshell.export.rhino import _clean_polyline
-    from gridshell.igl_adapter import closest_points_with_normals
-    from gridshell.strips3d import is_tangent, ring_tolerance, strip_frame
+    from gridshell.geometry.igl_adapter import closest_points_with_normals
+    from gridshell.geometry.strips3d import is_tangent, ring_tolerance, strip_frame
 
     b = make_bundle(kind)
     for lam in b.net.lamellae:       # 8 samples per span of the axis: straight stretches
@@ -499,10 +499,10 @@ def test_design_check_finds_the_closest_points_the_export_asked_ahead(tmp_path, 
     """The .3dm export asks the axes' and the joints' closest points before its design check
     forks: the check of an NCP kind then asks igl nothing (it would otherwise build the
     surface's tree again in the second process)."""
-    import gridshell.igl_adapter as ia
-    from gridshell.bundle import read_bundle
+    import gridshell.geometry.igl_adapter as ia
+    from gridshell.design.bundle import read_bundle
     from gridshell.export.rhino import _ask_ahead
-    from gridshell.verification import design_verdict
+    from gridshell.design.verification import design_verdict
 
     monkeypatch.setattr(ia, "_QUERIES", ia.Recent(8, copy=ia._QUERIES.copy))   # empty
     calls = []

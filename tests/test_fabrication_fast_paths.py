@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 from fab_cases import make_bundle
 
-from fabrication import FabParams
-from fabrication import nesting
-from fabrication.labels import _font
-from fabrication.part import build_part
-from fabrication.strips import strips_from_bundle
+from gridshell.fabrication import FabParams
+from gridshell.fabrication import nesting
+from gridshell.fabrication.labels import _font
+from gridshell.fabrication.part import build_part
+from gridshell.fabrication.strips import strips_from_bundle
 
 
 def _parts(kind, nr, nc, **kw):
@@ -65,7 +65,7 @@ def test_layout_unchanged_without_the_fast_lookups(monkeypatch):
 
 def test_stroke_joining_matches_allclose():
     f, _, _ = _font()
-    from fabrication.labels import _unit_strokes
+    from gridshell.fabrication.labels import _unit_strokes
     for text in ["L12", "3,17", "L40-S2", "0123456789"]:
         lines, _ = _unit_strokes(text)
         segs = np.array(list(f.lines_for_text(text)), float).reshape(-1, 2, 2)
@@ -89,7 +89,7 @@ def test_dxf_entities_equal_point_by_point_polylines(kind):
     ``add_lwpolyline(points.tolist())`` point by point, byte for byte."""
     import ezdxf
 
-    from fabrication import dxf
+    from gridshell.fabrication import dxf
 
     parts, params = _parts(kind, 4, 5)
     layout = nesting.nest(parts, params)
@@ -116,7 +116,7 @@ def test_dxf_entities_equal_point_by_point_polylines(kind):
 def test_svg_polylines_equal_numpy_formatting():
     """Engraved polylines formatted from Python floats equal those formatted from the
     numpy rows (the straightforward loop), character for character."""
-    from fabrication import svg
+    from gridshell.fabrication import svg
 
     parts, params = _parts("GG", 4, 5)
     layout = nesting.nest(parts, params)
@@ -159,7 +159,7 @@ def test_png_level_keeps_the_pixels(tmp_path, monkeypatch):
     at PIL's default level 6."""
     from PIL import Image
 
-    from fabrication import plan, preview
+    from gridshell.fabrication import plan, preview
 
     parts, params = _parts("GG", 4, 5)
     layout = nesting.nest(parts, params)
@@ -179,7 +179,7 @@ def test_png_level_keeps_the_pixels(tmp_path, monkeypatch):
 
 
 def test_line_axis_one_point_equals_the_array_path():
-    from fabrication.axis import LineAxis
+    from gridshell.fabrication.axis import LineAxis
 
     ax = LineAxis()
     for s, t in [(0.0, 0.0), (12.25, -3.5), (np.float64(7.1), 2.0), (-0.0, 1e-300)]:
@@ -239,8 +239,8 @@ def test_sheet_preview_description_names_the_colours_drawn(tmp_path):
     from matplotlib.colors import to_rgb
     from PIL import Image
 
-    from fabrication import preview
-    from fabrication.layers import LAYERS
+    from gridshell.fabrication import preview
+    from gridshell.fabrication.layers import LAYERS
 
     parts, params = _parts("GG", 4, 5)
     layout = nesting.nest(parts, params)
@@ -304,7 +304,7 @@ def test_glyph_composed_strokes_equal_the_library_lines():
     """The labels' stroke polylines composed from cached glyphs equal, bit for bit (same
     arrays, same line breaks), those from the library's ``lines_for_text`` joined
     segment by segment with np.allclose."""
-    from fabrication.labels import _unit_strokes
+    from gridshell.fabrication.labels import _unit_strokes
 
     for text in _label_texts():
         lines, length = _unit_strokes(text)
@@ -318,9 +318,9 @@ def test_glyph_composed_strokes_equal_the_library_lines():
 
 
 def _fullest_by_arrays(lengths, cap):
-    """:func:`fabrication.rows.fullest` the straightforward way: the reachable sums as a
+    """:func:`gridshell.fabrication.rows.fullest` the straightforward way: the reachable sums as a
     boolean array per item (the code before the bit sets)."""
-    from fabrication.rows import ROW_UNIT
+    from gridshell.fabrication.rows import ROW_UNIT
 
     units = np.ceil(lengths / ROW_UNIT - 1e-9).astype(int)
     c = int(np.floor(cap / ROW_UNIT + 1e-9)) - units[0]
@@ -345,7 +345,7 @@ def _fullest_by_arrays(lengths, cap):
 def test_fullest_bit_sets_choose_as_the_boolean_arrays():
     """The row filling's subset sum over int bit sets picks the same items as over boolean
     arrays (random strip lengths, caps from below the first to above the sum, ties)."""
-    from fabrication.rows import fullest
+    from gridshell.fabrication.rows import fullest
 
     rng = np.random.default_rng(3)
     cases = 0
@@ -372,7 +372,7 @@ def test_parts_built_at_once_equal_part_by_part(kind, kw, monkeypatch):
     import shapely
     from shapely.geometry import Polygon
 
-    from fabrication import part as part_mod
+    from gridshell.fabrication import part as part_mod
 
     params = FabParams(**kw)
     strips = strips_from_bundle(make_bundle(kind, nr=5, nc=6), params)

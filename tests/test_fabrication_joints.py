@@ -6,10 +6,10 @@ import pytest
 import shapely
 from fab_cases import make_bundle
 
-from fabrication.params import FabParams
-from fabrication.part import build_part
-from fabrication.strips import strips_from_bundle
-from gridshell.errors import InputError
+from gridshell.fabrication.params import FabParams
+from gridshell.fabrication.part import build_part
+from gridshell.fabrication.strips import strips_from_bundle
+from gridshell.core.errors import InputError
 
 
 def _part(kind, **kw):
@@ -113,7 +113,7 @@ def test_kerf_moves_outlines_out_and_holes_in(kind, joints):
 def test_joints_too_close_for_holes_are_engraved_as_marks_by_default(tmp_path):
     """A small model at 1:10: holes would merge, so the default engraves marks and says so;
     an explicit --joints hole (fallback_marks=False) refuses as before."""
-    from fabrication.pipeline import plan_parts
+    from gridshell.fabrication.pipeline import plan_parts
 
     b = make_bundle("GG")
     strict = FabParams(scale="1:100", hole=3, margin=15, fallback_marks=False)

@@ -6,10 +6,10 @@ import pytest
 import shapely
 from fab_cases import make_bundle
 
-from fabrication.labels import text_strokes
-from fabrication.params import FabParams
-from fabrication.part import build_part
-from fabrication.strips import strips_from_bundle
+from gridshell.fabrication.labels import text_strokes
+from gridshell.fabrication.params import FabParams
+from gridshell.fabrication.part import build_part
+from gridshell.fabrication.strips import strips_from_bundle
 
 
 def test_text_strokes_have_the_cap_height_and_start_at_zero():

@@ -9,11 +9,11 @@ import pytest
 import shapely
 from fab_cases import make_bundle, read_dxf_sheet
 
-from fabrication import FabParams, fabricate
-from fabrication.nesting import check_layout, nest
-from fabrication.part import build_part
-from fabrication.splice import extent, split_strip
-from fabrication.strips import strips_from_bundle
+from gridshell.fabrication import FabParams, fabricate
+from gridshell.fabrication.nesting import check_layout, nest
+from gridshell.fabrication.part import build_part
+from gridshell.fabrication.splice import extent, split_strip
+from gridshell.fabrication.strips import strips_from_bundle
 
 
 def _layout(kind, **kw):
@@ -70,7 +70,7 @@ def test_straight_rows_are_filled_best_first():
     """Rows of straight strips: each row takes the longest strip left and the others that
     fill it best; with lengths that pair up exactly (a + b = one row) every row is full and
     the strips take the fewest rows, where first fit decreasing wastes one."""
-    from fabrication.nesting import _fullest
+    from gridshell.fabrication.nesting import _fullest
 
     L = np.array([60.0, 50, 45, 40, 35, 30])       # + gap each; capacity 100
     assert sorted(L[_fullest(L, 100.0)]) == [40.0, 60.0]
@@ -99,7 +99,7 @@ def test_congruent_arcs_nest_into_each_other():
 def test_sheet_count_within_the_area_bound(kind, nr, nc, sheet):
     """At most ceil(1.15 x part area / sheet area) sheets (outline areas) where the parts
     fit at all; Layout.used agrees with the outline areas."""
-    from fabrication.nesting import sheet_bound
+    from gridshell.fabrication.nesting import sheet_bound
 
     parts, layout, params = _layout(kind, sheet=sheet, gap=5, nr=nr, nc=nc)
     _assert_valid(layout, 5)
@@ -173,7 +173,7 @@ def test_long_lamellae_are_split_at_joints_with_the_stated_overlap(tmp_path):
 
 
 def test_a_sheet_smaller_than_a_joint_spacing_is_an_input_error():
-    from gridshell.errors import InputError
+    from gridshell.core.errors import InputError
 
     b = make_bundle("GG")
     params = FabParams(scale="1:1", sheet="100x60")

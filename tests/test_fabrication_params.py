@@ -3,8 +3,8 @@ from __future__ import annotations
 
 import pytest
 
-from fabrication.params import FabParams, parse_scale, parse_sheet, scale_text
-from gridshell.errors import InputError
+from gridshell.fabrication.params import FabParams, parse_scale, parse_sheet, scale_text
+from gridshell.core.errors import InputError
 
 
 @pytest.mark.parametrize("text,value", [("1:10", 0.1), ("1:1", 1.0), ("0.1", 0.1), (" 2:1 ", 2.0),

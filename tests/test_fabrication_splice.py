@@ -10,16 +10,16 @@ import pytest
 from ezdxf import recover
 from fab_cases import make_bundle, read_dxf_sheet
 
-from fabrication import FabParams, fabricate
-from fabrication.axis import ArcAxis, LineAxis
-from fabrication.dxf import write_sheet_dxf
-from fabrication.nesting import check_layout, nest
-from fabrication.part import build_part
-from fabrication.splice import extent, split_strip
-from fabrication.strip import Strip
-from fabrication.strips import strips_from_bundle
-from fabrication.svg import write_sheet_svg
-from gridshell.errors import InputError
+from gridshell.fabrication import FabParams, fabricate
+from gridshell.fabrication.axis import ArcAxis, LineAxis
+from gridshell.fabrication.dxf import write_sheet_dxf
+from gridshell.fabrication.nesting import check_layout, nest
+from gridshell.fabrication.part import build_part
+from gridshell.fabrication.splice import extent, split_strip
+from gridshell.fabrication.strip import Strip
+from gridshell.fabrication.strips import strips_from_bundle
+from gridshell.fabrication.svg import write_sheet_svg
+from gridshell.core.errors import InputError
 
 DEFAULTS = FabParams()          # 1:10 polypropylene: 20 x 1 mm strips, 600 x 400 mm sheets
 

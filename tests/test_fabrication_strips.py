@@ -5,11 +5,11 @@ import numpy as np
 import pytest
 from fab_cases import make_bundle, parabola_at
 
-from fabrication import fabricate
-from fabrication.axis import ArcAxis, CurveAxis, DenseCurve, LineAxis
-from fabrication.params import FabParams
-from fabrication.strips import strips_from_bundle
-from gridshell.errors import InputError
+from gridshell.fabrication import fabricate
+from gridshell.fabrication.axis import ArcAxis, CurveAxis, DenseCurve, LineAxis
+from gridshell.fabrication.params import FabParams
+from gridshell.fabrication.strips import strips_from_bundle
+from gridshell.core.errors import InputError
 
 
 def test_gg_and_aa_unroll_to_straight_strips_of_the_axis_length():

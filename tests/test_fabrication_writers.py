@@ -6,8 +6,8 @@ import pytest
 import shapely
 from fab_cases import make_bundle, read_dxf_sheet
 
-from fabrication.layers import LAYERS
-from fabrication import FabParams, fabricate
+from gridshell.fabrication.layers import LAYERS
+from gridshell.fabrication import FabParams, fabricate
 
 
 @pytest.fixture(scope="module")

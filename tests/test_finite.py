@@ -3,7 +3,7 @@
 A property test over random bundles: NaN / Inf injected field by field (design.json geometry,
 every OBJ, the rotation axes); ``fabricate`` and ``render`` either refuse (exit 2, nothing
 written) or write files that hold only finite numbers. And the writers' own net
-(:mod:`gridshell.finite`) refuses a non-finite number in every text format, JSON and NPY.
+(:mod:`gridshell.core.finite`) refuses a non-finite number in every text format, JSON and NPY.
 """
 from __future__ import annotations
 
@@ -17,11 +17,11 @@ import numpy as np
 import pytest
 from fab_cases import make_bundle
 
-from gridshell import finite
-from gridshell.atomic import atomic_dir, write_text
-from gridshell.bundle import write_bundle
+from gridshell.core import finite
+from gridshell.core.atomic import atomic_dir, write_text
+from gridshell.design.bundle import write_bundle
 from gridshell.cli.main import main
-from gridshell.errors import GridshellError
+from gridshell.core.errors import GridshellError
 
 FIELDS = ["joint_s", "length", "collapse_s", "collapse.points", "collapse.radius", "net.obj",
           "axes.obj", "aligned.obj", "surface.obj", "axes_r.npy"]
@@ -116,7 +116,7 @@ def test_injected_non_finite_never_reaches_an_output(tmp_path, capsys, seed, fie
 
 @pytest.mark.parametrize("seed", range(6))
 def test_random_valid_bundles_give_finite_cut_files(tmp_path, seed):
-    from fabrication import fabricate
+    from gridshell.fabrication import fabricate
 
     b = _random_bundle(tmp_path / "b", np.random.default_rng(100 + seed))
     fabricate(b, tmp_path / "fab", plan=seed == 0)

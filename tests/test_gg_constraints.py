@@ -7,7 +7,7 @@ import pytest
 from gridshell.gg.constraints import (GridShape, diagonal_residual_rel, equal_diagonals,
                                       geodesic_residual, length_residual_rel)
 from gridshell.gg.design import design_gg_surface
-from gridshell.grid import grid_quads
+from gridshell.geometry.grid import grid_quads
 from gridshell.solver import Layout
 
 

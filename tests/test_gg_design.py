@@ -5,13 +5,13 @@ import numpy as np
 import pytest
 from gg_cases import catenoid, helicoid_grid, revolution_grid, sphere
 
-from gridshell.errors import InputError, MeshError
+from gridshell.core.errors import InputError, MeshError
 from gridshell.gg.design import (GGWeights, design_gg_surface, geodesic_residual,
                                  length_residual_rel)
 from gridshell.gg.initial import initial_grid
 from gridshell.gg.pipeline import gg_score
-from gridshell.grid import grid_quads
-from gridshell.quadmesh import QuadMesh
+from gridshell.geometry.grid import grid_quads
+from gridshell.geometry.quadmesh import QuadMesh
 
 
 def _diag(P):
@@ -89,7 +89,7 @@ def test_noisy_catenoid_converges_near_the_target():
     # boundary vertex). With the polish' fixed regularisation (before the shrinking schedule)
     # the residuals stayed at 5e-4, mean 0.34 % max 1.94 %, figures 0.26 of the thresholds;
     # now the polish reaches round-off (2.6e-9 rad): mean 0.42 %, max 1.13 %, figures 0.001
-    from gridshell.metrics import deviation
+    from gridshell.measure.metrics import deviation
     clean = deviation(d.P.reshape(-1, 3), *_quads(P))
     assert clean["mean"] < 0.5 and clean["max"] < 1.5, clean
     assert gg_score(d.P) < 0.01

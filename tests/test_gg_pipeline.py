@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 from gg_cases import catenoid, helicoid_grid, hill_grid, revolution_grid
 
-from gridshell.errors import ConvergenceError, InputError
-from gridshell.grid import grid_quads
+from gridshell.core.errors import ConvergenceError, InputError
+from gridshell.geometry.grid import grid_quads
 from gridshell.api import write
 from gridshell.gg.pipeline import collapse_gg, design_gg, gg_metrics, gg_net_from_mesh
 
@@ -65,7 +65,7 @@ def test_offsets_in_metres_place_curves_on_the_reference_parallel():
 def test_write_gg_bundle(tmp_path):
     P = helicoid_grid(15, 15, c=0.5)
     st = gg_net_from_mesh(P, n_lamellae=5, crossing_angle=90.0)
-    from gridshell.bundle import DesignBundle, read_design_json
+    from gridshell.design.bundle import DesignBundle, read_design_json
     V, F = _mesh(P)
     aligned, _ = collapse_gg(st["net"])
     b = DesignBundle(kind="GG", net=st["net"], aligned=aligned, surface_V=V, surface_F=F,
@@ -75,7 +75,7 @@ def test_write_gg_bundle(tmp_path):
     d = read_design_json(out)
     assert d["kind"] == "GG" and len(d["lamellae"]) == len(st["net"].lamellae)
     # the alignment sequence: net.obj first, aligned.obj last, pictures and a GIF
-    from gridshell.meshfile import read_configuration
+    from gridshell.geometry.meshfile import read_configuration
     from gridshell.render.sequence import read_sequence
     frames, loops = read_sequence(out)
     assert len(frames) == 4
@@ -129,7 +129,7 @@ def test_two_way_deviation_and_coverage_on_a_helicoid_grid():
     assert m["deviation"]["max"] < 0.01 and m["deviation_target"]["max"] < 0.2
     assert m["coverage"] == pytest.approx(100.0, abs=0.5)
     area = 2.0 * (np.sqrt(1 + c * c) + c * c * np.arcsinh(1 / c))   # int int sqrt(u^2+c^2)
-    from gridshell.metrics import surface_area
+    from gridshell.measure.metrics import surface_area
     assert surface_area(bundle.surface_V, bundle.surface_F) == pytest.approx(area, rel=2e-3)
     # the same design measured against a wider target (u in [-1.5, 1.5]) covers less of it
     # and is far from its outer rulings: 0.5 m along a ruling
@@ -236,7 +236,7 @@ def test_every_obj_of_a_gg_bundle_is_consistently_oriented(tmp_path, meridians, 
     # fabricate refused it
     from gg_cases import sphere
 
-    from gridshell.meshfile import read_mesh
+    from gridshell.geometry.meshfile import read_mesh
 
     P = revolution_grid(sphere(1.0), np.linspace(0.3, 1.6, 14), np.linspace(0.0, 1.2, 12))
     V, F = _mesh(P)
@@ -263,7 +263,7 @@ def test_every_obj_of_a_gg_bundle_is_consistently_oriented(tmp_path, meridians, 
 def test_offsets_off_the_surface_are_an_input_error_in_metres():
     """``gg --offsets -5 99`` on a ~2 m wide surface: no lamella reaches it. The user's
     positions are wrong, not the surface (exit 2, not 3), and the message is in metres."""
-    from gridshell.errors import InputError
+    from gridshell.core.errors import InputError
 
     P = helicoid_grid(14, 14)
     with pytest.raises(InputError, match=r"-5, 99 m.*0 to [0-9.]+ m of arc length"):

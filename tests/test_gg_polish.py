@@ -15,7 +15,7 @@ from gridshell.gg import design as gd
 from gridshell.gg.design import design_gg_surface, geodesic_residual, length_residual_rel
 from gridshell.gg.initial import initial_grid
 from gridshell.gg.pipeline import gg_score
-from gridshell.grid import grid_quads
+from gridshell.geometry.grid import grid_quads
 
 
 def _bumped_helicoid(n=40):

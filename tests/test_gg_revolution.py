@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from gg_cases import catenoid, cone, helicoid_grid, revolution_grid, sphere
 
-from gridshell.errors import InputError, NoNetError
+from gridshell.core.errors import InputError, NoNetError
 from gridshell.gg.revolution import embeddable_range, rebuild_revolution
 
 CASES = {

@@ -1,13 +1,13 @@
-"""Tests of gridshell.gg.simulate: the alignment sequence of a GG net keeps its lengths."""
+"""Tests of gridshell.gg.alignment: the alignment sequence of a GG net keeps its lengths."""
 from __future__ import annotations
 
 import numpy as np
 import pytest
 from gg_cases import helicoid_grid
 
-from gridshell.errors import InputError
+from gridshell.core.errors import InputError
 from gridshell.gg.pipeline import collapse_gg, gg_net_from_mesh
-from gridshell.gg.simulate import edge_length_errors, gg_alignment_sequence, line_frame
+from gridshell.gg.alignment import edge_length_errors, gg_alignment_sequence, line_frame
 
 
 @pytest.fixture(scope="module")

@@ -8,7 +8,7 @@ from io_cases import hill
 
 import gridshell.gg.pipeline as pipeline
 from gridshell.gg.pipeline import TracedNets, design_gg, gg_net_from_mesh, gg_score
-from gridshell.metrics import alignability_error, summary
+from gridshell.measure.metrics import alignability_error, summary
 
 OPTIONS = dict(grid=(10, 8), n_lamellae=4, frames=0, polish_iter=8, allow_unconverged=True)
 

@@ -1,12 +1,12 @@
-"""Tests of gridshell.grid: grid faces, grid recovery from any vertex order, polylines."""
+"""Tests of gridshell.geometry.grid: grid faces, grid recovery from any vertex order, polylines."""
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from gridshell.errors import MeshError
-from gridshell.grid import grid_from_quads, grid_polylines, grid_quads
-from gridshell.quadmesh import QuadMesh
+from gridshell.core.errors import MeshError
+from gridshell.geometry.grid import grid_from_quads, grid_polylines, grid_quads
+from gridshell.geometry.quadmesh import QuadMesh
 
 
 def planar_grid(R: int, C: int) -> tuple[np.ndarray, np.ndarray]:

@@ -20,9 +20,9 @@ import pytest
 from fab_cases import make_bundle
 from gg_cases import helicoid_grid
 
-from gridshell.bundle import write_bundle
+from gridshell.design.bundle import write_bundle
 from gridshell.cli.main import main
-from gridshell.grid import grid_quads
+from gridshell.geometry.grid import grid_quads
 
 CLASSES = {2: ("InputError", "MeshError"), 3: ("NoNetError",), 4: ("ConvergenceError",),
            5: ("OutputError",)}
@@ -424,7 +424,7 @@ def _target(tmp_path: Path) -> Path:
 
 
 def _foreign_manifest(d: Path, command: str):
-    from gridshell import manifest
+    from gridshell.core import manifest
 
     d.mkdir(parents=True, exist_ok=True)
     (d / "a.txt").write_text("a")
@@ -532,7 +532,7 @@ OPTION_WORDS = {"--lamellae": "lamellae", "--spacing": "spacing", "--angle": "an
 
 def test_exit_codes_have_one_table():
     """The codes the error classes carry are the documented ones, each once."""
-    from gridshell import errors
+    from gridshell.core import errors
 
     classes = [errors.GridshellError, errors.InputError, errors.MeshError, errors.NoNetError,
                errors.ConvergenceError, errors.OutputError]
@@ -554,7 +554,7 @@ def test_output_changing_while_the_command_runs(tmp_path, capsys, good, monkeypa
                                                 race):
     """Whatever happens at ``-o`` while the command computes is checked at the rename: the
     command either replaces an empty directory or refuses (exit 5) and leaves it as it is."""
-    import fabrication.pipeline as fab
+    import gridshell.fabrication.pipeline as fab
     import gridshell.gg.pipeline as gg
 
     out = tmp_path / "out"

@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 from scipy.spatial import ConvexHull, Delaunay
 
-from gridshell import igl_adapter as ia
-from gridshell.errors import InputError, MeshError
+from gridshell.geometry import igl_adapter as ia
+from gridshell.core.errors import InputError, MeshError
 
 
 def fibonacci_sphere(n: int, R: float) -> tuple[np.ndarray, np.ndarray]:
@@ -190,8 +190,8 @@ def test_non_disks_are_rejected():
 def test_cotangent_laplacian_integrates_the_gradient_of_linear_functions():
     # on a planar mesh a linear x = a . p is reproduced exactly: x^T L x = |a|^2 * area, and
     # constants are in the kernel (the adapter flips igl's negative semi-definite sign)
-    from gridshell.grid import grid_quads
-    from gridshell.igl_adapter import cotangent_laplacian
+    from gridshell.geometry.grid import grid_quads
+    from gridshell.geometry.igl_adapter import cotangent_laplacian
 
     s, t = np.meshgrid(np.linspace(0, 2, 7), np.linspace(0, 1.5, 5), indexing="ij")
     rng = np.random.default_rng(3)

@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 from io_cases import hill, soup
 
-from gridshell.grid import grid_quads
+from gridshell.geometry.grid import grid_quads
 from gridshell.io.clean import clean_mesh, coincident_vertices
-from gridshell.meshfile import orientation_problem
-from gridshell.quadmesh import _as_padded
+from gridshell.geometry.meshfile import orientation_problem
+from gridshell.geometry.quadmesh import _as_padded
 
 
 def _faces_by_coordinates(V, F):
@@ -91,7 +91,7 @@ def test_coincident_vertices_of_an_edge_are_a_degenerate_face_not_a_seam():
 
 
 def test_a_quad_grid_exported_face_by_face_welds_back_to_the_same_grid():
-    from gridshell.grid import grid_from_quads
+    from gridshell.geometry.grid import grid_from_quads
 
     R, C = 7, 5
     u, v = np.meshgrid(np.linspace(0, 3, R), np.linspace(0, 2, C), indexing="ij")

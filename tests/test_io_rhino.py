@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from io_cases import hill, hill_ctrl, rhino_mesh, rhino_nurbs, write_3dm
 
-from gridshell.errors import InputError
+from gridshell.core.errors import InputError
 from gridshell.io.read import read_input
 
 rhino3dm = pytest.importorskip("rhino3dm")

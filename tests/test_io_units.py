@@ -1,13 +1,13 @@
-"""Units at the edges (gridshell.io.units): parsing, conversion, the plausibility rule."""
+"""Units at the edges (gridshell.core.units): parsing, conversion, the plausibility rule."""
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from gridshell.errors import InputError
-from gridshell.io.units import (METRES, PLAUSIBLE_DIAGONAL, UNITS, Units, check_plausible,
+from gridshell.core.errors import InputError
+from gridshell.core.units import (METRES, PLAUSIBLE_DIAGONAL, UNITS, Units, check_plausible,
                                 parse_units, to_metres)
-from gridshell.quadmesh import bbox_diagonal
+from gridshell.geometry.quadmesh import bbox_diagonal
 
 
 @pytest.mark.parametrize("text, name, f", [("m", "m", 1.0), ("MM", "mm", 1e-3),

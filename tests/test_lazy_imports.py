@@ -7,7 +7,7 @@ import json
 import subprocess
 import sys
 
-PIPELINES = ("gridshell.gg", "gridshell.ncp", "fabrication", "scipy.integrate", "pymeshlab")
+PIPELINES = ("gridshell.gg", "gridshell.ncp", "gridshell.fabrication", "scipy.integrate", "pymeshlab")
 
 
 def _loaded(code: str) -> list[str]:
@@ -41,12 +41,12 @@ def test_the_export_plans_its_cut_sheets_without_the_dxf_writer():
             "from gridshell.export.fabparams import export_params, plan_sheets\n"
             "fab, _ = export_params(None)\n"
             "plan_sheets(make_bundle(), fab)\n"
-            "import fabrication\n"
+            "from gridshell import fabrication\n"
             "assert 'ezdxf' not in sys.modules, 'ezdxf loaded'\n"
             "for m in ('dxf', 'svg', 'preview', 'plan', 'cutlist'):\n"
-            "    assert 'fabrication.' + m not in sys.modules, m\n"
+            "    assert 'gridshell.fabrication.' + m not in sys.modules, m\n"
             "fabrication.fabricate\n"
             "assert 'ezdxf' not in sys.modules, 'ezdxf loaded by fabrication.fabricate'")
     subprocess.run([sys.executable, "-c", code], check=True, timeout=120)
-    loaded = _loaded("import fabrication\nfabrication.FabParams")
-    assert "fabrication.params" in loaded and "fabrication.pipeline" not in loaded, loaded
+    loaded = _loaded("from gridshell import fabrication\nfabrication.FabParams")
+    assert "gridshell.fabrication.params" in loaded and "gridshell.fabrication.pipeline" not in loaded, loaded

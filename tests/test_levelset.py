@@ -2,10 +2,10 @@
 import numpy as np
 import pytest
 
-from gridshell.errors import InputError
-from gridshell.metrics import alignability_error
+from gridshell.core.errors import InputError
+from gridshell.measure.metrics import alignability_error
 from gridshell.ncp import levelset as LS
-from gridshell.bspline import uniform_params
+from gridshell.geometry.bspline import uniform_params
 from gridshell.ncp.directions import net_directions
 
 from ncp_cases import pseudosphere, torus

@@ -8,7 +8,7 @@ import pytest
 import scipy.sparse as sp
 
 from gridshell.cli.main import main
-from gridshell.errors import InputError
+from gridshell.core.errors import InputError
 from gridshell.gg.design import (GridShape, edge_groups, equal_lengths, fairness_matrix,
                                  geodesic_meridians, init_group_lengths)
 from gridshell.solver import Layout, Problem, solve

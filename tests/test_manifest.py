@@ -12,13 +12,13 @@ import pytest
 from fab_cases import make_bundle
 from gg_cases import helicoid_grid
 
-from gridshell import manifest
-from gridshell.atomic import atomic_dir, check_output, write_bytes
-from gridshell.bundle import write_bundle
+from gridshell.core import manifest
+from gridshell.core.atomic import atomic_dir, check_output, write_bytes
+from gridshell.design.bundle import write_bundle
 from gridshell.cli.main import main
-from gridshell.errors import OutputError
-from gridshell.grid import grid_quads
-from gridshell.meshfile import write_mesh
+from gridshell.core.errors import OutputError
+from gridshell.geometry.grid import grid_quads
+from gridshell.geometry.meshfile import write_mesh
 
 GG = ["--grid", "6", "6", "--lamellae", "3", "--no-preview", "--frames", "0", "-q"]
 
@@ -203,7 +203,7 @@ def test_anything_unlisted_is_refused_at_start_and_at_the_rename(tmp_path, tampe
 
 def test_files_added_later_and_nested_outputs_are_registered(tmp_path):
     """render.png written into a bundle, DIR/fabrication: the bundle stays replaceable."""
-    from fabrication import fabricate
+    from gridshell.fabrication import fabricate
 
     b = write_bundle(tmp_path / "gg", make_bundle("GG"))
     write_bytes(b / "render.png", b"\x89PNG fake")

@@ -9,7 +9,7 @@ from gridshell.gg.clairaut import geodesic_net
 from gridshell.gg.mapback import (SurfaceMap, map_back, map_to_revolution, net_loops,
                                   segment_intersections)
 from gridshell.gg.revolution import rebuild_revolution
-from gridshell.metrics import alignability_error, alignability_error_arc
+from gridshell.measure.metrics import alignability_error, alignability_error_arc
 
 
 def test_segment_intersections_match_brute_force():

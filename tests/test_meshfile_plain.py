@@ -1,4 +1,4 @@
-"""gridshell.meshfile._parse_plain: OBJ files laid out as the tool writes them are read with
+"""gridshell.geometry.meshfile._parse_plain: OBJ files laid out as the tool writes them are read with
 numpy on the bytes, giving bit for bit the arrays the line-by-line parser (and the regex
 parsers) give; every other file goes to those parsers, which read it or name its problem as
 before."""
@@ -9,12 +9,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from gridshell.errors import MeshError
-from gridshell.meshfile import (_decode, _parse_obj, _parse_obj_fast, _parse_obj_regex,
+from gridshell.core.errors import MeshError
+from gridshell.geometry.meshfile import (_decode, _parse_obj, _parse_obj_fast, _parse_obj_regex,
                                 _parse_plain, _parse_polylines_fast, _parse_polylines_regex,
                                 read_configuration, read_mesh, read_polylines, write_mesh,
                                 write_polylines)
-from gridshell.quadmesh import _as_padded
+from gridshell.geometry.quadmesh import _as_padded
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -191,7 +191,7 @@ def test_polylines_are_their_own_arrays(tmp_path):
 
 
 def test_bbox_diagonal_column_by_column_is_the_rows_reduction():
-    from gridshell.quadmesh import bbox_diagonal
+    from gridshell.geometry.quadmesh import bbox_diagonal
 
     rng = np.random.default_rng(0)
     for V in (rng.normal(size=(1000, 3)) * 1e3, rng.normal(size=(5, 2)), np.zeros((1, 3)),
@@ -206,7 +206,7 @@ def test_records_whose_counts_add_up_are_refused_by_every_path(tmp_path, kind):
     """``v 0 0 0 1`` then ``v 1 1``: six numbers for two vertices. Read as one stream of
     numbers (the vectorized parser once did) the 1 of the first record became the second
     vertex's x, silently; every path now refuses it and the line parser names the record."""
-    from gridshell.meshfile import read_mesh, read_polylines
+    from gridshell.geometry.meshfile import read_mesh, read_polylines
 
     text = f"v 0 0 0 1\nv 1 1\nv 0 1 0\nv 1 1 0\n{kind} 1 2 3\n"
     (tmp_path / "odd.obj").write_text(text)
@@ -219,7 +219,7 @@ def test_records_whose_counts_add_up_are_refused_by_every_path(tmp_path, kind):
 
 def test_a_polyline_index_past_int64_is_a_missing_vertex(tmp_path):
     """The line parser's indices are Python ints: one past int64 was a bare OverflowError."""
-    from gridshell.meshfile import read_polylines
+    from gridshell.geometry.meshfile import read_polylines
 
     (tmp_path / "big.obj").write_text("v 0 0 0\nv 1 0 0\nvn 0 0 1\nl 1 99999999999999999999999\n")
     with pytest.raises(MeshError, match="polyline 0 refers to missing vertices"):

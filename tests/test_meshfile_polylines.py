@@ -1,4 +1,4 @@
-"""gridshell.meshfile.read_polylines: the vectorized reading of plain polyline OBJ files gives
+"""gridshell.geometry.meshfile.read_polylines: the vectorized reading of plain polyline OBJ files gives
 the arrays the line-by-line parser gives, and hands everything else to that parser."""
 from __future__ import annotations
 
@@ -7,8 +7,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from gridshell.errors import MeshError
-from gridshell.meshfile import (_decode, _parse_obj, _parse_polylines_fast, read_polylines,
+from gridshell.core.errors import MeshError
+from gridshell.geometry.meshfile import (_decode, _parse_obj, _parse_polylines_fast, read_polylines,
                                 write_polylines)
 
 

@@ -1,19 +1,19 @@
-"""Tests of gridshell.metrics on configurations with known values (paper 5.1)."""
+"""Tests of gridshell.measure.metrics on configurations with known values (paper 5.1)."""
 from __future__ import annotations
 
 import numpy as np
 import pytest
 from gg_cases import catenoid, revolution_grid
 
-from gridshell.errors import InputError
+from gridshell.core.errors import InputError
 from gridshell.gg.clairaut import geodesic_net
 from gridshell.gg.mapback import map_to_revolution
 from gridshell.gg.revolution import rebuild_revolution
-from gridshell.grid import grid_quads
-from gridshell.metrics import (alignability_error, alignability_error_arc, coverage, delta_l,
+from gridshell.geometry.grid import grid_quads
+from gridshell.measure.metrics import (alignability_error, alignability_error_arc, coverage, delta_l,
                                delta_n, deviation, geodesic_turning, smooth_grid_normals,
                                surface_area, target_deviation)
-from gridshell.net import Lamella, Net
+from gridshell.geometry.net import Lamella, Net
 
 
 @pytest.mark.parametrize("seed", range(5))
@@ -210,7 +210,7 @@ def test_geodesic_turning_of_exact_geodesics_with_smooth_normals():
 
 def _kn_one_by_one(net, normals, jidx):
     """The straightforward kn at the joints: normal_geodesic_curvature of each whole axis."""
-    from gridshell.metrics import kn_at_joints_per_axis
+    from gridshell.measure.metrics import kn_at_joints_per_axis
 
     return kn_at_joints_per_axis(net, normals, jidx)
 
@@ -220,7 +220,7 @@ def test_kn_at_joints_equals_the_whole_axes_one_by_one():
     for bit, what normal_geodesic_curvature of each whole axis gives there (wavy axes, normals
     of any length, joints at the ends and inside, short lamellae skipped); a polyline it
     refuses still raises its error."""
-    from gridshell.metrics import _kn_at_joints, crossing_normal_curvature
+    from gridshell.measure.metrics import _kn_at_joints, crossing_normal_curvature
 
     rng = np.random.default_rng(2)
     lams, normals, jidx = [], [], []

@@ -2,8 +2,8 @@
 import numpy as np
 import pytest
 
-from gridshell.errors import InputError, NoNetError
-from gridshell.bspline import uniform_params
+from gridshell.core.errors import InputError, NoNetError
+from gridshell.geometry.bspline import uniform_params
 from gridshell.ncp.directions import net_angle, net_directions, row_normal_curvature
 
 from ncp_cases import pseudosphere, torus

@@ -21,8 +21,8 @@ import re
 import numpy as np
 import pytest
 
-from gridshell.bspline import fit_grid, uniform_params
-from gridshell.errors import ConvergenceError, NoNetError
+from gridshell.geometry.bspline import fit_grid, uniform_params
+from gridshell.core.errors import ConvergenceError, NoNetError
 from gridshell.ncp.directions import net_directions
 from gridshell.ncp.pipeline import design_ncp
 
@@ -218,7 +218,7 @@ def test_a_phlw_step_that_leaves_no_net_is_a_convergence_failure(monkeypatch):
     """A reference that admits a net (a torus zone, K > 0, distinct principal curvatures)
     whose PHLW step ends on a surface without one (here: a sphere cap, as a blown-up step
     might): that is the optimizer's failure, exit 4, not "no net exists" (exit 3)."""
-    from gridshell.grid import grid_quads
+    from gridshell.geometry.grid import grid_quads
     from gridshell.ncp import phlw as P
     from ncp_cases import torus_grid
 
@@ -244,7 +244,7 @@ def test_aa_on_a_developable_reference_is_no_net_before_the_phlw_step():
     """A ridge z = h exp(-y^2 / w^2) + c x is developable (K = 0 everywhere): there is no AA
     net on it or near it (exit 3, K < 0 nowhere), found before any optimization. Before, the
     PHLW step ran for 20 s and the no-net answer came from its result."""
-    from gridshell.grid import grid_quads
+    from gridshell.geometry.grid import grid_quads
 
     x, y = np.meshgrid(np.linspace(-5, 5, 20), np.linspace(-5, 5, 20), indexing="ij")
     P = np.stack([x, y, 1.5 * np.exp(-y ** 2 / 4) + 0.05 * x], -1)

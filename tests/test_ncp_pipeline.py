@@ -6,14 +6,14 @@ import shutil
 import numpy as np
 import pytest
 
-from gridshell.bundle import read_bundle, read_design_json
-from gridshell.verification import verify_bundle
-from gridshell.diffgeo import surface_curvature
-from gridshell.ncp.collapse import fit_circle, fit_plane, line_deviation
+from gridshell.design.bundle import read_bundle, read_design_json
+from gridshell.design.verification import verify_bundle
+from gridshell.geometry.diffgeo import surface_curvature
+from gridshell.geometry.fit import fit_circle, fit_plane, line_deviation
 from gridshell.api import write
 from gridshell.ncp.pipeline import crossing_normal_curvature, design_ncp
-from gridshell.quadmesh import bbox_diagonal
-from gridshell.meshfile import read_configuration, write_mesh
+from gridshell.geometry.quadmesh import bbox_diagonal
+from gridshell.geometry.meshfile import read_configuration, write_mesh
 
 from ncp_cases import PHLW_SADDLE, pseudosphere, torus
 
@@ -214,7 +214,7 @@ def _oriented(F):
 
 
 def test_every_obj_of_a_bundle_is_consistently_oriented(aa_bundle, cnc_bundle):
-    from gridshell.meshfile import read_mesh
+    from gridshell.geometry.meshfile import read_mesh
 
     for _, _, out in (aa_bundle, cnc_bundle):
         names = ["net.obj", "surface.obj", "aligned.obj"] + sorted(
@@ -244,8 +244,8 @@ def test_a_design_missing_the_figures_is_refused_unless_allowed():
     """Torus zone, CNC, without a post-optimization round: Delta_a and the collapse miss
     their thresholds. design_ncp raises ConvergenceError naming the failing gates; with
     allow_unconverged it returns the design with metrics["quality"]["ok"] False."""
-    from gridshell.errors import ConvergenceError
-    from gridshell.quality import THRESHOLDS
+    from gridshell.core.errors import ConvergenceError
+    from gridshell.measure.quality import THRESHOLDS
 
     kw = dict(mode="cnc", curves=6, frames=2, postopt_rounds=0, collapse_samples=(200, 200),
               samples=(24, 24))

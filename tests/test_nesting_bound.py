@@ -3,7 +3,7 @@ sheets <= ceil(1.15 x part area / sheet area) wherever the parts fit at all, eve
 exactly once, inside its sheet's gap-wide margin, no two parts closer than the gap.
 
 "Fit at all": the parts grown by half the gap are disjoint and lie in the sheet shrunk by half
-the gap, so no layout needs fewer than :func:`fabrication.nesting.gap_bound` sheets. At the
+the gap, so no layout needs fewer than :func:`gridshell.fabrication.nesting.gap_bound` sheets. At the
 default 2 mm gap every case meets the 15 % bound itself; where a larger gap puts that floor
 above the bound (20 mm strips with 5 mm gaps lose 25 % of their area to the gap), the layout
 must reach the floor. The hyperbolic paraboloid (a corpus saddle) CNC
@@ -20,9 +20,9 @@ import functools
 import pytest
 import shapely
 
-from fabrication import FabParams
-from fabrication.nesting import FLAT_TOL, SLACK, gap_bound, sheet_bound
-from fabrication.pipeline import plan_parts
+from gridshell.fabrication import FabParams
+from gridshell.fabrication.nesting import FLAT_TOL, SLACK, gap_bound, sheet_bound
+from gridshell.fabrication.pipeline import plan_parts
 
 GG_SMALL = ["--frames", "2", "--no-preview"]
 NCP_SMALL = ["--samples", "24", "24", "--collapse-samples", "200", "200", "--frames", "2",
@@ -73,7 +73,7 @@ def _design(case: str, root) -> tuple:
     if case == "demo-cnc":
         from gridshell import data
         from gridshell.api import design_ncp
-        from gridshell.meshfile import read_mesh
+        from gridshell.geometry.meshfile import read_mesh
         from gridshell.ncp.phlw import optimize_phlw
         from gridshell.ncp.reference import initial_surface
 
@@ -86,7 +86,7 @@ def _design(case: str, root) -> tuple:
                                collapse_samples=nc["collapse_samples"], frames=2,
                                postopt_rounds=nc["postopt_rounds"])
         return bundle, FabParams(**FABRICATION)
-    from gridshell.bundle import read_bundle
+    from gridshell.design.bundle import read_bundle
     from gridshell.cli.main import main
     from gridshell.corpus import get
 
@@ -101,8 +101,8 @@ def _hypar(path, side=4.5, c=4.5, n=13):
     """OBJ of the hyperbolic paraboloid ``z = x y / c`` over ``side x side`` m, n x n."""
     import numpy as np
 
-    from gridshell.grid import grid_quads
-    from gridshell.meshfile import write_mesh
+    from gridshell.geometry.grid import grid_quads
+    from gridshell.geometry.meshfile import write_mesh
 
     t = np.linspace(-side / 2, side / 2, n)
     X, Y = np.meshgrid(t, t, indexing="ij")
@@ -173,7 +173,7 @@ def test_sheet_count_and_material_used_in_summary_cut_list_and_plan(tmp_path, ca
 
     from fab_cases import make_bundle
 
-    from gridshell.bundle import write_bundle
+    from gridshell.design.bundle import write_bundle
     from gridshell.cli.main import main
 
     write_bundle(tmp_path / "b", make_bundle("CNC", nr=5, nc=6))

@@ -1,9 +1,9 @@
-"""Curve nets (gridshell.net): lamella records and moving joints with their axes."""
+"""Curve nets (gridshell.geometry.net): lamella records and moving joints with their axes."""
 import numpy as np
 import pytest
 
-from gridshell.errors import InputError
-from gridshell.net import Lamella, Net, move_joints, polyline_arclength
+from gridshell.core.errors import InputError
+from gridshell.geometry.net import Lamella, Net, move_joints, polyline_arclength
 
 
 def _point_at(lam: Lamella, s: np.ndarray) -> np.ndarray:
@@ -76,7 +76,7 @@ def test_move_joints_rejects_wrong_shapes():
 def test_states_moved_at_once_equal_each_moved_alone():
     """move_joints_states carries several joint states through one spline with all states'
     columns; each state's net equals that state moved alone (the columns do not mix)."""
-    from gridshell.net import move_joints_states
+    from gridshell.geometry.net import move_joints_states
 
     net = _arc_net()
     rng = np.random.default_rng(7)

@@ -1,5 +1,5 @@
 """The lamella axes carried to joint states with the displacement splines of all lamellae
-solved at once (gridshell.net._carry_axes, gridshell.spline_batch) are the axes carried lamella
+solved at once (gridshell.geometry.net._carry_axes, gridshell.geometry.spline_batch) are the axes carried lamella
 by lamella with scipy's CubicSpline, bit for bit."""
 from __future__ import annotations
 
@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 from scipy.interpolate import CubicSpline
 
-from gridshell.net import Lamella, Net, _smooth_at, carried_axes, move_joints_states
-from gridshell.spline_batch import cubic_splines_at
+from gridshell.geometry.net import Lamella, Net, _smooth_at, carried_axes, move_joints_states
+from gridshell.geometry.spline_batch import cubic_splines_at
 
 
 def _bits(a) -> np.ndarray:

@@ -1,4 +1,4 @@
-"""gridshell.outputs.write_outputs (``gridshell render --report --3dm``): the .3dm built in a
+"""gridshell.workflow.outputs.write_outputs (``gridshell render --report --3dm``): the .3dm built in a
 second process while the pictures and the report are made gives the files of the calls one
 after the other, byte for byte and object by object; a failure on either side leaves no .3dm,
 no temporary file and no process behind, and the other side's error is the one raised."""
@@ -14,10 +14,10 @@ import pytest
 from render_cases import make_bundle, write_case
 from test_aside import _objects
 
-from gridshell import outputs
-from gridshell.aside import can_fork
-from gridshell.bundle import write_bundle
-from gridshell.errors import InputError
+from gridshell.workflow import outputs
+from gridshell.core.aside import can_fork
+from gridshell.design.bundle import write_bundle
+from gridshell.core.errors import InputError
 from gridshell.export.rhino import write_3dm
 from gridshell.render.report import write_report
 from gridshell.render.ribbons import render_bundle

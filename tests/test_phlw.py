@@ -13,9 +13,9 @@ benchmarks/phlw.py runs the paper's 9 x 9 / 18 x 18.
 import numpy as np
 import pytest
 
-from gridshell.bspline import BSplineSurface, fit_grid, uniform_params
-from gridshell.errors import InputError
-from gridshell.grid import grid_quads
+from gridshell.geometry.bspline import BSplineSurface, fit_grid, uniform_params
+from gridshell.core.errors import InputError
+from gridshell.geometry.grid import grid_quads
 from gridshell.ncp import phlw as P
 from gridshell.ncp.reference import initial_surface
 

@@ -12,6 +12,7 @@ import pytest
 
 from gridshell.corpus import get
 from gridshell.ncp import phlw as P
+from gridshell.ncp.phlw import optimize as O
 from gridshell.ncp.reference import initial_surface
 
 DENSE = np.linspace(0, 1, 60)
@@ -71,10 +72,10 @@ def test_early_stop_is_no_worse_than_running_the_rounds_out():
 
 
 def test_sample_levels():
-    assert P.sample_levels((18, 18)) == [(18, 18)]
-    assert P.sample_levels((12, 10)) == [(12, 10)]
-    assert P.sample_levels((36, 36)) == [(18, 18), (36, 36)]
-    assert P.sample_levels((24, 48)) == [(18, 24), (24, 48)]
+    assert O.sample_levels((18, 18)) == [(18, 18)]
+    assert O.sample_levels((12, 10)) == [(12, 10)]
+    assert O.sample_levels((36, 36)) == [(18, 18), (36, 36)]
+    assert O.sample_levels((24, 48)) == [(18, 24), (24, 48)]
 
 
 def test_coarse_level_figures_are_judged_at_the_asked_sampling():

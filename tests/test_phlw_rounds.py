@@ -11,10 +11,11 @@ Small sizes (7 x 7 control points, 10 - 12 samples) keep the file fast.
 import numpy as np
 import pytest
 
-from gridshell.bspline import BSplineSurface, fit_grid, uniform_params
-from gridshell.grid import grid_quads
+from gridshell.geometry.bspline import BSplineSurface, fit_grid, uniform_params
+from gridshell.geometry.grid import grid_quads
 from gridshell.ncp import phlw as P
-from gridshell.ncp import phlw_rounds
+from gridshell.ncp.phlw import optimize as O
+from gridshell.ncp.phlw import rounds as phlw_rounds
 from gridshell.ncp.reference import initial_surface
 
 
@@ -124,7 +125,7 @@ def test_a_round_that_raises_the_true_energy_is_cut_back_or_rejected():
     init = initial_surface(V, F, n_ctrl=(7, 7))
     center = V.mean(0)
     diag = float(np.linalg.norm(np.ptp(V, axis=0)))
-    s0 = P._scaled_surface(init.surface, center, diag)
+    s0 = O._scaled_surface(init.surface, center, diag)
     u, v = uniform_params(s0, (10, 10))
     data = P.make_samples(s0, u, v, "cnc")
     lay = P.make_layout(s0.n_ctrl, 100, 10, "cnc")
@@ -184,7 +185,7 @@ def test_aa_on_a_dome_says_early_that_no_net_exists():
     the K range of the reference (closed form of the elliptic paraboloid) in 1/m^2."""
     import time
 
-    from gridshell.errors import NoNetError
+    from gridshell.core.errors import NoNetError
 
     a, b = 20.0, 12.0                      # z = -(x^2 / 2a + y^2 / 2b): K = 1 / (a b (...)^2)
     V, F = height_mesh(lambda x, y: -(x ** 2 / (2 * a) + y ** 2 / (2 * b)), 10, 8, 20, 16)
@@ -205,7 +206,7 @@ def test_an_optimizer_that_only_makes_things_worse_raises_convergence_error(monk
     reference's figures do not hold, so ConvergenceError (exit 4), not a silent result."""
     from types import SimpleNamespace
 
-    from gridshell.errors import ConvergenceError
+    from gridshell.core.errors import ConvergenceError
 
     def worse(prob, x, **kw):
         lay = prob.layout

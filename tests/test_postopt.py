@@ -1,16 +1,16 @@
 """Post-optimization and alignment simulation of NCP joint meshes (gridshell.ncp.postopt,
-gridshell.ncp.simulate, paper 4.2.4)."""
+gridshell.ncp.alignment, paper 4.2.4)."""
 import numpy as np
 import pytest
 
-from gridshell.errors import InputError
-from gridshell.metrics import alignability_error, delta_l, delta_n
+from gridshell.core.errors import InputError
+from gridshell.measure.metrics import alignability_error, delta_l, delta_n
 from gridshell.ncp import levelset as LS
 from gridshell.ncp import postopt as PO
 from gridshell.ncp.collapse import collapse_curve
-from gridshell.bspline import uniform_params
+from gridshell.geometry.bspline import uniform_params
 from gridshell.ncp.directions import net_directions
-from gridshell.ncp.simulate import collapse_direction, embed_aligned, simulate_alignment
+from gridshell.ncp.alignment import collapse_direction, embed_aligned, simulate_alignment
 from gridshell.solver import Layout
 
 from ncp_cases import pseudosphere, torus
@@ -147,7 +147,7 @@ def test_faster_frames_match_the_fair_cold_started_sequence(pseudo_post, monkeyp
     against the sequence as it was computed before (fairness 1e-5, every frame's damping from
     1e-3): same end state, the same energy in every frame within 2 %, an edge-length error
     in every state no larger by more than a quarter of a percent, in fewer iterations."""
-    import gridshell.ncp.simulate as SIM
+    import gridshell.ncp.alignment as SIM
 
     surf, tn, _, post = pseudo_post
     E, d = tn.net.edges(), collapse_direction(surf)

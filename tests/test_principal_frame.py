@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from gridshell.bspline import fit_grid
+from gridshell.geometry.bspline import fit_grid
 from gridshell.ncp.principal_frame import ALIGN_MIN_DEG, principal_angle
 from gridshell.ncp.reference import initial_surface
 

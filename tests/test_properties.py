@@ -10,12 +10,12 @@ from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from gridshell.bspline import basis_matrix
-from gridshell.grid import grid_quads
-from gridshell.igl_adapter import closest_points
-from gridshell.metrics import alignability_error, delta_l, delta_n, deviation
+from gridshell.geometry.bspline import basis_matrix
+from gridshell.geometry.grid import grid_quads
+from gridshell.geometry.igl_adapter import closest_points
+from gridshell.measure.metrics import alignability_error, delta_l, delta_n, deviation
 from gridshell.ncp.collapse import fit_circle, fit_plane, integrate_collapse, line_deviation
-from gridshell.net import polyline_arclength, polyline_length
+from gridshell.geometry.net import polyline_arclength, polyline_length
 from gridshell.render.ribbons import ribbon_polygons
 from gridshell.solver.layout import Layout
 

@@ -1,13 +1,13 @@
-"""Tests of gridshell.quadmesh: geometry, topology, mesh files and input checks."""
+"""Tests of gridshell.geometry.quadmesh: geometry, topology, mesh files and input checks."""
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from gridshell.errors import MeshError
-from gridshell.grid import grid_quads
-from gridshell.quadmesh import QuadMesh, TriMesh, validate_mesh
-from gridshell.meshfile import read_mesh, read_polylines, write_mesh, write_polylines
+from gridshell.core.errors import MeshError
+from gridshell.geometry.grid import grid_quads
+from gridshell.geometry.quadmesh import QuadMesh, TriMesh, validate_mesh
+from gridshell.geometry.meshfile import read_mesh, read_polylines, write_mesh, write_polylines
 
 
 def planar_grid(R: int = 4, C: int = 5, h: float = 0.5) -> QuadMesh:
@@ -258,7 +258,7 @@ def test_non_manifold_vertex():
 
 
 def test_too_large(monkeypatch):
-    import gridshell.quadmesh as qm
+    import gridshell.geometry.quadmesh as qm
     M = planar_grid(3, 3)
     monkeypatch.setattr(qm, "MAX_ELEMENTS", 3)
     with pytest.raises(MeshError, match="too large"):
@@ -271,7 +271,7 @@ def test_quadmesh_checks_input():
 
 
 def test_read_configuration_accepts_a_collapsed_net_but_not_garbage(tmp_path):
-    from gridshell.meshfile import read_configuration
+    from gridshell.geometry.meshfile import read_configuration
     # a collapsed net: every loop's joints on the x axis, zero area by design
     V = np.array([[0.0, 0, 0], [1, 0, 0], [2, 0, 0], [1.5, 0, 0]])
     F = np.array([[0, 1, 2, 3]])
@@ -293,7 +293,7 @@ def test_read_configuration_accepts_a_collapsed_net_but_not_garbage(tmp_path):
 def test_orientation_message_counts_and_names_as_numpys_unique():
     """The directed edges run twice found by sorting: the count and first edge of the message
     are those of np.unique's counts (a grid with several faces flipped)."""
-    from gridshell.quadmesh import _face_edges, _topology_problem
+    from gridshell.geometry.quadmesh import _face_edges, _topology_problem
 
     n = 7
     F = np.array([[i * n + j, (i + 1) * n + j, (i + 1) * n + j + 1, i * n + j + 1]

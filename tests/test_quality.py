@@ -3,7 +3,7 @@ import math
 
 import pytest
 
-from gridshell.quality import THRESHOLDS, design_gates, failing, gate_summary, passed
+from gridshell.measure.quality import THRESHOLDS, design_gates, failing, gate_summary, passed
 
 
 def _gg(mean, mx, amean=None, amax=None):

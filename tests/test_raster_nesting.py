@@ -1,4 +1,4 @@
-"""Raster nesting (fabrication.raster): the scanline fill against shapely, and placements of
+"""Raster nesting (gridshell.fabrication.raster): the scanline fill against shapely, and placements of
 random arcs and strips checked exactly with shapely: every part once, on one sheet, inside
 the gap-wide margin, no two parts closer than the gap, rigid motions only."""
 from __future__ import annotations
@@ -8,9 +8,9 @@ import pytest
 import shapely
 from shapely.geometry import Polygon
 
-from fabrication.path import Motion
-from fabrication.raster import fill, raster_nest
-from gridshell.errors import InputError
+from gridshell.fabrication.path import Motion
+from gridshell.fabrication.raster import fill, raster_nest
+from gridshell.core.errors import InputError
 
 
 def _arc(R: float, w: float, span: float, n: int = 60) -> Polygon:
@@ -89,7 +89,7 @@ def test_raster_part_too_large_is_none():
 
 
 def test_rotation_option_is_checked():
-    from fabrication import FabParams
+    from gridshell.fabrication import FabParams
 
     assert FabParams(rotation="grain").rotation == "grain"
     with pytest.raises(InputError, match="--rotation"):
@@ -99,7 +99,7 @@ def test_rotation_option_is_checked():
 def test_depth_of_a_mask_inside_another_is_not_larger():
     """depth: a disc of radius r is about r deep; a mask translated inside another is at most as
     deep (the rule that lets a sheet skip rotations without an FFT)."""
-    from fabrication.raster import depth
+    from gridshell.fabrication.raster import depth
 
     yy, xx = np.mgrid[0:120, 0:160]
     disc = (xx - 60) ** 2 + (yy - 50) ** 2 <= 20 ** 2
@@ -119,7 +119,7 @@ def test_depth_pruning_keeps_the_layout_and_skips_products(monkeypatch):
     free band is thinner than a bar costs the bar no FFT product."""
     import scipy.fft
 
-    import fabrication.raster as raster
+    import gridshell.fabrication.raster as raster
 
     rng = np.random.default_rng(11)
     bars = [shapely.affinity.rotate(shapely.box(0, 0, rng.uniform(200, 280), 40),

@@ -1,7 +1,7 @@
-"""gridshell.recent.Recent: least recently used dropped first, byte limit, copies in and out."""
+"""gridshell.core.recent.Recent: least recently used dropped first, byte limit, copies in and out."""
 import numpy as np
 
-from gridshell.recent import Recent
+from gridshell.core.recent import Recent
 
 
 def test_oldest_unused_is_dropped_and_copies_are_returned():

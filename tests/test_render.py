@@ -6,7 +6,7 @@ import pytest
 from PIL import Image
 from render_cases import make_bundle, write_case
 
-from gridshell.errors import InputError
+from gridshell.core.errors import InputError
 from gridshell.render.ribbons import (FAMILY_COLOURS, ribbon_polygons, render_bundle,
                                       render_ribbons, view_angles)
 from gridshell.render.sequence import read_sequence, render_bundle_sequence, sequence_files
@@ -67,7 +67,7 @@ def test_render_ribbons_png(tmp_path, kind):
 
 def _square(z: float, n: int = 1, half: float = 1.0):
     """A horizontal square ``[-half, half]^2`` at height ``z`` as an ``n x n`` quad grid."""
-    from gridshell.grid import grid_quads
+    from gridshell.geometry.grid import grid_quads
 
     t = np.linspace(-half, half, n + 1)
     X, Y = np.meshgrid(t, t, indexing="ij")
@@ -219,7 +219,7 @@ def test_sequence_missing(tmp_path):
 
 def _states_case():
     """A 4 x 4 joint grid of a dome shrinking onto a line: deployed, half-way, collapsed."""
-    from gridshell.grid import grid_quads
+    from gridshell.geometry.grid import grid_quads
 
     t = np.linspace(-1.0, 1.0, 4)
     X, Y = np.meshgrid(t, t, indexing="ij")
@@ -233,7 +233,7 @@ def _states_case():
 
 
 def test_state_images_share_one_crop_and_scale():
-    from gridshell.render.states import state_images
+    from gridshell.render.state_sheet import state_images
 
     frames, E, fam, _ = _states_case()
     imgs = state_images(frames, E, families=fam, dpi=60)
@@ -251,7 +251,7 @@ def test_state_images_share_one_crop_and_scale():
 def test_states_png_strip_and_sequence_pngs():
     import io
 
-    from gridshell.render.states import sequence_pngs, state_images, states_png
+    from gridshell.render.state_sheet import sequence_pngs, state_images, states_png
 
     frames, E, fam, _ = _states_case()
     with Image.open(io.BytesIO(states_png(frames, E, labels=["deployed", "t = 0.5",

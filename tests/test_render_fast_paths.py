@@ -120,7 +120,7 @@ def test_strips_faces_are_each_strips_solid_sides(tangent):
     """All strips at once: axis by axis, the quads of each side of strip_solid's section (each
     side in two halves), the same numbers as one strip at a time."""
     from gridshell.render.painter import strips_faces
-    from gridshell.strips3d import strip_solid
+    from gridshell.geometry.strips3d import strip_solid
 
     rng = np.random.default_rng(8)
     axes = [np.cumsum(rng.normal(size=(k, 3)), axis=0) for k in (2, 5, 17)]
@@ -225,7 +225,7 @@ def test_picture_transform_is_the_axes_transdata(rect):
 def _strips_faces_by_groups(axes, normals, width, thickness, tangent):
     """strips_faces as it was written first: each of the 8 groups stacked from the frames'
     rows, the groups concatenated, then reordered axis by axis."""
-    from gridshell.strips3d import strip_frames
+    from gridshell.geometry.strips3d import strip_frames
 
     P, N, _, W, H = strip_frames(axes, normals, tangent)
     sizes = np.array([len(a) for a in axes], dtype=np.int64)

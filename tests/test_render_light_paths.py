@@ -98,7 +98,7 @@ def designed():
     from ncp_cases import pseudosphere
 
     from gridshell.api import design_gg, design_ncp
-    from gridshell.grid import grid_quads
+    from gridshell.geometry.grid import grid_quads
 
     out = {f"NCP {c}": design_ncp(pseudosphere(), mode="aa", curves=c).bundle for c in (10, 20)}
     P = hill_grid(24, 16)

@@ -8,7 +8,7 @@ from test_render import _states_case
 
 
 def test_a_state_picture_does_not_depend_on_the_states_drawn_before_it():
-    from gridshell.render.states import state_images
+    from gridshell.render.state_sheet import state_images
 
     frames, E, fam, _ = _states_case()
     view = (25.0, -50.0)  # one camera for both orders (the default one is fitted to all)

@@ -12,7 +12,7 @@ from PIL import Image
 from render_cases import write_case
 
 from gridshell.cli.main import main
-from gridshell.errors import InputError
+from gridshell.core.errors import InputError
 from gridshell.render.report import metric_checks, write_report
 
 VOID = {"area", "base", "br", "col", "embed", "hr", "img", "input", "link", "meta", "source",

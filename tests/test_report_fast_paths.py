@@ -15,8 +15,8 @@ import pytest
 sys.path.insert(0, str(Path(__file__).parent))
 from render_cases import make_bundle, paraboloid, sequence_extra, write_case  # noqa: E402
 
-from gridshell.bundle import read_bundle, write_bundle  # noqa: E402
-from gridshell.net import Lamella, Net, polyline_arclength  # noqa: E402
+from gridshell.design.bundle import read_bundle, write_bundle  # noqa: E402
+from gridshell.geometry.net import Lamella, Net, polyline_arclength  # noqa: E402
 from gridshell.render.viewer import scene as sc  # noqa: E402
 
 
@@ -81,9 +81,9 @@ def _former_joint_normals(states, loops, n0):
 def _former_strips(d: Path) -> dict:
     """The strips, Delta_a samples and centres of build_scene as computed before 2026-12-02:
     move_joints_states' nets, one _sample / np.interp / strip_solid per lamella and state."""
-    from gridshell.net import move_joints_states
+    from gridshell.geometry.net import move_joints_states
     from gridshell.render.section import bundle_section
-    from gridshell.strips3d import is_tangent, nearest_vertex_normals, strip_solid
+    from gridshell.geometry.strips3d import is_tangent, nearest_vertex_normals, strip_solid
 
     b = read_bundle(d)
     section = bundle_section(d)
@@ -210,7 +210,7 @@ def test_interp_rows_is_np_interp_row_by_row():
 
 
 def test_carried_axes_are_the_moved_nets_axes():
-    from gridshell.net import carried_axes, move_joints_states
+    from gridshell.geometry.net import carried_axes, move_joints_states
 
     b = _edge_net()
     rng = np.random.default_rng(2)
@@ -253,7 +253,7 @@ def test_extremes_are_each_states_min_and_max_with_the_sign_of_zero():
 
 
 def test_vertex_normals_by_bincount_are_those_of_add_at():
-    from gridshell.quadmesh import _unit, area_weighted_vertex_normals, polygon_vector_areas
+    from gridshell.geometry.quadmesh import _unit, area_weighted_vertex_normals, polygon_vector_areas
 
     rng = np.random.default_rng(8)
     for trial in range(20):
@@ -270,7 +270,7 @@ def test_vertex_normals_by_bincount_are_those_of_add_at():
 
 
 def test_strip_solid_faces_are_strip_solids():
-    from gridshell.strips3d import strip_solid, strip_solid_faces
+    from gridshell.geometry.strips3d import strip_solid, strip_solid_faces
 
     for k in (2, 3, 17):
         P = np.column_stack([np.arange(k, dtype=float), np.zeros(k), np.zeros(k)])
@@ -281,8 +281,8 @@ def test_strip_solid_faces_are_strip_solids():
 def test_surface_lookup_is_kept_by_content_only():
     from scipy.spatial import cKDTree
 
-    from gridshell.quadmesh import area_weighted_vertex_normals
-    from gridshell.strips3d import nearest_vertex_normals
+    from gridshell.geometry.quadmesh import area_weighted_vertex_normals
+    from gridshell.geometry.strips3d import nearest_vertex_normals
 
     b = make_bundle("GG")
     V, F = b.surface_V.copy(), b.surface_F.copy()
@@ -305,7 +305,7 @@ def test_smooth_curve_at_its_knots_is_the_vertices():
     interior knot is 0.0 + y there (+-0 included), bit for bit; elsewhere it is the spline."""
     from scipy.interpolate import CubicSpline
 
-    from gridshell.net import _smooth_at
+    from gridshell.geometry.net import _smooth_at
 
     rng = np.random.default_rng(6)
     for trial in range(300):
@@ -339,7 +339,7 @@ def test_joint_normals_of_all_states_at_once_are_state_by_state():
 
 
 def test_row_norms_are_numpys_norms():
-    from gridshell.vectors import row_norms
+    from gridshell.geometry.vectors import row_norms
 
     rng = np.random.default_rng(12)
     for trial in range(200):

@@ -124,8 +124,8 @@ def test_committed_meshes_are_what_make_meshes_makes():
 
 
 def test_sample_meshes_read_back_as_described():
-    from gridshell.quadmesh import QuadMesh, TriMesh
-    from gridshell.meshfile import read_mesh
+    from gridshell.geometry.quadmesh import QuadMesh, TriMesh
+    from gridshell.geometry.meshfile import read_mesh
 
     assert isinstance(read_mesh(SAMPLES / "dome.obj"), TriMesh)
     for name in ("helicoid", "saddle", "pseudosphere", "torus_patch"):

@@ -12,8 +12,8 @@ from ncp_cases import torus_grid
 pytest.importorskip("ghhops_server")
 import rhino3dm  # noqa: E402
 
-from gridshell.bundle import read_bundle  # noqa: E402
-from gridshell.grid import grid_quads  # noqa: E402
+from gridshell.design.bundle import read_bundle  # noqa: E402
+from gridshell.geometry.grid import grid_quads  # noqa: E402
 from gridshell.server.components import make_app  # noqa: E402
 from gridshell.server.rhino import mesh_arrays, to_mesh  # noqa: E402
 
@@ -111,8 +111,8 @@ def test_gg_component_matches_the_api(gg_solved):
 
 
 def test_verify_and_fabricate_components_match_the_api(client, gg_solved, tmp_path):
-    from fabrication import FabParams, fabricate
-    from gridshell.verification import verify_bundle
+    from gridshell.fabrication import FabParams, fabricate
+    from gridshell.design.verification import verify_bundle
 
     _, _, out = gg_solved
     path = json.loads(out["Bundle"][0])

@@ -6,7 +6,7 @@ import scipy.sparse as sp
 
 from fd_cases.fixtures import circle_term, grid_quads, planarity_term, rosenbrock_term
 
-from gridshell.errors import ConvergenceError, InputError
+from gridshell.core.errors import ConvergenceError, InputError
 from gridshell.solver import Layout, Problem, result, solve, term
 from gridshell.solver import terms as T
 from gridshell.solver.fdcheck import jacobian_error

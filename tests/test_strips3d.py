@@ -1,9 +1,9 @@
-"""The strip as built (gridshell.strips3d): frames and closed solids against closed forms."""
+"""The strip as built (gridshell.geometry.strips3d): frames and closed solids against closed forms."""
 import numpy as np
 import pytest
 
-from gridshell.errors import InputError
-from gridshell.strips3d import (is_tangent, real_section_m, strip_frame, strip_solid)
+from gridshell.core.errors import InputError
+from gridshell.geometry.strips3d import (is_tangent, real_section_m, strip_frame, strip_solid)
 
 
 def _circle(R=2.0, k=200, angle=np.pi):
@@ -82,7 +82,7 @@ def test_strip_solid_with_the_frame_given_is_the_strip_solid():
     """The .3dm export hands strip_solid the frame it computed: the same solid, bit for bit."""
     import numpy as np
 
-    from gridshell.strips3d import strip_frame, strip_solid
+    from gridshell.geometry.strips3d import strip_frame, strip_solid
 
     t = np.linspace(0, 2, 41)
     P = np.column_stack([t, np.sin(t), 0.2 * t * t])
@@ -113,7 +113,7 @@ def _check_rings(P, N, w, t, tangent):
     """solid_rings keeps the ends, its solid's corner edges within ring_tolerance of the full
     ones (each full-resolution corner point to the simplified corner polyline), and the
     solid through the kept rings is closed and consistently oriented like strip_solid's."""
-    from gridshell.strips3d import ring_tolerance, solid_rings
+    from gridshell.geometry.strips3d import ring_tolerance, solid_rings
 
     T, W, H = strip_frame(P, N, tangent)
     r = solid_rings(P, W, H, w, t)
@@ -136,7 +136,7 @@ def test_solid_rings_of_a_helix_strip(tangent):
     """A helix strip (bent and twisted: the normal of its cylinder turns round the axis),
     2000 samples over two turns of radius 0.5 m: far fewer rings, every corner edge within
     ring_tolerance (0.05 mm here: 1 % of 10 mm is 0.1 mm) of the full-resolution one."""
-    from gridshell.strips3d import ring_tolerance
+    from gridshell.geometry.strips3d import ring_tolerance
 
     k, R, pitch = 2000, 0.5, 0.3
     a = np.linspace(0.0, 4 * np.pi, k)
@@ -151,7 +151,7 @@ def test_solid_rings_of_a_helix_strip(tangent):
 
 def test_solid_rings_keep_what_a_finer_tolerance_needs():
     """A tolerance of 0 keeps every sample of a curved axis; a straight axis needs its ends."""
-    from gridshell.strips3d import solid_rings
+    from gridshell.geometry.strips3d import solid_rings
 
     P = _circle(k=50)
     N = np.tile([0.0, 0.0, 1.0], (len(P), 1))
@@ -168,7 +168,7 @@ def test_solid_rings_of_an_ncp_bundle():
     the .3dm export builds them): within the tolerance, and at most half the rings."""
     from ncp_cases import pseudosphere
 
-    from gridshell.igl_adapter import closest_points_with_normals
+    from gridshell.geometry.igl_adapter import closest_points_with_normals
     from gridshell.ncp.pipeline import design_ncp
 
     bundle, _ = design_ncp(pseudosphere(), mode="aa", curves=10)
@@ -189,7 +189,7 @@ def _rings_one_by_one(P, W, H, w, t, tol):
     """The straightforward Ramer-Douglas-Peucker of solid_rings: each span split at its first
     farthest sample (the largest of the four corners' distances to their chords) while that
     exceeds ``tol``, span by span (recursion), one axis at a time."""
-    from gridshell.strips3d import _segment_distance
+    from gridshell.geometry.strips3d import _segment_distance
 
     X = _corners(P, W, H, w, t)
     keep = {0, len(P) - 1}
@@ -211,7 +211,7 @@ def test_solid_rings_many_equal_one_axis_at_a_time():
     axis the indices solid_rings gives it alone, and both those of the straightforward
     recursive simplification: wiggly axes of many lengths (1, 2, 3 samples too), tangent and
     standing frames, several tolerances."""
-    from gridshell.strips3d import ring_tolerance, solid_rings, solid_rings_many
+    from gridshell.geometry.strips3d import ring_tolerance, solid_rings, solid_rings_many
 
     rng = np.random.default_rng(7)
     axes = []

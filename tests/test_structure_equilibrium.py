@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 
 from fab_cases import make_bundle
-from gridshell import manifest
-from gridshell.bundle import write_bundle
+from gridshell.core import manifest
+from gridshell.design.bundle import write_bundle
 from gridshell.cli.main import main
-from gridshell.errors import InputError
+from gridshell.core.errors import InputError
 from gridshell.structure import Section, get_material
 from gridshell.structure.deployed import GRAVITY, Stiffness, build_model
 from gridshell.structure.equilibrium import simulate

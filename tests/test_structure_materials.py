@@ -5,8 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from fabrication.params import FabParams
-from gridshell.errors import InputError
+from gridshell.fabrication.params import FabParams
+from gridshell.core.errors import InputError
 from gridshell.structure import MATERIALS, Section, get_material, material_names, user_material
 from gridshell.structure.section import torsion_beta, torsion_stress_factor
 

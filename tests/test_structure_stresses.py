@@ -44,7 +44,7 @@ def test_cylinder_helix_on_a_mesh():
     z = np.linspace(-0.2, 2.8, 60)
     Ph, Z = np.meshgrid(phi, z, indexing="ij")
     V = np.stack([R * np.cos(Ph), R * np.sin(Ph), Z], -1).reshape(-1, 3)
-    from gridshell.grid import grid_quads
+    from gridshell.geometry.grid import grid_quads
     F = grid_quads(60, 60)
     P, N_exact = helix(R, a, L=2.4, n=241)
     N = surface_normals(P, V, F)
@@ -219,7 +219,7 @@ def test_joint_estimate_agrees_with_dense():
 
 
 def test_joint_normals_of_a_grid_and_a_collapsed_net():
-    from gridshell.grid import grid_quads
+    from gridshell.geometry.grid import grid_quads
     X, Y = np.meshgrid(np.linspace(0, 1, 4), np.linspace(0, 1, 4), indexing="ij")
     V = np.stack([X, Y, 0 * X], -1).reshape(-1, 3)
     F = grid_quads(4, 4)

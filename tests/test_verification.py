@@ -10,11 +10,11 @@ import numpy as np
 import pytest
 from fab_cases import make_bundle
 
-from gridshell.bundle import write_bundle
+from gridshell.design.bundle import write_bundle
 from gridshell.cli.main import main
-from gridshell.errors import GridshellError, InputError
-from gridshell.meshfile import orientation_problem, read_configuration, write_mesh
-from gridshell.verification import verify_bundle
+from gridshell.core.errors import GridshellError, InputError
+from gridshell.geometry.meshfile import orientation_problem, read_configuration, write_mesh
+from gridshell.design.verification import verify_bundle
 
 FLAT = {"c": 0.0, "twist": 0.0, "stretch": 0.0}  # a plane rectangular grid: Delta_a = 0
 
@@ -187,7 +187,7 @@ def test_write_mesh_refuses_inconsistent_orientation(tmp_path):
 
 def test_collapsed_net_with_degenerate_loops_is_still_writable(tmp_path):
     # aligned.obj: every joint on a line, loops of zero area, orientation is combinatorial
-    from gridshell.grid import grid_quads
+    from gridshell.geometry.grid import grid_quads
 
     F = grid_quads(4, 5)
     V = np.zeros((20, 3))

@@ -15,13 +15,13 @@ import pytest
 from PIL import Image
 from render_cases import write_case
 
-from gridshell.bundle import read_bundle
-from gridshell.errors import InputError
+from gridshell.design.bundle import read_bundle
+from gridshell.core.errors import InputError
 from gridshell.render.report import write_report
 from gridshell.render.section import DEFAULT_CUT, bundle_section
 from gridshell.render.viewer import assets
 from gridshell.render.viewer.scene import build_scene, decode, strip_solids_vertices
-from gridshell.strips3d import nearest_vertex_normals, strip_solid
+from gridshell.geometry.strips3d import nearest_vertex_normals, strip_solid
 
 VENDOR = Path(assets.__file__).parent / "vendor"
 
@@ -89,7 +89,7 @@ def test_three_script_is_classic_and_complete():
 
 
 def test_section_from_fabrication_json_or_defaults(tmp_path, gg):
-    from fabrication.params import FabParams
+    from gridshell.fabrication.params import FabParams
 
     p = FabParams()
     assert (p.width, p.thickness, p.scale) == (DEFAULT_CUT["width"], DEFAULT_CUT["thickness"],
@@ -152,7 +152,7 @@ def test_scene_decodes_to_the_bundle_geometry(gg):
     Vs = decode(S["surface"]["V"], "f4").reshape(-1, 3)
     Fs = decode(S["surface"]["F"], "u4").reshape(-1, 3)
     assert np.allclose(Vs, b.surface_V, atol=1e-6)
-    from gridshell.metrics import surface_area
+    from gridshell.measure.metrics import surface_area
     assert _tri_areas(Vs.astype(float), Fs.astype(np.int64)).sum() == pytest.approx(
         surface_area(b.surface_V, b.surface_F), rel=1e-6)
     # the last state: every strip near the aligned joints' line (the x axis)
@@ -169,7 +169,7 @@ def test_scene_decodes_to_the_bundle_geometry(gg):
 
 
 def test_scene_delta_a_matches_the_metrics(gg):
-    from gridshell.metrics import alignability_error
+    from gridshell.measure.metrics import alignability_error
 
     S = build_scene(gg)
     b = read_bundle(gg)
@@ -239,7 +239,7 @@ def test_scene_without_sequence_has_deployed_and_aligned(tmp_path):
 def test_long_sequence_is_thinned_keeping_both_ends(tmp_path):
     from render_cases import make_bundle, sequence_extra
 
-    from gridshell.bundle import write_bundle
+    from gridshell.design.bundle import write_bundle
     from gridshell.render.viewer.scene import MAX_STATES
 
     b = make_bundle("GG")

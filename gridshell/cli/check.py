@@ -18,13 +18,13 @@ from typing import Any
 HELP = ("stresses the design imposes on its strips (bending about both axes, twist) for a "
         "material and section; writes DIR/structure.json (exit 0 elastic, 4 overstressed)")
 
-#: exit code of an overstressed design (gridshell.errors.EXIT_CODES: a figure fails)
+#: exit code of an overstressed design (gridshell.core.errors.EXIT_CODES: a figure fails)
 OVERSTRESSED = 4
 
 
 def add_args(p: argparse.ArgumentParser) -> None:
-    from ..structure import MATERIALS
-    from .common import add_bundle_arg
+    from gridshell.structure import MATERIALS
+    from gridshell.cli.common import add_bundle_arg
 
     add_bundle_arg(p, "; structure.json goes into it")
     g = p.add_argument_group("material")
@@ -68,10 +68,10 @@ def _fabrication_params(bundle: Path) -> dict[str, Any]:
 
 def section_and_material(args: Any):
     """The :class:`Section` and :class:`Material` the options describe (SI inside)."""
-    from fabrication.params import parse_scale
+    from gridshell.fabrication.params import parse_scale
 
-    from ..errors import InputError
-    from ..structure import Section, get_material, user_material
+    from gridshell.core.errors import InputError
+    from gridshell.structure import Section, get_material, user_material
 
     fab = _fabrication_params(Path(args.bundle))
     width = args.width if args.width is not None else fab.get("width", 20.0)
@@ -129,10 +129,10 @@ def verdict_line(result: dict[str, Any]) -> str:
 
 
 def run(args: Any) -> int:
-    from ..bundle import finite_json, read_bundle, read_design_json
-    from ..errors import InputError
-    from ..structure.check import check_bundle, write_structure_json
-    from .common import Progress
+    from gridshell.design.bundle import finite_json, read_bundle, read_design_json
+    from gridshell.core.errors import InputError
+    from gridshell.structure.check import check_bundle, write_structure_json
+    from gridshell.cli.common import Progress
 
     progress = Progress(args)
     if args.top < 0:
@@ -145,7 +145,7 @@ def run(args: Any) -> int:
     out = write_structure_json(args.bundle, res)
     picture = None
     if not args.no_picture:
-        from ..render.structure import PICTURE, render_utilisation
+        from gridshell.render.utilisation import PICTURE, render_utilisation
 
         progress(f"drawing {PICTURE}")
         picture = render_utilisation(bundle, res, Path(args.bundle) / PICTURE)

@@ -49,7 +49,7 @@ def add_bundle_arg(p: Any, note: str = "") -> None:
 def add_input_args(p: Any) -> None:
     """``--units``, ``--no-clean`` and ``--object``: how a command reads the user's geometry
     (:func:`gridshell.io.read.read_input`)."""
-    from ..io.units import UNITS
+    from gridshell.core.units import UNITS
 
     p.add_argument("--units", choices=tuple(UNITS), metavar="|".join(UNITS),
                    help="the unit the input is drawn in (default: a .3dm's own unit system, "
@@ -94,7 +94,7 @@ def input_line(info: dict | None) -> str:
 def print_summary(args: Any, title: str, summary: dict[str, Any]) -> None:
     """One-screen summary on stdout, or JSON with ``--json``."""
     if getattr(args, "json", False):  # strict JSON: a figure not measured is null, not NaN
-        from ..bundle import finite_json
+        from gridshell.design.bundle import finite_json
 
         print(json.dumps(finite_json({"ok": True, **summary}), indent=1, default=_default,
                          allow_nan=False))

@@ -10,7 +10,7 @@
 
 Everything is written into a temporary directory that replaces ``-o DIR`` only when all of it
 succeeded; ``DIR/demo.json`` holds the summary printed at the end. An existing non-empty ``DIR``
-without ``demo.json`` is refused before any work (:func:`gridshell.atomic.check_output`,
+without ``demo.json`` is refused before any work (:func:`gridshell.core.atomic.check_output`,
 exit code 5, as for the other commands).
 """
 from __future__ import annotations
@@ -68,8 +68,8 @@ def _agrees(v: dict, stored: dict, keys: tuple[tuple[str, str], ...]) -> bool:
 
 
 def _checks(kind: str, metrics: dict) -> str:
-    """The design's verdict on the paper's figures (:func:`gridshell.quality.design_gates`)."""
-    from ..quality import design_gates, gate_summary, passed
+    """The design's verdict on the paper's figures (:func:`gridshell.measure.quality.design_gates`)."""
+    from gridshell.measure.quality import design_gates, gate_summary, passed
 
     gates = design_gates(kind, metrics)
     return ("pass (" if passed(gates) else "FAIL (") + gate_summary(gates) + ")"
@@ -78,10 +78,10 @@ def _checks(kind: str, metrics: dict) -> str:
 def _finish(d: Path, label: str, name: str, fab_params: dict, progress) -> dict[str, Any]:
     """Cut, check, render, export and report a written bundle ``d``; returns the fabrication
     report. The pictures, the report and the .3dm come from one call
-    (:func:`gridshell.outputs.write_outputs`: the .3dm built beside the pictures)."""
-    from fabrication import fabricate
+    (:func:`gridshell.workflow.outputs.write_outputs`: the .3dm built beside the pictures)."""
+    from gridshell.fabrication import fabricate
 
-    from ..outputs import write_outputs
+    from gridshell.workflow.outputs import write_outputs
 
     progress(f"{label}: cut files ({fab_params['scale']}, {fab_params['thickness']:g} mm "
              "polypropylene)")
@@ -94,11 +94,11 @@ def _finish(d: Path, label: str, name: str, fab_params: dict, progress) -> dict[
 
 def _structure(d: Path, label: str, fab_params: dict, progress) -> dict[str, Any]:
     """``gridshell check`` of the cut strips in polypropylene: structure.json and .png."""
-    from fabrication.params import parse_scale
+    from gridshell.fabrication.params import parse_scale
 
-    from ..render.structure import PICTURE, render_utilisation
-    from ..structure import Section, get_material
-    from ..structure.check import check_bundle, write_structure_json
+    from gridshell.render.utilisation import PICTURE, render_utilisation
+    from gridshell.structure import Section, get_material
+    from gridshell.structure.check import check_bundle, write_structure_json
 
     progress(f"{label}: stresses in the strips (structure.json, {PICTURE})")
     sec = Section(fab_params["width"], fab_params["thickness"], parse_scale(fab_params["scale"]))
@@ -117,9 +117,9 @@ def _strength(fab: dict) -> str:
 
 
 def _gg(root: Path, sizes: dict, progress) -> dict[str, Any]:
-    from .. import data
-    from ..api import design_gg, write
-    from ..verification import verify_bundle
+    from gridshell import data
+    from gridshell.api import design_gg, write
+    from gridshell.design.verification import verify_bundle
 
     t0 = time.perf_counter()
     target = data.path("dome.obj")
@@ -151,13 +151,13 @@ def _gg(root: Path, sizes: dict, progress) -> dict[str, Any]:
 
 
 def _ncp(root: Path, sizes: dict, progress) -> dict[str, Any]:
-    from .. import data
-    from ..atomic import write_bytes
-    from ..ncp.phlw import optimize_phlw, write_phlw
-    from ..api import design_ncp, write
-    from ..ncp.reference import initial_surface
-    from ..meshfile import read_mesh
-    from ..verification import verify_bundle
+    from gridshell import data
+    from gridshell.core.atomic import write_bytes
+    from gridshell.ncp.phlw import optimize_phlw, write_phlw
+    from gridshell.api import design_ncp, write
+    from gridshell.ncp.reference import initial_surface
+    from gridshell.geometry.meshfile import read_mesh
+    from gridshell.design.verification import verify_bundle
 
     t0 = time.perf_counter()
     ref = data.path("torus_patch.obj")
@@ -276,8 +276,8 @@ def _nested(summary: dict, gg: dict | None, ncp: dict | None) -> dict[str, Any]:
 
 
 def run(args: Any) -> int:
-    from ..atomic import atomic_dir, check_output, write_text
-    from .common import Progress, print_summary
+    from gridshell.core.atomic import atomic_dir, check_output, write_text
+    from gridshell.cli.common import Progress, print_summary
 
     progress = Progress(args)
     out = check_output(args.output, marker=MARKER)

@@ -11,7 +11,7 @@ HELP = ("export a design bundle to Rhino .3dm: lamellae as strips of their real 
 
 
 def add_args(p: argparse.ArgumentParser) -> None:
-    from .common import add_bundle_arg
+    from gridshell.cli.common import add_bundle_arg
 
     add_bundle_arg(p)
     p.add_argument("-o", "--output", metavar="PATH",
@@ -36,10 +36,10 @@ def add_args(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: Any) -> int:
-    from ..atomic import check_output
-    from ..bundle import read_design_json
-    from ..export.rhino import write_3dm
-    from .common import Progress, print_summary
+    from gridshell.core.atomic import check_output
+    from gridshell.design.bundle import read_design_json
+    from gridshell.export.rhino import write_3dm
+    from gridshell.cli.common import Progress, print_summary
 
     progress = Progress(args)
     design = read_design_json(args.bundle)

@@ -5,14 +5,14 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-from .common import add_bundle_arg, choice_help
+from gridshell.cli.common import add_bundle_arg, choice_help
 
 HELP = ("cut files of a design bundle: flat lamellae with joint holes, slots or marks and "
         "engraved ids, nested on sheets as DXF and SVG with PNG previews, with a cut list and an "
         "assembly plan")
 
 
-#: what each choice of the option sets of :mod:`fabrication.params` means (the choices and
+#: what each choice of the option sets of :mod:`gridshell.fabrication.params` means (the choices and
 #: defaults come from there)
 AXIS_HELP = {"centre": "on the centre line",
              "edge": "on one edge (orthogonal lamellae standing on the surface; not GG)"}
@@ -23,7 +23,7 @@ DXF_HELP = {"R2010": "AutoCAD 2010", "R12": "through ezdxf's R12 export"}
 
 
 def add_args(p: argparse.ArgumentParser) -> None:
-    from fabrication.params import AXIS_PLACES, DXF_VERSIONS, JOINT_STYLES, ROTATIONS, FabParams
+    from gridshell.fabrication.params import AXIS_PLACES, DXF_VERSIONS, JOINT_STYLES, ROTATIONS, FabParams
 
     add_bundle_arg(p)
     p.add_argument("-o", "--out", metavar="OUT",
@@ -77,27 +77,11 @@ def add_args(p: argparse.ArgumentParser) -> None:
                         "default: refused, exit 2)")
 
 
-def check_design(bundle: str, force: bool) -> dict[str, Any]:
-    """:func:`gridshell.verification.verify_bundle` of ``bundle``; :class:`InputError` naming
-    the failing figures and problems unless it is ok or ``force``. The verdict comes from the
-    figures recomputed from the files, never from a flag stored in design.json."""
-    from ..errors import InputError
-    from ..verification import verify_bundle
-
-    res = verify_bundle(bundle)
-    if res["ok"] or force:
-        return res
-    bad = [line.split("  ", 1)[1] for line in res["checks"] if line.startswith("FAIL")]
-    why = "; ".join(bad + res["problems"])
-    raise InputError(f"{bundle}: the design fails its checks ({why}); 'gridshell verify "
-                     f"{bundle}' shows them - pass --force to cut it anyway")
-
-
 def _structure_warning(bundle: str, params, material: str, progress) -> str | None:
     """The warning of :func:`gridshell.structure.check.overstress_warning` for these strips
     (deployed and collapsed states, the sequence too when the bundle has one)."""
-    from ..structure import Section, get_material
-    from ..structure.check import check_bundle, overstress_warning
+    from gridshell.structure import Section, get_material
+    from gridshell.structure.check import check_bundle, overstress_warning
 
     progress("checking the strips' stresses")
     res = check_bundle(bundle, get_material(material), Section.from_params(params))
@@ -108,14 +92,15 @@ def _structure_warning(bundle: str, params, material: str, progress) -> str | No
 
 
 def run(args: Any) -> int:
-    from fabrication import FabParams, fabricate
+    from gridshell.fabrication import FabParams, fabricate
 
-    from ..atomic import check_output
-    from ..bundle import read_design_json
-    from .common import Progress, print_summary
+    from gridshell.core.atomic import check_output
+    from gridshell.design.bundle import read_design_json
+    from gridshell.design.verification import require_design
+    from gridshell.cli.common import Progress, print_summary
 
     progress = Progress(args)
-    from ..structure import get_material
+    from gridshell.structure import get_material
 
     get_material(args.material)  # an unknown name is refused before any work
     params = FabParams(width=args.width, thickness=args.thickness, hole=args.hole,
@@ -130,19 +115,20 @@ def run(args: Any) -> int:
     out = Path(args.out) if args.out else Path(args.bundle) / "fabrication"
     check_output(out)
     progress(f"verifying {args.bundle}")
-    verdict = check_design(args.bundle, args.force)
-    if not verdict["ok"]:
+    verdict = require_design(args.bundle, args.force, f"'gridshell verify {args.bundle}' shows "
+                             "them - pass --force to cut it anyway")
+    if not verdict.ok:
         progress("warning: the design fails its checks; cut anyway (--force)")
     rep = fabricate(args.bundle, out, params, progress=progress.callback, plan=not args.no_plan)
-    from ..quality import Gate, gate_summary
+    from gridshell.measure.quality import gate_summary
 
-    gates = [Gate(g["name"], g["label"], g["value"], g["limit"]) for g in verdict["gates"]]
+    gates = list(verdict.gates)
     summary = {
         "output": str(out),
         "design": f"{rep['kind']} ({rep['shape']} strips)",
-        "design checks": (gate_summary(gates) if verdict["ok"] else
+        "design checks": (gate_summary(gates) if verdict.ok else
                           "cut with --force: " + "; ".join(
-                              [gate_summary(gates)] + verdict["problems"])),
+                              [gate_summary(gates)] + list(verdict.problems))),
         "strips / pieces": f"{rep['n_strips']} / {rep['n_pieces']}",
         "joint marks": rep["n_joint_marks"],
         "sheets": f"{rep['n_sheets']} x {params.sheet[0]:g} x {params.sheet[1]:g} mm "

@@ -9,7 +9,7 @@ HELP = "design a geodesic (GG) alignable gridshell on a target surface and write
 
 
 def add_args(p: argparse.ArgumentParser) -> None:
-    from .common import add_input_args
+    from gridshell.cli.common import add_input_args
 
     p.add_argument("target", help="target surface: a mesh (OBJ, PLY, OFF) or a Rhino .3dm (mesh, "
                                   "NURBS surface or single-face Brep), one disk")
@@ -60,8 +60,8 @@ def add_args(p: argparse.ArgumentParser) -> None:
 
 def _offsets(args: Any) -> tuple[list[float], list[float]] | None:
     """The (C1, C3) positions of ``--offsets`` / ``--offsets1`` / ``--offsets3``, validated."""
-    from ..errors import InputError
-    from ..gg.pipeline import check_offsets
+    from gridshell.core.errors import InputError
+    from gridshell.gg.pipeline import check_offsets
 
     o1 = args.offsets1 if args.offsets1 is not None else args.offsets
     o3 = args.offsets3 if args.offsets3 is not None else args.offsets
@@ -79,14 +79,14 @@ def _offsets(args: Any) -> tuple[list[float], list[float]] | None:
 
 
 def run(args: Any) -> int:
-    from ..atomic import check_output
-    from ..api import design_gg, write
-    from ..quality import Gate, gate_lines
-    from .common import Progress, input_line, input_options, print_summary
+    from gridshell.core.atomic import check_output
+    from gridshell.api import design_gg, write
+    from gridshell.measure.quality import Gate, gate_lines
+    from gridshell.cli.common import Progress, input_line, input_options, print_summary
 
     offsets = _offsets(args)
     if not 0 <= args.frames <= 1000:
-        from ..errors import InputError
+        from gridshell.core.errors import InputError
         raise InputError(f"--frames must be in 0 .. 1000 (each state is an optimization), got "
                          f"{args.frames}; e.g. 12")
     check_output(args.output, marker="design.json")

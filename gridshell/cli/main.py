@@ -14,8 +14,8 @@ import sys
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 from typing import Iterable, Sequence
 
-from .. import __version__
-from ..errors import GridshellError
+from gridshell.core.version import __version__
+from gridshell.core.errors import GridshellError
 
 #: subcommand name -> module in gridshell.cli with ``HELP``, ``add_args(parser)`` and ``run(args)``
 SUBCOMMANDS: dict[str, str] = {
@@ -53,7 +53,7 @@ class _Version(argparse.Action):
         super().__init__(option_strings, dest=dest, default=default, nargs=0, help=help)
 
     def __call__(self, parser, namespace, values, option_string=None):  # noqa: ANN001
-        from ..solver.linear import describe
+        from gridshell.solver.linear import describe
 
         try:
             lin = describe()
@@ -97,7 +97,7 @@ def _requested(argv: Sequence[str]) -> list[str]:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run the CLI; returns the exit code (:data:`gridshell.errors.EXIT_CODES`: 0 success,
+    """Run the CLI; returns the exit code (:data:`gridshell.core.errors.EXIT_CODES`: 0 success,
     2 bad input or no command, 3 no net, 4 not converged, 5 output refused or not writable,
     1 other tool error; argparse exits with 2 on an unknown option)."""
     argv = sys.argv[1:] if argv is None else list(argv)
@@ -108,7 +108,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"\ngridshell: error: give a command, one of {', '.join(SUBCOMMANDS)} "
               "(gridshell COMMAND --help describes its options)", file=sys.stderr)
         return 2
-    from ..manifest import set_command
+    from gridshell.core.manifest import set_command
 
     set_command(args.command, ["gridshell", *argv])
     try:

@@ -4,7 +4,7 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-from .common import choice_help
+from gridshell.cli.common import choice_help
 
 HELP = ("trace a normal-curvature-preserving alignable net on a PHLW / CNC / PK surface, "
         "post-optimize it, simulate its alignment and write a design bundle (NCP, CNC or AA)")
@@ -16,9 +16,9 @@ MODE_HELP = {"phlw": "normal curvature per principal line",
 
 
 def add_args(p: argparse.ArgumentParser) -> None:
-    from ..ncp.pipeline import KIND
+    from gridshell.ncp.pipeline import KIND
 
-    from .common import add_input_args
+    from gridshell.cli.common import add_input_args
 
     p.add_argument("reference", help="a surface.json written by 'gridshell phlw', or a reference "
                                      "mesh (OBJ, PLY, OFF) or Rhino .3dm (a NURBS surface is "
@@ -82,9 +82,9 @@ def _unconverged(bundle: Any, report: dict) -> list[str]:
 
 
 def run(args: Any) -> int:
-    from ..atomic import check_output
-    from ..api import design_ncp, write
-    from .common import Progress, input_line, input_options, print_gates
+    from gridshell.core.atomic import check_output
+    from gridshell.api import design_ncp, write
+    from gridshell.cli.common import Progress, input_line, input_options, print_gates
 
     check_output(args.output, marker="design.json")
     progress = Progress(args)

@@ -4,7 +4,7 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-from .common import choice_help
+from gridshell.cli.common import choice_help
 
 HELP = ("optimize a B-spline towards a PHLW (phlw), constant-normal-curvature (cnc) or "
         "PK (aa) surface near a reference mesh; writes surface.json/.obj, rows.csv, "
@@ -18,9 +18,9 @@ MODE_HELP = {"phlw": "(n_u, t_u) per principal line",
 
 
 def add_args(p: argparse.ArgumentParser) -> None:
-    from ..ncp.phlw import MODES
+    from gridshell.ncp.phlw import MODES
 
-    from .common import add_input_args
+    from gridshell.cli.common import add_input_args
 
     p.add_argument("reference", help="reference surface: a mesh (OBJ, PLY, OFF; a structured quad "
                                      "grid is fitted directly, rows -> u), a Rhino .3dm (a NURBS "
@@ -65,14 +65,14 @@ def add_args(p: argparse.ArgumentParser) -> None:
 def _load_reference(path: str, args: Any) -> tuple[Any, Any, Any, Any]:
     """(initial surface, V, F, input) from a mesh, a .3dm or a B-spline JSON; ``input`` is the
     :class:`gridshell.io.read.InputGeometry` (None for a JSON)."""
-    from ..bspline import BSplineSurface
-    from ..io.read import read_input
-    from ..ncp.reference import initial_surface
-    from .common import input_options
+    from gridshell.geometry.bspline import BSplineSurface
+    from gridshell.io.read import read_input
+    from gridshell.ncp.reference import initial_surface
+    from gridshell.cli.common import input_options
 
     if str(path).lower().endswith(".json"):
         if args.units is not None or args.object is not None:
-            from ..errors import InputError
+            from gridshell.core.errors import InputError
 
             raise InputError(f"{path}: a B-spline .json is in metres: drop --units / --object")
         surf = BSplineSurface.load(path)
@@ -80,7 +80,7 @@ def _load_reference(path: str, args: Any) -> tuple[Any, Any, Any, Any]:
         return surf, mesh.V, mesh.F, None
     geo = read_input(path, **input_options(args), what="the reference")
     if geo.surface is not None:  # a NURBS surface is the initial B-spline as it is
-        from ..io.read import swap_uv
+        from gridshell.io.read import swap_uv
 
         srf = swap_uv(geo.surface) if args.transpose else geo.surface
         mesh = srf.sample(*args.check_samples)
@@ -91,12 +91,12 @@ def _load_reference(path: str, args: Any) -> tuple[Any, Any, Any, Any]:
 
 
 def run(args: Any) -> int:
-    from ..atomic import check_output
-    from ..bspline import uniform_params
-    from ..errors import ConvergenceError
-    from ..ncp.phlw import optimize_phlw, row_relation_residual, write_phlw
-    from ..ncp.phlw_gates import phlw_gates
-    from .common import Progress, input_line, print_gates
+    from gridshell.core.atomic import check_output
+    from gridshell.geometry.bspline import uniform_params
+    from gridshell.core.errors import ConvergenceError
+    from gridshell.ncp.phlw import optimize_phlw, row_relation_residual, write_phlw
+    from gridshell.ncp.phlw.gates import phlw_gates
+    from gridshell.cli.common import Progress, input_line, print_gates
 
     check_output(args.output, marker="report.json")
     progress = Progress(args)
@@ -161,7 +161,7 @@ def _add_quality(directory: str, quality: dict) -> None:
     import json
     from pathlib import Path
 
-    from ..atomic import write_text
+    from gridshell.core.atomic import write_text
 
     path = Path(directory) / "report.json"
     report = json.loads(path.read_text())

@@ -11,7 +11,7 @@ HELP = ("render a design bundle: render.png (lamellae as strips of their real wi
 
 
 def add_args(p: argparse.ArgumentParser) -> None:
-    from .common import add_bundle_arg
+    from gridshell.cli.common import add_bundle_arg
 
     add_bundle_arg(p, "; files go into it")
     p.add_argument("--report", action="store_true",
@@ -32,19 +32,19 @@ def add_args(p: argparse.ArgumentParser) -> None:
 
 
 def _sequence_is_current(bundle: Path, gif: Path) -> bool:
-    from ..render.sequence import sequence_files
+    from gridshell.render.sequence import sequence_files
 
     files = sequence_files(bundle)
     return gif.is_file() and all(gif.stat().st_mtime >= f.stat().st_mtime for f in files)
 
 
 def run(args: Any) -> int:
-    from ..atomic import check_output
-    from ..bundle import read_design_json
-    from ..errors import InputError
-    from ..outputs import write_outputs
-    from ..render.sequence import sequence_files
-    from .common import Progress, print_summary
+    from gridshell.core.atomic import check_output
+    from gridshell.design.bundle import read_design_json
+    from gridshell.core.errors import InputError
+    from gridshell.workflow.outputs import write_outputs
+    from gridshell.render.sequence import sequence_files
+    from gridshell.cli.common import Progress, print_summary
 
     progress = Progress(args)
     bundle = Path(args.bundle)

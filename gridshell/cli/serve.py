@@ -19,12 +19,12 @@ def add_args(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: Any) -> int:
-    from ..errors import InputError
+    from gridshell.core.errors import InputError
 
     if not 0 < args.port < 65536:
         raise InputError(f"--port {args.port} is not a TCP port; give 1..65535")
     try:
-        from ..server.components import make_app
+        from gridshell.server.components import make_app
     except ModuleNotFoundError as exc:
         raise InputError(f"the Hops server needs {exc.name}; install it with "
                          "pip install 'gridshell[server]'") from None

@@ -13,8 +13,8 @@ HELP = ("elastic equilibrium of the deployed gridshell: every lamella a discrete
 
 
 def add_args(p: argparse.ArgumentParser) -> None:
-    from ..structure.materials import material_names
-    from .common import add_bundle_arg
+    from gridshell.structure.materials import material_names
+    from gridshell.cli.common import add_bundle_arg
 
     add_bundle_arg(p)
     p.add_argument("-o", "--out", metavar="OUT",
@@ -39,7 +39,7 @@ def add_args(p: argparse.ArgumentParser) -> None:
 
 def parse_supports(text: str):
     """'boundary' or a comma-separated list of joint indices."""
-    from ..errors import InputError
+    from gridshell.core.errors import InputError
 
     text = str(text).strip()
     if text == "boundary":
@@ -55,17 +55,17 @@ def parse_supports(text: str):
 
 
 def run(args: Any) -> int:
-    from fabrication.params import parse_scale
+    from gridshell.fabrication.params import parse_scale
 
-    from ..atomic import atomic_dir, check_output
-    from ..bundle import finite_json, read_bundle
-    from ..errors import InputError
-    from ..meshfile import write_mesh, write_polylines
-    from ..render.equilibrium import render_equilibrium
-    from ..structure.equilibrium import simulate
-    from ..structure.materials import get_material
-    from ..structure.section import Section
-    from .common import Progress, print_summary
+    from gridshell.core.atomic import atomic_dir, check_output
+    from gridshell.design.bundle import finite_json, read_bundle
+    from gridshell.core.errors import InputError
+    from gridshell.geometry.meshfile import write_mesh, write_polylines
+    from gridshell.render.equilibrium import render_equilibrium
+    from gridshell.structure.equilibrium import simulate
+    from gridshell.structure.materials import get_material
+    from gridshell.structure.section import Section
+    from gridshell.cli.common import Progress, print_summary
 
     progress = Progress(args)
     bundle_dir = Path(args.bundle)

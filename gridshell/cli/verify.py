@@ -1,8 +1,8 @@
 """``gridshell verify``: recompute a bundle's metrics (paper 5.1) from its files alone and
-check them against the paper's thresholds (:mod:`gridshell.quality`).
+check them against the paper's thresholds (:mod:`gridshell.measure.quality`).
 
-Prints the JSON of :func:`gridshell.verification.verify_bundle` on stdout (``"ok"`` first) and
-one pass / FAIL line per figure on stderr. Exit code (:func:`gridshell.verification.exit_code`):
+Prints the JSON of :func:`gridshell.design.verification.verify_bundle` on stdout (``"ok"`` first) and
+one pass / FAIL line per figure on stderr. Exit code (:func:`gridshell.design.verification.exit_code`):
 0 every figure holds; 2 the bundle is incomplete or its files disagree with design.json;
 4 a figure misses its threshold.
 """
@@ -13,8 +13,8 @@ import json
 import sys
 from typing import Any
 
-from ..bundle import finite_json
-from ..verification import exit_code, verify_bundle
+from gridshell.design.bundle import finite_json
+from gridshell.design.verification import exit_code, verify_bundle
 
 HELP = ("recompute the figures of a design bundle from its files, check them against the paper's "
         "thresholds and print JSON (exit 0 ok, 2 incomplete or inconsistent bundle, 4 a figure "

@@ -11,10 +11,12 @@ orientations and offsets, as quad grids and triangle meshes.
     ref.modes                         # ('gg', 'ncp-phlw', 'ncp-cnc', 'ncp-aa')
 
 ``benchmarks/corpus.py`` runs every applicable pipeline on every reference.
+
+May import: :mod:`gridshell.core`, :mod:`gridshell.geometry`.
 """
-from .registry import (COUNTS, FAST, MODES, REFERENCES, Reference, build_reference, get, names,
+from gridshell.corpus.registry import (COUNTS, FAST, MODES, REFERENCES, Reference, build_reference, get, names,
                        select)
-from .surfaces import FAMILIES, Shape
+from gridshell.corpus.surfaces import FAMILIES, Shape
 
 __all__ = ["COUNTS", "FAMILIES", "FAST", "MODES", "REFERENCES", "Reference", "Shape",
            "build_reference", "get", "names", "select"]

@@ -11,7 +11,7 @@ from typing import Callable
 
 import numpy as np
 
-from ..grid import grid_quads
+from gridshell.geometry.grid import grid_quads
 
 __all__ = ["curvatures", "fundamental_forms", "grid_faces", "sample_grid"]
 
@@ -60,7 +60,7 @@ def sample_grid(f: Fn, rows: int, cols: int) -> np.ndarray:
 def grid_faces(rows: int, cols: int, kind: str = "quad", diagonal: str = "alternate"
                ) -> np.ndarray:
     """Faces of a ``rows x cols`` vertex grid (vertex ``i * cols + j``), oriented as
-    :func:`gridshell.grid.grid_quads`: ``"quad"`` ``(m, 4)``, or ``"tri"`` ``(2m, 3)`` with the
+    :func:`gridshell.geometry.grid.grid_quads`: ``"quad"`` ``(m, 4)``, or ``"tri"`` ``(2m, 3)`` with the
     diagonal of each quad ``"alternate"`` (checkerboard) or ``"same"`` (all one way)."""
     Q = grid_quads(rows, cols)
     if kind == "quad":

@@ -16,8 +16,8 @@ from typing import Any, Callable, Iterable
 
 import numpy as np
 
-from .geometry import curvatures, fundamental_forms, grid_faces, sample_grid
-from .surfaces import FAMILIES, Shape
+from gridshell.corpus.geometry import curvatures, fundamental_forms, grid_faces, sample_grid
+from gridshell.corpus.surfaces import FAMILIES, Shape
 
 __all__ = ["COUNTS", "FAST", "MODES", "REFERENCES", "Reference", "build_reference", "get",
            "names", "select"]
@@ -120,7 +120,7 @@ class Reference:
 
     def write_obj(self, path: str | Path) -> Path:
         """Write the mesh as an OBJ file (exact coordinates; atomic); returns the path."""
-        from ..meshfile import write_mesh
+        from gridshell.geometry.meshfile import write_mesh
 
         path = Path(path)
         V, F = self.mesh_arrays()

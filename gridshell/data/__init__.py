@@ -4,6 +4,8 @@
 reference of the CNC pavilion) are copies of ``samples/dome.obj`` and
 ``samples/torus_patch.obj``, written by ``samples/make_meshes.py`` (origin and formulas:
 ``samples/README.md``). Metres.
+
+May import: :mod:`gridshell.core`.
 """
 from __future__ import annotations
 
@@ -18,7 +20,7 @@ DEMO_MESHES = ("dome.obj", "torus_patch.obj")
 
 def path(name: str) -> Path:
     """The file system path of the shipped mesh ``name`` (one of :data:`DEMO_MESHES`)."""
-    from ..errors import InputError
+    from gridshell.core.errors import InputError
 
     if name not in DEMO_MESHES:
         raise InputError(f"no bundled mesh {name!r}; the package ships {', '.join(DEMO_MESHES)}")

@@ -6,9 +6,9 @@ The strip's real section is the cut strip's (mm of the physical model) divided b
 1. the caller's values (``--width``, ``--thickness``, ``--hole``, ``--scale`` ...);
 2. the bundle's fabrication report ``DIR/fabrication/fabrication.json`` (the parameters the
    cut files were written with), when there is one;
-3. :class:`fabrication.params.FabParams` defaults (20 x 1 mm, 3 mm holes, 1:10, 600 x 400 mm).
+3. :class:`gridshell.fabrication.params.FabParams` defaults (20 x 1 mm, 3 mm holes, 1:10, 600 x 400 mm).
 
-The cut sheets are planned in memory with :func:`fabrication.pipeline.plan_parts` from these
+The cut sheets are planned in memory with :func:`gridshell.fabrication.pipeline.plan_parts` from these
 parameters: the same nesting as ``gridshell fabricate`` writes (deterministic).
 """
 from __future__ import annotations
@@ -18,7 +18,7 @@ from dataclasses import fields
 from pathlib import Path
 from typing import Any, Callable
 
-from ..errors import InputError
+from gridshell.core.errors import InputError
 
 __all__ = ["FABRICATION_REPORT", "export_params", "plan_sheets"]
 
@@ -53,10 +53,10 @@ def export_params(bundle_dir: str | Path | None = None, params: Any = None,
     params : FabParams or dict, optional
         Parameters to start from instead of the stored ones.
     **overrides
-        Fields of :class:`~fabrication.params.FabParams` (``width``, ``thickness``, ``hole``,
+        Fields of :class:`~gridshell.fabrication.params.FabParams` (``width``, ``thickness``, ``hole``,
         ``scale``, ``sheet`` ...; mm of the model); None values are ignored.
     """
-    from fabrication.params import FabParams
+    from gridshell.fabrication.params import FabParams
 
     names = {f.name for f in fields(FabParams)}
     unknown = sorted(set(overrides) - names)
@@ -81,10 +81,10 @@ def export_params(bundle_dir: str | Path | None = None, params: Any = None,
 
 def plan_sheets(bundle, params, progress: Callable[[str], None] | None = None):
     """``(layout, params, fallback)``: the parts of ``bundle`` nested on sheets (mm, each
-    sheet's own frame ``[0, W] x [0, H]``), as :func:`fabrication.pipeline.plan_parts` plans
+    sheet's own frame ``[0, W] x [0, H]``), as :func:`gridshell.fabrication.pipeline.plan_parts` plans
     them, the parameters it used, and ``fallback``: why joints too close for holes became
     engraved marks (None when they did not)."""
-    from fabrication.pipeline import plan_parts
+    from gridshell.fabrication.pipeline import plan_parts
 
     _, layout, info = plan_parts(bundle, params, progress)
     return layout, info["params"], info["joints_fallback"]

@@ -12,9 +12,9 @@ moved. Lengths in user strings are in the same unit (``units`` names it) and in 
     B-spline surface  NCP kinds: the PHLW B-spline of surface.json as a NURBS surface
     family 1          one closed mesh per C^1 lamella (each side its own vertices, shaded
                       flat; see unwelded_sides; only the axis samples it needs, its
-                      corner edges within gridshell.strips3d.ring_tolerance of the
+                      corner edges within gridshell.geometry.strips3d.ring_tolerance of the
                       full-resolution ones: solid_rings): the strip as built, real width x
-                      thickness (gridshell.strips3d), tangent to the surface for GG (stacked:
+                      thickness (gridshell.geometry.strips3d), tangent to the surface for GG (stacked:
                       family 1 on the side the surface.obj normals point to, family 3 on the
                       other, so that crossing strips touch on the surface), standing on
                       it for NCP / CNC / AA (on the centre line, or on its edge with axis "edge")
@@ -53,10 +53,10 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..atomic import atomic_path
-from ..errors import GridshellError, InputError, OutputError
-from . import rhino_geometry as geo
-from .units import METRES, Units, bundle_units, parse_units
+from gridshell.core.atomic import atomic_path
+from gridshell.core.errors import GridshellError, InputError, OutputError
+from gridshell.export import rhino_geometry as geo
+from gridshell.core.units import METRES, Units, bundle_units, parse_units
 
 __all__ = ["LAYERS", "RHINO_UNITS", "bundle_to_3dm", "export_3dm", "write_3dm"]
 
@@ -170,17 +170,17 @@ def _distinct(P: np.ndarray) -> np.ndarray:
 def _axes_points(bundle) -> np.ndarray:
     """Every lamella axis's points one after the other ``(sum k_i, 3)``, metres: the points
     whose closest surface points the strips' frames and the design check
-    (:func:`gridshell.metrics.crossing_normal_curvature_on_mesh`) both ask."""
+    (:func:`gridshell.measure.metrics.crossing_normal_curvature_on_mesh`) both ask."""
     return np.concatenate([np.asarray(lam.axis, float).reshape(-1, 3)
                            for lam in bundle.net.lamellae])
 
 
 def _ask_ahead(bundle) -> None:
     """The closest surface points (and normals) of the axes and the closest points of the
-    joints asked now, in one igl query, and kept for reuse (:mod:`gridshell.igl_adapter`):
+    joints asked now, in one igl query, and kept for reuse (:mod:`gridshell.geometry.igl_adapter`):
     the strips ask the first, and the design check of an NCP kind asks both, in a process
-    forked after this (:mod:`gridshell.aside`) where it finds them."""
-    from ..igl_adapter import ask_closest_points, closest_points_with_normals
+    forked after this (:mod:`gridshell.core.aside`) where it finds them."""
+    from gridshell.geometry.igl_adapter import ask_closest_points, closest_points_with_normals
 
     P, V, F = _axes_points(bundle), bundle.surface_V, bundle.surface_F
     ask_closest_points([P, bundle.net.joints], V, F)
@@ -188,7 +188,7 @@ def _ask_ahead(bundle) -> None:
 
 
 def unwelded_sides(V: np.ndarray, F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The closed strip mesh of :func:`gridshell.strips3d.strip_solid` (``V (4k,3)``,
+    """The closed strip mesh of :func:`gridshell.geometry.strips3d.strip_solid` (``V (4k,3)``,
     ``F (8(k-1)+4, 3)``: the four long sides, two triangles per segment each, then the two end
     caps) with its own vertices for each of its six sides, so that a renderer shades the
     sides flat instead of smoothing the normals round the strip's edges. The shape is the
@@ -204,7 +204,7 @@ def unwelded_sides(V: np.ndarray, F: np.ndarray) -> tuple[np.ndarray, np.ndarray
 
 
 def _split_frames(PNTWH: tuple[np.ndarray, ...], ends: np.ndarray) -> list[tuple]:
-    """The ``(T, W, H)`` of each lamella from :func:`gridshell.strips3d.strip_frames`' output
+    """The ``(T, W, H)`` of each lamella from :func:`gridshell.geometry.strips3d.strip_frames`' output
     ``(P, N, T, W, H)`` of all lamellae, split at the row offsets ``ends``."""
     _, _, T, W, H = PNTWH
     return list(zip(np.split(T, ends), np.split(W, ends), np.split(H, ends)))
@@ -212,9 +212,9 @@ def _split_frames(PNTWH: tuple[np.ndarray, ...], ends: np.ndarray) -> list[tuple
 
 def _strips(m: _Model, bundle, params, with_holes: bool) -> dict[str, Any]:
     """Strip solids on the family layers, axes, and the holes; returns figures."""
-    from ..igl_adapter import closest_points_with_normals
-    from ..net import polyline_arclength
-    from ..strips3d import (is_tangent, real_section_m, solid_rings_many, strip_frames,
+    from gridshell.geometry.igl_adapter import closest_points_with_normals
+    from gridshell.geometry.net import polyline_arclength
+    from gridshell.geometry.strips3d import (is_tangent, real_section_m, solid_rings_many, strip_frames,
                             strip_solid)
 
     tangent = is_tangent(bundle.kind)
@@ -229,7 +229,7 @@ def _strips(m: _Model, bundle, params, with_holes: bool) -> dict[str, Any]:
     # the surface normal interpolated at the closest point (smooth along the axis; the nearest
     # vertex's normal jumps from vertex to vertex and crinkles the strip: +1.7 % of area on
     # the demo dome, 0.2 % with these), asked for every axis point (reuse: the query the
-    # verification of the design asks, gridshell.verification; igl answers each point alone)
+    # verification of the design asks, gridshell.design.verification; igl answers each point alone)
     normals = closest_points_with_normals(np.concatenate(axes), bundle.surface_V,
                                           bundle.surface_F, reuse=True)[1]   # _axes_points
     normals = normals[np.concatenate([k & u for k, u in zip(keeps, used)])]
@@ -349,7 +349,7 @@ def _sheets(m: _Model, bundle, layout, params) -> list[dict[str, Any]]:
 def bundle_to_3dm(bundle, *, name: str = "", units: Any = None, params: Any = None,
                   layout: Any = None, bspline: Any = None, params_source: str = ""
                   ) -> tuple[Any, dict[str, Any]]:
-    """``(model, info)``: a ``rhino3dm.File3dm`` of a :class:`~gridshell.bundle.DesignBundle`
+    """``(model, info)``: a ``rhino3dm.File3dm`` of a :class:`~gridshell.design.bundle.DesignBundle`
     (layers, objects and user strings: the module docstring) and what went into it.
 
     Parameters
@@ -358,8 +358,8 @@ def bundle_to_3dm(bundle, *, name: str = "", units: Any = None, params: Any = No
         The model's unit; default the bundle's input unit (metres when it records none).
     params : FabParams, optional
         Strip section, holes and sheets (mm of the model); default
-        :class:`~fabrication.params.FabParams` ().
-    layout : fabrication.nesting.Layout, optional
+        :class:`~gridshell.fabrication.params.FabParams` ().
+    layout : gridshell.fabrication.nesting.Layout, optional
         Cut sheets to draw (:func:`gridshell.export.fabparams.plan_sheets`); None: none.
     bspline : BSplineSurface, optional
         The NURBS surface of the "B-spline surface" layer.
@@ -371,7 +371,7 @@ def bundle_to_3dm(bundle, *, name: str = "", units: Any = None, params: Any = No
 def _body(bundle, *, name: str, units: Any, params: Any, bspline: Any) -> dict[str, Any]:
     """The model of :func:`bundle_to_3dm` but its cut sheets and strings, and what
     :func:`_finish` needs to add them."""
-    from fabrication.params import FabParams
+    from gridshell.fabrication.params import FabParams
 
     units = parse_units(units) if units is not None else bundle_units(bundle)
     note = ""
@@ -487,7 +487,7 @@ def write_3dm(bundle, path: str | os.PathLike, *, width: float | None = None,
     force : bool
         Draw the cut sheets of a design that fails its figures too.
 
-    The design check and the cut-sheet plan run in a second process (:mod:`gridshell.aside`,
+    The design check and the cut-sheet plan run in a second process (:mod:`gridshell.core.aside`,
     forked on Linux) while this one builds the rest of the model; the file is the same.
     """
     path = check_3dm_path(path)
@@ -513,13 +513,13 @@ def write_model(bundle, path: str | os.PathLike, *, width: float | None = None,
                 progress: Callable[[str], None] | None = None, publish: bool = False,
                 shown: str | os.PathLike | None = None) -> dict[str, Any]:
     """The body of :func:`write_3dm` (same parameters): build the model, then write it to
-    ``path`` - atomically with ``publish`` (:func:`gridshell.atomic.atomic_path`: temporary
+    ``path`` - atomically with ``publish`` (:func:`gridshell.core.atomic.atomic_path`: temporary
     file, rename, manifest entry), else as it is, into a temporary file the caller publishes
-    (:mod:`gridshell.outputs` runs this in a second process). ``shown`` is the path progress and
+    (:mod:`gridshell.workflow.outputs` runs this in a second process). ``shown`` is the path progress and
     errors name (default ``path``). Returns what :func:`write_3dm` returns but ``path``."""
-    from ..aside import Aside
-    from ..bundle import read_bundle, read_design_json
-    from .fabparams import export_params
+    from gridshell.core.aside import Aside
+    from gridshell.design.bundle import read_bundle, read_design_json
+    from gridshell.export.fabparams import export_params
 
     shown = path if shown is None else shown
     bundle_dir = None
@@ -537,7 +537,7 @@ def write_model(bundle, path: str | os.PathLike, *, width: float | None = None,
     notes: list[str] = []
     bspline = None
     if bundle_dir is not None and (bundle_dir / "surface.json").is_file():
-        from ..bspline import BSplineSurface
+        from gridshell.geometry.bspline import BSplineSurface
 
         bspline = BSplineSurface.load(bundle_dir / "surface.json")
     judged = bundle_dir if bundle_dir is not None else bundle
@@ -545,7 +545,7 @@ def write_model(bundle, path: str | os.PathLike, *, width: float | None = None,
         _say(progress, "checking the design's figures and planning the cut sheets")
     # the cut sheets (design check, then plan) computed aside, in a second process, while this
     # one builds the rest of the model: the same objects in the same order as one after the
-    # other (gridshell.aside; one process where a fork is not safe)
+    # other (gridshell.core.aside; one process where a fork is not safe)
     if sheets:
         _ask_ahead(bundle)
     with Aside(_cut_sheets, judged, bundle, fab, force) if sheets else nullcontext() as aside:
@@ -577,14 +577,15 @@ def write_model(bundle, path: str | os.PathLike, *, width: float | None = None,
 
 def _cut_sheets(judged, bundle, fab, force: bool) -> tuple[bool, str, Any, Any, str | None]:
     """``(ok, why, layout, params, fallback)``: the verdict on the design
-    (:func:`gridshell.verification.design_verdict` of ``judged``, its directory or itself) and,
+    (:func:`gridshell.design.verification.design_verdict` of ``judged``, its directory or itself) and,
     if it holds or ``force``, its cut sheets planned (:func:`.fabparams.plan_sheets`; ``layout``
     None otherwise) with the parameters the plan used and why joints too close for holes
     became marks (``fallback``, None when they did not)."""
-    from ..verification import design_verdict
-    from .fabparams import plan_sheets
+    from gridshell.design.verification import design_verdict
+    from gridshell.export.fabparams import plan_sheets
 
-    ok, why = design_verdict(judged)
+    verdict = design_verdict(judged)
+    ok, why = verdict.ok, verdict.why()
     if not (ok or force):
         return ok, why, None, fab, None
     return (ok, why, *plan_sheets(bundle, fab))

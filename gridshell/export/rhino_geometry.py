@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import InputError
+from gridshell.core.errors import InputError
 
 __all__ = ["mesh", "point_list", "bulge_curve", "circle", "cylinder",
            "nurbs_surface"]
@@ -75,7 +75,7 @@ def bulge_curve(V: np.ndarray, B: np.ndarray, closed: bool, z: float = 0.0):
     there is no arc, else a ``PolyCurve`` of lines and arcs (exact, as in the DXF)."""
     import rhino3dm
 
-    from fabrication.path import arc_geometry
+    from gridshell.fabrication.path import arc_geometry
 
     V = np.asarray(V, float).reshape(-1, 2)
     B = np.zeros(len(V)) if B is None else np.asarray(B, float).reshape(-1)
@@ -124,7 +124,7 @@ def cylinder(centre: np.ndarray, axis: np.ndarray, radius: float, height: float)
 def nurbs_surface(degree_u: int, degree_v: int, knots_u: np.ndarray, knots_v: np.ndarray,
                   ctrl: np.ndarray):
     """A non-rational ``NurbsSurface`` from clamped full knot vectors (``n + degree + 1``
-    values each, as :class:`gridshell.bspline.BSplineSurface` holds them) and control points
+    values each, as :class:`gridshell.geometry.bspline.BSplineSurface` holds them) and control points
     ``ctrl (nu, nv, 3)``. Rhino drops the first and the last knot of each vector."""
     import rhino3dm
 

@@ -25,8 +25,8 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.interpolate import CubicHermiteSpline
 
-from ..errors import InputError, NoNetError
-from .revolution import Profile, Revolution
+from gridshell.core.errors import InputError, NoNetError
+from gridshell.gg.revolution import Profile, Revolution
 
 __all__ = ["IntrinsicNet", "clairaut_constant_for_angle", "geodesic_net", "trace_geodesic"]
 

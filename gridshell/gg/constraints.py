@@ -22,8 +22,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..errors import InputError
-from ..solver import Layout, TermResult, result, term
+from gridshell.core.errors import InputError
+from gridshell.solver import Layout, TermResult, result, term
 
 __all__ = ["GridShape", "EdgeGroups", "geodesic_meridians", "geodesic_residual", "edge_groups",
            "equal_lengths", "init_group_lengths", "length_residual_rel", "equal_diagonals",

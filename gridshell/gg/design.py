@@ -81,13 +81,13 @@ from typing import Any, Callable, Mapping
 import numpy as np
 import scipy.sparse as sp
 
-from ..errors import InputError
-from ..solver import Layout, Problem, solve
-from ..solver import terms as T
-from .constraints import (EdgeGroups, GridShape, diagonal_residual_rel, edge_groups,
+from gridshell.core.errors import InputError
+from gridshell.solver import Layout, Problem, solve
+from gridshell.solver import terms as T
+from gridshell.gg.constraints import (EdgeGroups, GridShape, diagonal_residual_rel, edge_groups,
                           equal_diagonals, equal_lengths, geodesic_meridians, geodesic_residual,
                           init_group_lengths, length_residual_rel)
-from .soft_terms import boundary_gliding, boundary_sides, fairness_matrix, surface_gliding
+from gridshell.gg.soft_terms import boundary_gliding, boundary_sides, fairness_matrix, surface_gliding
 
 __all__ = ["GGDesign", "GGWeights", "design_gg_surface", "edge_groups", "equal_lengths",
            "fairness_matrix", "geodesic_meridians", "geodesic_residual", "GridShape",
@@ -417,8 +417,8 @@ def design_gg_surface(target_V: Any, target_F: Any, P0: Any, *,
         ``converged=False`` (never an exception) when the tolerances are not met: the caller
         decides.
     """
-    from ..igl_adapter import triangulate
-    from ..metrics import deviation
+    from gridshell.geometry.igl_adapter import triangulate
+    from gridshell.measure.metrics import deviation
 
     if target_F is None:
         if not (hasattr(target_V, "V") and hasattr(target_V, "F")):

@@ -3,14 +3,14 @@
 Convention (as in :mod:`gridshell.gg.design`): ``P0[i, j]`` with ``i`` the parallel and ``j``
 the meridian; meridians are ``P0[:, j]``, parallels ``P0[i, :]``.
 
-- A **structured quad grid** target (:func:`gridshell.grid.grid_from_quads` gives its vertex
+- A **structured quad grid** target (:func:`gridshell.geometry.grid.grid_from_quads` gives its vertex
   grid ``G (R0, C0)``) is used as it is: ``meridians="cols"`` makes the grid's columns
   ``G[:, j]`` the meridians (``P0 = V[G]``), ``meridians="rows"`` its rows ``G[i, :]``
   (``P0 = V[G.T]``). For a mesh written from ``P`` with ``grid_quads(R, C)`` (vertex
   ``i*C + j``), ``"cols"`` gives back ``P``. A different ``grid=(R, C)`` (by default: a grid
   longer than :data:`MAX_DEFAULT_GRID` along a side) resamples it
   bilinearly in the grid's index space.
-- A **triangle mesh** target is parameterized (:func:`gridshell.igl_adapter.parameterize_disk`,
+- A **triangle mesh** target is parameterized (:func:`gridshell.geometry.igl_adapter.parameterize_disk`,
   LSCM) and the parameter domain turned so that the meridian ``direction`` runs along its first
   axis ``s``. Four boundary corners are chosen (the target's own corners if its boundary has
   four, else the extremes of ``+-s +-t``) and the target is mapped onto the unit square with
@@ -33,7 +33,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import spsolve
 
-from ..errors import InputError, MeshError
+from gridshell.core.errors import InputError, MeshError
 
 __all__ = ["initial_grid"]
 
@@ -67,7 +67,7 @@ def _check_disk(mesh: Any) -> None:
 
 
 def _check_size(R: int, C: int, what: str) -> None:
-    from ..quadmesh import MAX_ELEMENTS
+    from gridshell.geometry.quadmesh import MAX_ELEMENTS
 
     if R < _MIN or C < _MIN:
         raise InputError(f"{what} is too coarse ({R} x {C} vertices); the GG design needs at "
@@ -209,7 +209,7 @@ def _quad_domain(V: np.ndarray, T: np.ndarray, loop: np.ndarray,
         s0, s1 = s1, s0
     if centre[k + 1, 1] > centre[(k + 3) % 4, 1]:
         t0, t1 = t1, t0
-    from ..igl_adapter import cotangent_laplacian
+    from gridshell.geometry.igl_adapter import cotangent_laplacian
 
     L = cotangent_laplacian(V, T)
     W = np.stack([_harmonic(L, s0, s1), _harmonic(L, t0, t1)], axis=1)
@@ -231,7 +231,7 @@ def _lift(V: np.ndarray, T: np.ndarray, D: np.ndarray, Q: np.ndarray) -> np.ndar
     """Points ``(k, 3)`` of the target at parameters ``Q (k, 2)`` of the parameterization
     ``D (n, 2)``: barycentric interpolation in the closest parameter triangle (samples just
     outside the domain are clamped onto its edge)."""
-    from ..igl_adapter import closest_points
+    from gridshell.geometry.igl_adapter import closest_points
 
     D3 = np.concatenate([D, np.zeros((len(D), 1))], axis=1)
     Q3 = np.concatenate([Q, np.zeros((len(Q), 1))], axis=1)
@@ -269,7 +269,7 @@ def _smooth_lift(V: np.ndarray, T: np.ndarray, D: np.ndarray, Q: np.ndarray) -> 
     """
     from scipy.interpolate import RBFInterpolator
 
-    from ..igl_adapter import closest_points
+    from gridshell.geometry.igl_adapter import closest_points
 
     try:
         nb = None if len(D) <= _RBF_GLOBAL else _RBF_NEIGHBOURS
@@ -307,7 +307,7 @@ def _default_size(ext: np.ndarray, n_vertices: int) -> tuple[int, int]:
 
 def _from_triangles(V: np.ndarray, F: np.ndarray, loop: np.ndarray,
                     grid: tuple[int, int] | None, direction: Any) -> np.ndarray:
-    from ..igl_adapter import closest_points, closest_points_with_normals, parameterize_disk
+    from gridshell.geometry.igl_adapter import closest_points, closest_points_with_normals, parameterize_disk
 
     UV = parameterize_disk(V, F, method="lscm", normalize=False)
     UV = UV - UV.mean(axis=0)
@@ -392,7 +392,7 @@ def initial_grid(target: Any, F: Any = None, *, meridians: str = "cols",
     InputError
         Fewer than 4 x 4 vertices, a bad ``meridians`` / ``direction`` / ``grid``.
     """
-    from ..quadmesh import QuadMesh, TriMesh
+    from gridshell.geometry.quadmesh import QuadMesh, TriMesh
 
     if meridians not in ("rows", "cols"):
         raise InputError(f"meridians must be 'rows' or 'cols', got {meridians!r}")

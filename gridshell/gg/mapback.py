@@ -20,10 +20,10 @@ from typing import Callable
 import numpy as np
 from scipy.interpolate import RectBivariateSpline
 
-from ..errors import InputError, NoNetError
-from ..net import Lamella, Net, polyline_arclength
-from .clairaut import IntrinsicNet
-from .revolution import Revolution
+from gridshell.core.errors import InputError, NoNetError
+from gridshell.geometry.net import Lamella, Net, polyline_arclength
+from gridshell.gg.clairaut import IntrinsicNet
+from gridshell.gg.revolution import Revolution
 
 __all__ = ["SurfaceMap", "map_net", "map_to_revolution", "net_loops", "orient_loops",
            "segment_intersections"]

@@ -8,7 +8,7 @@ Stages (each usable alone):
 2. :func:`gg_net_from_mesh`: :func:`~gridshell.gg.revolution.rebuild_revolution`,
    :func:`~gridshell.gg.clairaut.geodesic_net`, :func:`~gridshell.gg.mapback.map_back` (4.1.2);
 3. :func:`collapse_gg`: the aligned (collapsed) configuration, and
-   :func:`gridshell.gg.simulate.gg_alignment_sequence`: the states between the two;
+   :func:`gridshell.gg.alignment.gg_alignment_sequence`: the states between the two;
 4. :func:`gg_metrics`: paper 5.1 on the result.
 """
 from __future__ import annotations
@@ -21,17 +21,17 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 from scipy.sparse.linalg import lsqr
 
-from ..bundle import Design, DesignBundle, report_json, write_bundle
-from ..errors import ConvergenceError, GridshellError, InputError, NoNetError
-from ..grid import grid_quads
-from ..metrics import (alignability_error, alignability_error_arc, coverage, delta_l, deviations,
+from gridshell.design.bundle import Design, DesignBundle, report_json, write_bundle
+from gridshell.core.errors import ConvergenceError, GridshellError, InputError, NoNetError
+from gridshell.geometry.grid import grid_quads
+from gridshell.measure.metrics import (alignability_error, alignability_error_arc, coverage, delta_l, deviations,
                        geodesic_turning, summary, target_deviation)
-from ..net import Net
-from ..quality import Gate, design_gates, gate_lines, gate_summary, passed
-from .clairaut import IntrinsicNet, geodesic_net
-from .mapback import map_back, map_to_revolution
-from .revolution import rebuild_revolution
-from .simulate import GGSequence, gg_alignment_sequence
+from gridshell.geometry.net import Net
+from gridshell.measure.quality import Gate, design_gates, gate_lines, gate_summary, passed
+from gridshell.gg.clairaut import IntrinsicNet, geodesic_net
+from gridshell.gg.mapback import map_back, map_to_revolution
+from gridshell.gg.revolution import rebuild_revolution
+from gridshell.gg.alignment import GGSequence, gg_alignment_sequence
 
 __all__ = ["check_offsets", "collapse_gg", "design_gg", "gg_files", "gg_gates", "gg_metrics",
            "gg_net_from_mesh", "gg_score", "TracedNets", "write_gg"]
@@ -229,7 +229,7 @@ def gg_metrics(net: Net, V: np.ndarray, F: np.ndarray, *, net_rev: Net | None = 
         ``alignability`` and ``alignability_arc`` (``{"mean", "max"}`` of ``Delta_a`` in %),
         ``alignability_revolution`` (the same net on the surface of revolution, if given),
         ``geodesic_turning`` (ratio, %, with the normals of the smooth surface through the grid
-        when ``(V, F)`` is one, see :func:`gridshell.metrics.geodesic_turning`), and with a
+        when ``(V, F)`` is one, see :func:`gridshell.measure.metrics.geodesic_turning`), and with a
         target: ``deviation`` (the surface's vertices from the target; ``target_samples``, a
         working copy of a big target, if given, is what the target -> surface figures
         ``deviation_target`` and ``coverage`` sample), ``deviation_joints``
@@ -262,7 +262,7 @@ def gg_metrics(net: Net, V: np.ndarray, F: np.ndarray, *, net_rev: Net | None = 
 
 
 def gg_gates(metrics: dict[str, Any]) -> list[Gate]:
-    """The quality gates of a GG design (:func:`gridshell.quality.design_gates`): ``Delta_a``
+    """The quality gates of a GG design (:func:`gridshell.measure.quality.design_gates`): ``Delta_a``
     mean < 1 % and max < 3 % on the traced net, with straight edges and with arc lengths."""
     return design_gates("GG", metrics)
 
@@ -342,7 +342,7 @@ def _load_target(target: Any, units: Any = None, clean: bool = True, obj: str | 
                  progress: Progress = None) -> tuple[np.ndarray, np.ndarray, Any]:
     """``(V, F, input)`` of a target (path, InputGeometry, mesh or ``(V, F)``), metres, read
     through :func:`gridshell.io.read.read_input` (units, cleaning, the disk check)."""
-    from ..io.read import read_input
+    from gridshell.io.read import read_input
 
     geo = read_input(target, units=units, clean=clean, obj=obj)
     if progress is not None and geo.path is not None:
@@ -390,7 +390,7 @@ def design_gg(target: Any, *, meridians: str = "cols", grid: tuple[int, int] | N
         ``bundle.params["quality"]`` (``"ok": False``) and ``bundle.params["converged"]``.
     frames : int
         Steps of the alignment sequence from the deployed to the collapsed net
-        (:func:`gridshell.gg.simulate.gg_alignment_sequence`); 0: none.
+        (:func:`gridshell.gg.alignment.gg_alignment_sequence`); 0: none.
     progress : callable, optional
         Receives one-line progress messages.
 
@@ -410,7 +410,7 @@ def design_gg(target: Any, *, meridians: str = "cols", grid: tuple[int, int] | N
         surface optimization's residuals and why its polish stopped.
     report : dict
         The surface optimization's report, the revolution's info, the collapse info and
-        ``sequence`` (a :class:`~gridshell.gg.simulate.GGSequence`, or None with
+        ``sequence`` (a :class:`~gridshell.gg.alignment.GGSequence`, or None with
         ``frames=0``). With a sequence the metrics hold ``delta_l`` (``{"mean", "max"}``, %:
         edge lengths of ``aligned`` against the deployed chords - lamellae straighten, so
         chords lengthen to the arc lengths) and ``sequence_length_error`` (the largest such
@@ -421,11 +421,11 @@ def design_gg(target: Any, *, meridians: str = "cols", grid: tuple[int, int] | N
         n_lamellae = spacing = None       # the offsets place every lamella
     V, F, geo = _load_target(target, units, clean, obj, progress)
     target_path = geo.path
-    from .design import design_gg_surface
-    from .initial import initial_grid
+    from gridshell.gg.design import design_gg_surface
+    from gridshell.gg.initial import initial_grid
 
     _say(progress, f"target: {len(V)} vertices, {len(F)} faces")
-    from ..io.working import working_mesh
+    from gridshell.io.working import working_mesh
 
     # a big target: the grid is sampled and projected on a working copy; the deviations
     # below are measured against the full target
@@ -524,7 +524,7 @@ def write_gg(path: str | Path, bundle: DesignBundle, *, preview: bool = True,
 
 def gg_files(bundle: DesignBundle, report: dict | None = None, *, render: bool = True,
              frames: int = 12, progress: Progress = None) -> dict[str, Any]:
-    """The GG files of a design bundle beyond :func:`gridshell.bundle.write_bundle`'s, as its
+    """The GG files of a design bundle beyond :func:`gridshell.design.bundle.write_bundle`'s, as its
     ``extra`` (name -> bytes or writer); :func:`gridshell.api.write` writes them.
 
     ``report.json`` (the report of :func:`design_gg` without its arrays, when given), the
@@ -542,7 +542,7 @@ def gg_files(bundle: DesignBundle, report: dict | None = None, *, render: bool =
     frames : int
         Steps of a computed sequence; 0 writes none.
     """
-    from ..meshfile import write_mesh
+    from gridshell.geometry.meshfile import write_mesh
 
     net = bundle.net
     extra: dict[str, Any] = {}
@@ -562,7 +562,7 @@ def gg_files(bundle: DesignBundle, report: dict | None = None, *, render: bool =
             extra[f"sequence/frame_{k:0{width}d}.obj"] = (
                 lambda p, V=V: write_mesh(p, V, net.loops))
     if render:
-        from ..render.net_preview import net_preview
+        from gridshell.render.net_preview import net_preview
 
         values = 100.0 * alignability_error(net.joints, net.loops)
 
@@ -573,8 +573,8 @@ def gg_files(bundle: DesignBundle, report: dict | None = None, *, render: bool =
 
         extra["preview.png"] = _png
         if sequence is not None:
-            from ..render import ncp_maps
-            from ..render.states import sequence_pngs, states_png
+            from gridshell.render import ncp_maps
+            from gridshell.render.state_sheet import sequence_pngs, states_png
 
             _say(progress, f"rendering {len(sequence.V)} alignment states and alignment.gif")
             fam = _edge_families(net, sequence.edges)

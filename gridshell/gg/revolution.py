@@ -23,7 +23,7 @@ from typing import Any, Callable
 import numpy as np
 from scipy.interpolate import CubicSpline
 
-from ..errors import InputError, NoNetError
+from gridshell.core.errors import InputError, NoNetError
 
 __all__ = ["Profile", "Revolution", "embeddable_range", "parallel_turning_angle",
            "rebuild_revolution"]
@@ -175,7 +175,7 @@ class Revolution:
         F : ((R-1)(n_phi-1), 4) int64
             Quads ``[(i,j), (i,j+1), (i+1,j+1), (i+1,j)]``, oriented as the GG mesh's grid.
         """
-        from ..grid import grid_quads
+        from gridshell.geometry.grid import grid_quads
 
         R, C = self.shape
         if n_phi is None or int(n_phi) == C:

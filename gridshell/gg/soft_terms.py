@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from ..solver import terms as T
+from gridshell.solver import terms as T
 
 __all__ = ["boundary_gliding", "boundary_sides", "fairness_matrix", "surface_gliding"]
 
@@ -68,7 +68,7 @@ def boundary_gliding(X: np.ndarray, P0flat: np.ndarray, sides: list[np.ndarray])
 def surface_gliding(X: np.ndarray, V: np.ndarray, F: np.ndarray) -> T.Gliding:
     """Gliding data keeping vertices ``X (k, 3)`` on the tangent planes of the target ``(V, F)``
     (triangles, metres) at their closest points (a zero normal where none is defined)."""
-    from ..igl_adapter import closest_points_with_normals
+    from gridshell.geometry.igl_adapter import closest_points_with_normals
 
     C, N = closest_points_with_normals(X, V, F)
     bad = ~np.all(np.isfinite(N), axis=1)

@@ -6,17 +6,20 @@
 - :mod:`.read`: :func:`read_input`, the one entry for a user's surface
 
 Light at import: pymeshlab and rhino3dm load when a file needs them.
+
+May import: :mod:`gridshell.core`, :mod:`gridshell.solver`, :mod:`gridshell.geometry`,
+:mod:`gridshell.measure`.
 """
 from __future__ import annotations
 
-from .units import METRES, UNITS, Units, parse_units
+from gridshell.core.units import METRES, UNITS, Units, parse_units
 
 __all__ = ["METRES", "UNITS", "Units", "parse_units", "read_input", "InputGeometry"]
 
 
 def __getattr__(name: str):  # lazy: read pulls scipy, pymeshlab and rhino3dm on use
     if name in ("read_input", "InputGeometry"):
-        from . import read
+        from gridshell.io import read
 
         return getattr(read, name)
     raise AttributeError(name)

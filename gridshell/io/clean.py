@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import MeshError
+from gridshell.core.errors import MeshError
 
 #: vertices closer than this fraction of the mean edge length are welded
 WELD_TOLERANCE = 1e-3
@@ -73,7 +73,7 @@ def coincident_vertices(V: np.ndarray, tol: float, P: np.ndarray | None = None) 
         return 0
     pairs = cKDTree(V).query_pairs(max(tol, 0.0), output_type="ndarray")
     if len(pairs) and P is not None and len(P):
-        from ..quadmesh import _face_edges
+        from gridshell.geometry.quadmesh import _face_edges
 
         a, b, _ = _face_edges(P)
         n = np.int64(len(V))
@@ -199,7 +199,7 @@ def clean_mesh(V: np.ndarray, P: np.ndarray, sizes: np.ndarray, *, name: str = "
     used[Pm[Pm >= 0]] = True
     # canonical numbering: each welded vertex is its first copy in the file (its coordinates,
     # its place in the order), so a grid exported face by face keeps its first corner first
-    # (gridshell.grid.grid_from_quads starts from the corner of smallest index)
+    # (gridshell.geometry.grid.grid_from_quads starts from the corner of smallest index)
     first_copy = np.full(len(keep), np.iinfo(np.int64).max)
     ok = vmap >= 0
     np.minimum.at(first_copy, vmap[ok], np.flatnonzero(ok))
@@ -232,7 +232,7 @@ def needs_cleaning(V: np.ndarray, P: np.ndarray, sizes: np.ndarray, tol: float,
     """Whether :func:`clean_mesh` has anything to do: coincident vertices (within ``tol``,
     metres), duplicate faces, unreferenced vertices or inconsistently oriented faces. Cheap
     (numpy), so a clean mesh never goes through pymeshlab."""
-    from ..meshfile import orientation_problem
+    from gridshell.geometry.meshfile import orientation_problem
 
     if _unreferenced_count(P, len(V)) or (check_weld and coincident_vertices(V, tol, P)):
         return True

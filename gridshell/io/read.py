@@ -1,10 +1,10 @@
 """What users bring, read once: a mesh file (OBJ, PLY, OFF) or a Rhino .3dm, in the user's
 units, cleaned, checked, as metres (:func:`read_input`).
 
-Order: parse (:func:`gridshell.meshfile.read_polygons` / :func:`gridshell.io.rhino.read_3dm`),
+Order: parse (:func:`gridshell.geometry.meshfile.read_polygons` / :func:`gridshell.io.rhino.read_3dm`),
 units (the .3dm's own, ``units``, or metres after the plausibility check of
-:func:`gridshell.io.units.check_plausible`), conversion to metres, cleaning
-(:func:`gridshell.io.clean.clean_mesh`), the mesh checks (:func:`gridshell.quadmesh.
+:func:`gridshell.core.units.check_plausible`), conversion to metres, cleaning
+(:func:`gridshell.io.clean.clean_mesh`), the mesh checks (:func:`gridshell.geometry.quadmesh.
 validate_mesh`), the extent and, with ``require_disk``, one disk-like patch (the message says
 whether the mesh looked unwelded).
 """
@@ -17,8 +17,8 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import InputError, MeshError
-from .units import METRES, Units, check_plausible, parse_units, to_metres
+from gridshell.core.errors import InputError, MeshError
+from gridshell.core.units import METRES, Units, check_plausible, parse_units, to_metres
 
 #: a NURBS surface is sampled for mesh uses (gg's target, deviations) with this many vertices
 #: along its longer side (gg's default grid, so its design grid is the sampling itself)
@@ -28,7 +28,7 @@ SURFACE_SAMPLES = 64
 @dataclass
 class InputGeometry:
     """A user's geometry in metres: ``V (n,3)``, ``F (m,3|4)`` (quads when every face is a
-    quad), and for a NURBS input its :class:`~gridshell.bspline.BSplineSurface` (``F`` then a
+    quad), and for a NURBS input its :class:`~gridshell.geometry.bspline.BSplineSurface` (``F`` then a
     sampling of it). ``units`` is the unit the user drew in; ``info()`` goes into bundles."""
 
     V: np.ndarray
@@ -108,7 +108,7 @@ def read_input(source: Any, *, units: Units | str | None = None, clean: bool = T
         path = Path(source)
         name = path.name
         if path.suffix.lower() == ".3dm":
-            from .rhino import read_3dm
+            from gridshell.io.rhino import read_3dm
 
             r = read_3dm(path, obj)
             file_u, obj_label, notes = r.units, r.object.label(), list(r.notes)
@@ -120,7 +120,7 @@ def read_input(source: Any, *, units: Units | str | None = None, clean: bool = T
             if obj is not None:
                 raise InputError(f"{name}: --object picks an object of a .3dm file; a mesh file "
                                  "holds one mesh - drop --object")
-            from ..meshfile import read_polygons
+            from gridshell.geometry.meshfile import read_polygons
 
             V, P, sizes = read_polygons(path)
         path_s = str(path.resolve())
@@ -141,7 +141,7 @@ def read_input(source: Any, *, units: Units | str | None = None, clean: bool = T
     if surface is not None:
         surface = _scaled_surface(surface, u.metres_per_unit)
         if src == "default":
-            from ..quadmesh import bbox_diagonal
+            from gridshell.geometry.quadmesh import bbox_diagonal
 
             check_plausible(bbox_diagonal(surface.ctrl.reshape(-1, 3)), name)
         mesh = _sample_surface(surface)
@@ -149,24 +149,24 @@ def read_input(source: Any, *, units: Units | str | None = None, clean: bool = T
                              surface=surface, object=obj_label, object_query=obj, clean=None,
                              notes=notes, units_source=src)
     if src == "default":
-        from ..quadmesh import bbox_diagonal
+        from gridshell.geometry.quadmesh import bbox_diagonal
 
         check_plausible(bbox_diagonal(V), name)
     V = to_metres(V, u)
-    from ..meshfile import _check_extent, check_coordinates
+    from gridshell.geometry.meshfile import _check_extent, check_coordinates
 
     check_coordinates(V, name)
     report = None
     if clean:
-        from .clean import clean_mesh
+        from gridshell.io.clean import clean_mesh
 
-        from ..quadmesh import check_face_areas
+        from gridshell.geometry.quadmesh import check_face_areas
 
         if len(P):  # a weld must not hide a degenerate face of the file (welding its corners
             check_face_areas(V, P, name)  # would drop it; a mesh at one point would vanish)
 
         V, P, sizes, report = clean_mesh(V, P, sizes, name=name)
-    from ..quadmesh import validate_mesh
+    from gridshell.geometry.quadmesh import validate_mesh
 
     validate_mesh(V, P, name=name)
     _check_extent(V, name)
@@ -178,7 +178,7 @@ def read_input(source: Any, *, units: Units | str | None = None, clean: bool = T
 
 
 def _arrays(source: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    from ..quadmesh import _as_padded
+    from gridshell.geometry.quadmesh import _as_padded
 
     if hasattr(source, "V") and hasattr(source, "F"):
         V, F = source.V, source.F
@@ -200,7 +200,7 @@ def _arrays(source: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 def _faces(V: np.ndarray, P: np.ndarray, sizes: np.ndarray) -> np.ndarray:
     """Quads when every face is a quad, triangles when every face is one, else triangulated."""
-    from ..quadmesh import _triangulate_padded
+    from gridshell.geometry.quadmesh import _triangulate_padded
 
     if np.all(sizes == 4):
         return P[:, :4].copy()
@@ -210,7 +210,7 @@ def _faces(V: np.ndarray, P: np.ndarray, sizes: np.ndarray) -> np.ndarray:
 
 
 def _scaled_surface(surface: Any, factor: float) -> Any:
-    from ..bspline import BSplineSurface
+    from gridshell.geometry.bspline import BSplineSurface
 
     if factor == 1.0:
         return surface
@@ -221,7 +221,7 @@ def _scaled_surface(surface: Any, factor: float) -> Any:
 def swap_uv(surface: Any) -> Any:
     """The same B-spline surface with ``u`` and ``v`` exchanged (``--transpose`` of a NURBS
     input: the PHLW rows follow the other family)."""
-    from ..bspline import BSplineSurface
+    from gridshell.geometry.bspline import BSplineSurface
 
     return BSplineSurface(surface.degree_v, surface.degree_u, surface.knots_v, surface.knots_u,
                           surface.ctrl.transpose(1, 0, 2).copy())
@@ -252,7 +252,7 @@ def check_disk(V: np.ndarray, F: np.ndarray, name: str, report: Any = None, *,
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 
-    from ..quadmesh import unique_ints
+    from gridshell.geometry.quadmesh import unique_ints
 
     F = np.asarray(F, dtype=np.int64)
     n = len(V)
@@ -288,8 +288,8 @@ def check_disk(V: np.ndarray, F: np.ndarray, name: str, report: Any = None, *,
         weld = (f"it was welded ({report.summary()}) and is still not one disk" if report.welded
                 else "it is not an unwelded mesh (no coincident vertices to weld)")
     else:
-        from .clean import WELD_TOLERANCE, coincident_vertices, mean_edge_length
-        from ..quadmesh import _as_padded
+        from gridshell.io.clean import WELD_TOLERANCE, coincident_vertices, mean_edge_length
+        from gridshell.geometry.quadmesh import _as_padded
 
         P, sizes = _as_padded(F)
         tol = tolerance if tolerance is not None else \

@@ -1,7 +1,7 @@
 """Rhino ``.3dm`` input through rhino3dm: a mesh, a NURBS surface or a single-face Brep, picked
 by name, id or layer when the file holds several, in the file's unit system.
 
-A NURBS surface becomes a :class:`~gridshell.bspline.BSplineSurface` (still in file units; the
+A NURBS surface becomes a :class:`~gridshell.geometry.bspline.BSplineSurface` (still in file units; the
 caller converts): Rhino stores ``count + order - 2`` knots per direction (no end knots), so one
 knot is added at each end, and the knot vectors are mapped onto ``[0, 1]`` (an affine change of
 parameter: the surface is the same). A rational surface (weights not all equal) has no exact
@@ -18,8 +18,8 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import InputError, MeshError
-from .units import Units, parse_units
+from gridshell.core.errors import InputError, MeshError
+from gridshell.core.units import Units, parse_units
 
 #: Rhino unit system name -> our unit name
 RHINO_UNITS = {"Millimeters": "mm", "Centimeters": "cm", "Meters": "m", "Inches": "in",
@@ -174,7 +174,7 @@ def nurbs_to_bspline(ns: Any, name: str) -> tuple[Any, float | None]:
     """The :class:`BSplineSurface` of a rhino3dm NurbsSurface (file units, knots on [0, 1]),
     and for a rational surface the largest distance of the non-rational fit (file units;
     None for a non-rational surface)."""
-    from ..bspline import BSplineSurface
+    from gridshell.geometry.bspline import BSplineSurface
 
     du, dv = ns.OrderU - 1, ns.OrderV - 1
     nu, nv = ns.Points.CountU, ns.Points.CountV
@@ -214,7 +214,7 @@ def _fit_rational(ns: Any, du: int, dv: int, full_u: np.ndarray, full_v: np.ndar
     diagonal of the control net. Returns it and that distance (file units)."""
     import scipy.sparse.linalg as spla
 
-    from ..bspline import BSplineSurface, open_uniform_knots
+    from gridshell.geometry.bspline import BSplineSurface, open_uniform_knots
 
     (u0, u1), (v0, v1) = _domain(full_u, du), _domain(full_v, dv)
     spans_u = max(len(np.unique(full_u[du:len(full_u) - du])) - 1, 1)
@@ -290,7 +290,7 @@ def read_3dm(path: str | os.PathLike, obj: str | None = None) -> RhinoInput:
                          "surface in Rhino (ToNurbs)")
     surf, err = nurbs_to_bspline(ns, name)
     if reversed_:  # the face's normal is the surface's reversed: flip u
-        from ..bspline import BSplineSurface
+        from gridshell.geometry.bspline import BSplineSurface
 
         surf = BSplineSurface(surf.degree_u, surf.degree_v, 1.0 - surf.knots_u[::-1],
                               surf.knots_v, surf.ctrl[::-1].copy())

@@ -31,8 +31,8 @@ def working_mesh(V: np.ndarray, F: np.ndarray, max_faces: int = WORKING_FACES
     if len(F) <= max_faces:
         return V, F, None
     if F.shape[1] == 4:
-        from ..errors import MeshError
-        from ..grid import grid_from_quads, grid_quads
+        from gridshell.core.errors import MeshError
+        from gridshell.geometry.grid import grid_from_quads, grid_quads
 
         try:
             G = grid_from_quads(F, len(V))
@@ -54,10 +54,10 @@ def _decimate(V: np.ndarray, T: np.ndarray, max_faces: int
               ) -> tuple[np.ndarray, np.ndarray, dict[str, Any] | None]:
     import pymeshlab
 
-    from ..errors import MeshError
-    from ..metrics import surface_area
-    from ..quadmesh import bbox_diagonal, validate_mesh
-    from .read import check_disk
+    from gridshell.core.errors import MeshError
+    from gridshell.measure.metrics import surface_area
+    from gridshell.geometry.quadmesh import bbox_diagonal, validate_mesh
+    from gridshell.io.read import check_disk
 
     diag = bbox_diagonal(V)
     cell = np.sqrt(2.0 * surface_area(V, T) / max_faces)
@@ -99,7 +99,7 @@ def _largest_piece(V: np.ndarray, T: np.ndarray) -> tuple[np.ndarray, np.ndarray
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 
-    from ..quadmesh import unique_ints
+    from gridshell.geometry.quadmesh import unique_ints
 
     n = len(V)
     src, dst = T.ravel(), np.roll(T, -1, axis=1).ravel()

@@ -2,4 +2,7 @@
 
 ``phlw``: B-spline surface design towards PHLW, CNC and PK surfaces (paper 3.4, 4.2.1);
 ``reference``: the initial B-spline from a reference mesh.
+
+May import: the floors below (core, solver, geometry, measure, io, design) and render
+(the maps a design writes); never gg, export or a face.
 """

@@ -14,7 +14,7 @@ On a dense ``a x b`` sampling (paper: 1200 x 1200):
 
 The curve starts at the origin with tangent ``(1, 0)`` (increasing ``u``); the flattened surface
 normal ``n~_i`` is the tangent turned by +90 degrees, and the curve bends towards ``n~`` where
-``n > 0`` (the surface bends towards its normal ``S_u x S_v``, :mod:`gridshell.diffgeo`).
+``n > 0`` (the surface bends towards its normal ``S_u x S_v``, :mod:`gridshell.geometry.diffgeo`).
 Everything is vectorized: the sampling is evaluated in blocks of rows with
 :meth:`BSplineSurface.evaluate_grid`, and the integration is a cumulative sum of angles.
 """
@@ -26,11 +26,12 @@ from typing import Literal
 
 import numpy as np
 
-from ..bspline import BSplineSurface
-from ..errors import InputError, NoNetError
-from ..bspline import uniform_params
-from .directions import (MAX_DROPPED, grid_curvature, net_angle, row_normal_curvature,
+from gridshell.geometry.bspline import BSplineSurface
+from gridshell.core.errors import InputError, NoNetError
+from gridshell.geometry.bspline import uniform_params
+from gridshell.ncp.directions import (MAX_DROPPED, grid_curvature, net_angle, row_normal_curvature,
                          surface_size)
+from gridshell.geometry.fit import fit_circle, fit_plane, line_deviation  # noqa: F401
 
 __all__ = ["CollapseResult", "collapse_chords", "integrate_collapse", "collapse_curve",
            "fit_circle", "fit_plane", "line_deviation", "closest_on_polyline"]
@@ -115,57 +116,6 @@ def integrate_collapse(chords: np.ndarray, n_rows: np.ndarray) -> tuple[np.ndarr
     tang[1:-1] = 0.5 * (phi[:-1] + hb[:-1] + phi[1:] - ha[1:])
     N = np.stack([-np.sin(tang), np.cos(tang)], axis=1)
     return P, N
-
-
-def _points(P: np.ndarray, dim: int | None, least: int, what: str) -> np.ndarray:
-    P = np.asarray(P, float)
-    if P.ndim != 2 or (dim is not None and P.shape[1] != dim) or len(P) < least:
-        shape = f"(k, {dim})" if dim is not None else "(k, d)"
-        raise InputError(f"{what} needs at least {least} points of shape {shape}, got "
-                         f"{P.shape}")
-    return P
-
-
-def fit_circle(P: np.ndarray) -> tuple[np.ndarray, float]:
-    """Least-squares circle (Kasa fit) through 2D points ``P (k, 2)``, ``k >= 3``: centre,
-    radius (exact for points on a circle)."""
-    P = _points(P, 2, 3, "a circle fit")
-    c0 = P.mean(axis=0)
-    Q = P - c0
-    A = np.column_stack([2 * Q, np.ones(len(Q))])
-    b = np.einsum("ij,ij->i", Q, Q)
-    sol = np.linalg.lstsq(A, b, rcond=None)[0]
-    centre = sol[:2]
-    r = float(np.sqrt(sol[2] + centre @ centre))
-    return centre + c0, r
-
-
-def fit_plane(P: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Least-squares plane of points ``P (k, 3)``, ``k >= 3`` (principal axes).
-
-    Returns
-    -------
-    centroid : (3,) a point of the plane
-    basis : (2, 3) orthonormal in-plane axes, largest spread first; ``(P - centroid) @ basis.T``
-        are the points' coordinates in the plane
-    distance : (k,) signed distances of the points from the plane along its normal
-        ``basis[0] x basis[1]``, metres
-    """
-    P = _points(P, 3, 3, "a plane fit")
-    c = P.mean(axis=0)
-    _, _, Vt = np.linalg.svd(P - c, full_matrices=False)
-    return c, Vt[:2], (P - c) @ np.cross(Vt[0], Vt[1])
-
-
-def line_deviation(P: np.ndarray) -> float:
-    """Max distance of points ``P (k, d)`` from their best-fit line, divided by their span."""
-    P = _points(P, None, 2, "a line fit")
-    Q = P - P.mean(axis=0)
-    _, _, Vt = np.linalg.svd(Q, full_matrices=False)
-    along = Q @ Vt[0]
-    off = np.linalg.norm(Q - along[:, None] * Vt[0][None, :], axis=1)
-    span = float(np.ptp(along))
-    return float(off.max() / span) if span > 0 else float("nan")
 
 
 def closest_on_polyline(P: np.ndarray, Q: np.ndarray, N: np.ndarray | None = None

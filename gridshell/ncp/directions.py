@@ -11,7 +11,7 @@ eq. 4.8) makes the angle ``+-beta`` with ``e5``:
   (orthogonal to ``e3``); both frames ``(e1, e2)`` and ``(e3, e4)`` are right-handed like
   ``(e5, e6)``.
 
-Signs follow :mod:`gridshell.diffgeo` (curvatures positive when the surface bends towards
+Signs follow :mod:`gridshell.geometry.diffgeo` (curvatures positive when the surface bends towards
 ``S_u x S_v``), units 1/m. Arrays are on a tensor grid ``u (a,) x v (b,)``: scalars ``(a, b)``,
 vectors ``(a, b, 3)``; row ``i`` is the curve ``u = u[i]``.
 """
@@ -22,9 +22,9 @@ from typing import Any, Literal
 
 import numpy as np
 
-from ..bspline import BSplineSurface, uniform_params
-from ..diffgeo import curvatures, fundamental_forms
-from ..errors import InputError, NoNetError
+from gridshell.geometry.bspline import BSplineSurface, uniform_params
+from gridshell.geometry.diffgeo import curvatures, fundamental_forms
+from gridshell.core.errors import InputError, NoNetError
 
 Mode = Literal["phlw", "cnc", "aa"]
 
@@ -96,7 +96,7 @@ def row_normal_curvature(K: np.ndarray, H: np.ndarray, mode: Mode = "phlw",
     ``cnc``: the given constant ``n``, else one slope fitted over all rows (on a subsampled grid
     of at most :data:`CNC_FIT_SAMPLES` squared samples); ``aa``: ``n = 0``.
     """
-    from .phlw_checks import fit_rows
+    from gridshell.ncp.phlw.checks import fit_rows
 
     K = np.atleast_2d(np.asarray(K, float))
     H = np.atleast_2d(np.asarray(H, float))
@@ -210,7 +210,7 @@ def cnc_normal_curvature(kI: np.ndarray, kII: np.ndarray, K: np.ndarray, H: np.n
     n : float
     info : ``{"lo", "hi", "lo_at", "hi_at" (sample indices (i, j)), "fit", "choice", "note"}``
     """
-    from .phlw_checks import fit_rows
+    from gridshell.ncp.phlw.checks import fit_rows
 
     c = classify_samples(kI, kII, np.zeros(1), floor=1.0 / max(size, 1e-300))
     keep = ~c["umbilic"]

@@ -20,14 +20,14 @@ from typing import Callable, NamedTuple
 import numpy as np
 import scipy.sparse as sp
 
-from ..bspline import BSplineSurface, local_basis, paired_params, open_uniform_knots
-from ..errors import InputError, NoNetError
-from ..net import Lamella, Net
-from ..solver import Layout, TermResult, result, term
-from ..solver.linear import NotPositiveDefinite, shared_solver
-from ..solver.solve import lm_update
-from ..solver.threads import one_blas_thread
-from .directions import NetDirections
+from gridshell.geometry.bspline import BSplineSurface, local_basis, paired_params, open_uniform_knots
+from gridshell.core.errors import InputError, NoNetError
+from gridshell.geometry.net import Lamella, Net
+from gridshell.solver import Layout, TermResult, result, term
+from gridshell.solver.linear import NotPositiveDefinite, shared_solver
+from gridshell.solver.solve import lm_update
+from gridshell.solver.threads import one_blas_thread
+from gridshell.ncp.directions import NetDirections
 
 __all__ = ["LEVELSET_DEFAULTS", "DirectionalDerivative", "directional_derivative", "LevelFit",
            "LevelOperators", "level_function", "level_operators", "fit_level_function",
@@ -448,7 +448,7 @@ def _newton_joints(F1: BSplineSurface, F3: BSplineSurface, uv: np.ndarray, a: np
 class TracedNet:
     """The traced NCP net.
 
-    net : :class:`~gridshell.net.Net` (joints on the surface, loops ``A, B, C, D`` with ``A``
+    net : :class:`~gridshell.geometry.net.Net` (joints on the surface, loops ``A, B, C, D`` with ``A``
         the corner of least ``u`` and ``C`` the opposite one, lamellae with dense axes)
     joint_uv : (n, 2) surface parameters of the joints
     joint_ij : (n, 2) level indices (family 1, family 3) of each joint

@@ -3,7 +3,7 @@
 Stages, each timed in the report: PHLW surface (only for a mesh input, :mod:`.phlw`), net
 directions (:mod:`.directions`), level-set tracing (:mod:`.levelset`), collapse curve
 (:mod:`.collapse`), post-optimization (:mod:`.postopt`), alignment simulation
-(:mod:`.simulate`), metrics (:mod:`gridshell.metrics`). The bundle kind follows the mode:
+(:mod:`.simulate`), metrics (:mod:`gridshell.measure.metrics`). The bundle kind follows the mode:
 ``phlw -> "NCP"``, ``cnc -> "CNC"``, ``aa -> "AA"``.
 """
 from __future__ import annotations
@@ -16,19 +16,19 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..bspline import BSplineSurface
-from ..bundle import CollapseCurve, Design, DesignBundle, report_json, write_bundle
-from ..errors import ConvergenceError, InputError, NoNetError
-from ..metrics import alignability_error, delta_l, delta_n, deviation, summary
-from ..quality import design_gates, gate_summary, passed
-from ..net import move_joints
-from .collapse import (CollapseResult, closest_on_polyline, collapse_curve, fit_circle,
+from gridshell.geometry.bspline import BSplineSurface
+from gridshell.design.bundle import CollapseCurve, Design, DesignBundle, report_json, write_bundle
+from gridshell.core.errors import ConvergenceError, InputError, NoNetError
+from gridshell.measure.metrics import alignability_error, delta_l, delta_n, deviation, summary
+from gridshell.measure.quality import design_gates, gate_summary, passed
+from gridshell.geometry.net import move_joints
+from gridshell.ncp.collapse import (CollapseResult, closest_on_polyline, collapse_curve, fit_circle,
                        line_deviation)
-from ..bspline import uniform_params
-from .directions import net_directions, reference_net_check
-from .levelset import TracedNet, trace
-from .postopt import PostOptResult, interior_vertices, post_optimize
-from .simulate import AlignmentSequence, collapse_direction, plane_frame, simulate_alignment
+from gridshell.geometry.bspline import uniform_params
+from gridshell.ncp.directions import net_directions, reference_net_check
+from gridshell.ncp.levelset import TracedNet, trace
+from gridshell.ncp.postopt import PostOptResult, interior_vertices, post_optimize
+from gridshell.ncp.alignment import AlignmentSequence, collapse_direction, plane_frame, simulate_alignment
 
 __all__ = ["KIND", "NCPState", "crossing_normal_curvature", "design_ncp", "ncp_files", "write_ncp",
            "load_surface"]
@@ -58,9 +58,9 @@ def load_surface(source: Any, *, mode: str, phlw_options: dict | None = None,
     with :func:`gridshell.ncp.phlw.optimize_phlw` first: a .3dm NURBS surface is its initial
     B-spline directly, a mesh is fitted). ``n`` is the CNC normal curvature when the source
     provides it. ``info["units"]`` is the unit of the input (:class:`gridshell.io.Units`)."""
-    from ..io.read import InputGeometry, read_input
-    from ..io.units import METRES
-    from .phlw import PHLWResult, optimize_phlw
+    from gridshell.io.read import InputGeometry, read_input
+    from gridshell.core.units import METRES
+    from gridshell.ncp.phlw import PHLWResult, optimize_phlw
 
     if isinstance(source, BSplineSurface):
         return source, None, {"source": "bspline", "units": METRES}
@@ -74,7 +74,7 @@ def load_surface(source: Any, *, mode: str, phlw_options: dict | None = None,
                              "phlw' (its input unit is in report.json): drop --units / --object")
         return BSplineSurface.load(source), None, {"source": str(source),
                                                    "units": _phlw_units(Path(source))}
-    from .reference import initial_surface
+    from gridshell.ncp.reference import initial_surface
 
     opts = dict(phlw_options or {})
     if isinstance(source, (str, Path, InputGeometry)) or hasattr(source, "V"):
@@ -93,9 +93,9 @@ def load_surface(source: Any, *, mode: str, phlw_options: dict | None = None,
     ctrl, degree = tuple(opts.pop("ctrl", (9, 9))), tuple(opts.pop("degree", (4, 4)))
     transpose, align = bool(opts.pop("transpose", False)), bool(opts.pop("align", False))
     if geo.surface is not None:  # a NURBS surface is the initial B-spline as it is
-        from .reference import InitialFit
+        from gridshell.ncp.reference import InitialFit
 
-        from ..io.read import swap_uv
+        from gridshell.io.read import swap_uv
 
         srf = swap_uv(geo.surface) if transpose else geo.surface
         init = InitialFit(surface=srf, rms=0.0, method="NURBS")
@@ -136,7 +136,7 @@ def load_surface(source: Any, *, mode: str, phlw_options: dict | None = None,
 def _phlw_units(path: Path) -> Any:
     """The input unit recorded in the ``report.json`` beside a ``surface.json`` written by
     ``gridshell phlw`` (metres when there is none)."""
-    from ..io.units import METRES, Units
+    from gridshell.core.units import METRES, Units
 
     report = path.parent / "report.json"
     try:
@@ -170,10 +170,10 @@ def _stopped(info: dict, traced: TracedNet, post: PostOptResult) -> list[str]:
 
 
 def crossing_normal_curvature(surf: BSplineSurface, traced: TracedNet) -> dict[str, Any]:
-    """:func:`gridshell.metrics.crossing_normal_curvature` on the traced axes with the B-spline
+    """:func:`gridshell.measure.metrics.crossing_normal_curvature` on the traced axes with the B-spline
     normals at their parameters and Euler's-circle radius at the joints (1/m, fractions)."""
-    from ..diffgeo import surface_curvature
-    from ..metrics import crossing_normal_curvature as crossing
+    from gridshell.geometry.diffgeo import surface_curvature
+    from gridshell.measure.metrics import crossing_normal_curvature as crossing
 
     normals = [np.cross(surf.evaluate(uv[:, 0], uv[:, 1], 1, 0),
                         surf.evaluate(uv[:, 0], uv[:, 1], 0, 1)) for uv in traced.axis_uv]
@@ -237,9 +237,9 @@ def design_ncp(source: Any, *, mode: str = "phlw", curves: int | tuple[int, int]
     phlw_options : options of the PHLW step for a mesh source (``ctrl``, ``degree``,
         ``transpose``, ``align`` (see :func:`gridshell.ncp.reference.initial_surface`), and any keyword of :func:`gridshell.ncp.phlw.optimize_phlw`)
     allow_unconverged : return a design whose figures miss the paper's thresholds
-        (:func:`gridshell.quality.design_gates`: Delta_a mean / max after the
+        (:func:`gridshell.measure.quality.design_gates`: Delta_a mean / max after the
         post-optimization, Delta_l max, Delta_n max, the collapse error of CNC / AA) instead of
-        raising :class:`~gridshell.errors.ConvergenceError`; its ``metrics["quality"]`` says
+        raising :class:`~gridshell.core.errors.ConvergenceError`; its ``metrics["quality"]`` says
         ``"ok": false`` with the failing gates
     strict : deprecated (the figures decide now); also raise as soon as an optimizer (the
         PHLW step, a level-set fit, the post-optimization) stops without meeting its own
@@ -448,7 +448,7 @@ def write_ncp(path: str | Path, bundle: DesignBundle, report: dict, *, render: b
 def ncp_files(bundle: DesignBundle, report: dict, *, render: bool = True,
               progress: Callable[[str], None] | None = None) -> dict[str, Any]:
     """The NCP / CNC / AA files of a design bundle beyond
-    :func:`gridshell.bundle.write_bundle`'s, as its ``extra`` (name -> bytes or writer);
+    :func:`gridshell.design.bundle.write_bundle`'s, as its ``extra`` (name -> bytes or writer);
     :func:`gridshell.api.write` writes them. ``report``: the report of :func:`design_ncp`
     (its ``"state"`` holds the arrays).
 
@@ -462,7 +462,7 @@ def ncp_files(bundle: DesignBundle, report: dict, *, render: bool = True,
     """
     import io
 
-    from ..meshfile import write_mesh
+    from gridshell.geometry.meshfile import write_mesh
 
     st: NCPState = report["state"]
     net = bundle.net
@@ -480,8 +480,8 @@ def ncp_files(bundle: DesignBundle, report: dict, *, render: bool = True,
     for k, V in enumerate(st.sequence.V):
         extra[f"sequence/frame_{k:0{width}d}.obj"] = (lambda p, V=V: write_mesh(p, V, loops))
     if render:
-        from ..render import ncp_maps
-        from ..render.net_preview import net_preview
+        from gridshell.render import ncp_maps
+        from gridshell.render.net_preview import net_preview
 
         if progress is not None:
             progress("rendering pictures and the alignment sequence")

@@ -18,7 +18,7 @@ The optimization runs on geometry scaled to a unit bounding-box diagonal of the 
 weights mean the same on any model, and the length and axis constraints are weighted by the
 net's density (:data:`EDGE_REF`), so they mean the same at any number of curves; results are
 returned in metres. The same three constraint
-terms drive the alignment simulation (:mod:`gridshell.ncp.simulate`), with the reference
+terms drive the alignment simulation (:mod:`gridshell.ncp.alignment`), with the reference
 configuration as fixed blocks.
 """
 from __future__ import annotations
@@ -29,12 +29,12 @@ from typing import Callable, NamedTuple
 
 import numpy as np
 
-from ..bspline import BSplineSurface
-from ..errors import InputError
-from ..net import Net
-from ..solver import Layout, Problem, TermResult, result, solve, term
-from ..solver import terms as T
-from .collapse import CollapseResult, closest_on_polyline
+from gridshell.geometry.bspline import BSplineSurface
+from gridshell.core.errors import InputError
+from gridshell.geometry.net import Net
+from gridshell.solver import Layout, Problem, TermResult, result, solve, term
+from gridshell.solver import terms as T
+from gridshell.ncp.collapse import CollapseResult, closest_on_polyline
 
 __all__ = ["DEFAULT_WEIGHTS", "EDGE_REF", "CONSTRAINT_TOL", "net_density", "constraint_errors",
            "EdgeLength", "edge_length_eq", "AxisPairs", "rotation_axis_eq", "UnitNorm",
@@ -312,7 +312,7 @@ def post_optimize(surf: BSplineSurface, net: Net, joint_uv: np.ndarray, collapse
     lay = Layout([("V", (n, 3)), ("r", (n, 3)), ("Vt", (n, 2)), ("rt", (n, 2))])
     x = lay.pack({"V": (V0 - centre) / scale, "r": r0, "Vt": Vt0 / scale, "rt": rt0})
     inner = interior_vertices(n, E)
-    from ..solver.terms import laplacian_matrix
+    from gridshell.solver.terms import laplacian_matrix
     Lap = laplacian_matrix(n, E, fixed_rows=np.setdiff1d(np.arange(n), inner))
     density = net_density(lay.view(x, "V"), E)
     ell = EDGE_REF / density          # mean edge length, scaled units

@@ -17,8 +17,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..bspline import BSplineSurface, fit_points
-from ..diffgeo import surface_curvature
+from gridshell.geometry.bspline import BSplineSurface, fit_points
+from gridshell.geometry.diffgeo import surface_curvature
 
 #: Below this mean misalignment (degrees) the parametrization is kept as it is.
 ALIGN_MIN_DEG = 5.0

@@ -1,9 +1,9 @@
 """The initial B-spline of the PHLW design (paper 4.2.1) from a reference mesh.
 
 A structured quad grid is fitted directly: its rows give ``u`` and its columns ``v``
-(:func:`gridshell.grid.grid_from_quads`). Any other disk-like mesh (triangles, or quads that
+(:func:`gridshell.geometry.grid.grid_from_quads`). Any other disk-like mesh (triangles, or quads that
 do not form a grid) is parameterized with libigl first
-(:func:`gridshell.igl_adapter.parameterize_disk`) and fitted as scattered points.
+(:func:`gridshell.geometry.igl_adapter.parameterize_disk`) and fitted as scattered points.
 """
 from __future__ import annotations
 
@@ -12,8 +12,8 @@ from typing import Any
 
 import numpy as np
 
-from ..bspline import BSplineSurface, fit_grid, fit_points
-from ..errors import InputError, MeshError
+from gridshell.geometry.bspline import BSplineSurface, fit_grid, fit_points
+from gridshell.core.errors import InputError, MeshError
 
 
 @dataclass
@@ -63,7 +63,7 @@ def initial_surface(mesh: Any, F: np.ndarray | None = None, *, n_ctrl: tuple[int
     F : (m, 4) or (m, 3) int faces
     n_ctrl : control points in u and v
     degree : degrees in u and v
-    smoothing : relative thin-plate weight of the fit (see :func:`gridshell.bspline.fit_grid`);
+    smoothing : relative thin-plate weight of the fit (see :func:`gridshell.geometry.bspline.fit_grid`);
         scattered data (triangle meshes) use at least 1e-4
     transpose : swap u and v (grid rows -> v); the PHLW rows then follow the other family
     align : turn the parameter plane onto the mean principal directions of the first fit
@@ -82,7 +82,7 @@ def initial_surface(mesh: Any, F: np.ndarray | None = None, *, n_ctrl: tuple[int
     nu, nv = (int(k) for k in n_ctrl)
     du, dv = (int(k) for k in degree)
     if F.shape[1] == 4:
-        from ..grid import grid_from_quads
+        from gridshell.geometry.grid import grid_from_quads
 
         try:
             G = grid_from_quads(F, len(V))
@@ -100,13 +100,13 @@ def initial_surface(mesh: Any, F: np.ndarray | None = None, *, n_ctrl: tuple[int
             fit = InitialFit(surf, rms, "grid", (P.shape[0], P.shape[1]))
             if not align:
                 return fit
-            from ..bspline import _chord_params
+            from gridshell.geometry.bspline import _chord_params
 
             pu, pv = np.meshgrid(_chord_params(P), _chord_params(P.transpose(1, 0, 2)),
                                  indexing="ij")
             return _aligned(fit, P.reshape(-1, 3), pu.ravel(), pv.ravel(), (nu, nv), (du, dv),
                             max(smoothing, 1e-4), V, F)
-    from ..igl_adapter import parameterize_disk
+    from gridshell.geometry.igl_adapter import parameterize_disk
 
     UV = parameterize_disk(V, F)
     if transpose:
@@ -134,8 +134,8 @@ def _aligned(fit: InitialFit, P: np.ndarray, u: np.ndarray, v: np.ndarray,
     step's coverage and deviation tolerances (the first fit's own deviation if larger), else
     none (measured: a full 44 degree turn of corpus associate-07 left coverage 16 % before
     and 28 % after the PHLW step, tolerance 10 %)."""
-    from .phlw_figures import COVERAGE_TOL, DEVIATION_TOL, coverage_percent, deviation_percent
-    from .principal_frame import ALIGN_BUDGET, ALIGN_MIN_DEG, principal_angle, rotated_fit
+    from gridshell.ncp.phlw.figures import COVERAGE_TOL, DEVIATION_TOL, coverage_percent, deviation_percent
+    from gridshell.ncp.principal_frame import ALIGN_BUDGET, ALIGN_MIN_DEG, principal_angle, rotated_fit
 
     pa = principal_angle(fit.surface)
     fit.principal = pa

@@ -10,8 +10,8 @@ import os
 
 import numpy as np
 
-from ..atomic import atomic_path
-from ..errors import InputError
+from gridshell.core.atomic import atomic_path
+from gridshell.core.errors import InputError
 
 
 def curvature_diagram(path: str | os.PathLike, H: np.ndarray, K: np.ndarray,

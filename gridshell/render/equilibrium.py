@@ -13,8 +13,8 @@ from typing import Sequence
 
 import numpy as np
 
-from ..atomic import atomic_path
-from .ribbons import FAMILY_COLOURS, view_angles
+from gridshell.core.atomic import atomic_path
+from gridshell.render.ribbons import FAMILY_COLOURS, view_angles
 
 
 def _fit_view(fig, ax, P: np.ndarray, fill: float = 0.92) -> None:

@@ -12,8 +12,8 @@ from typing import Sequence
 
 import numpy as np
 
-from ..errors import InputError
-from .figure import content_box, cube_limits, png_bytes, pyplot
+from gridshell.core.errors import InputError
+from gridshell.render.figure import content_box, cube_limits, png_bytes, pyplot
 
 __all__ = ["edge_map", "vertex_map", "collapse_plot", "sequence_frames", "gif"]
 

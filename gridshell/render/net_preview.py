@@ -9,7 +9,7 @@ from typing import Sequence
 
 import numpy as np
 
-from ..errors import InputError
+from gridshell.core.errors import InputError
 
 __all__ = ["net_preview"]
 
@@ -25,7 +25,7 @@ def net_preview(path: str | Path, V: np.ndarray, F: np.ndarray, joints: np.ndarr
     Parameters
     ----------
     path : path-like
-        Output ``.png`` file (written directly; wrap in :func:`gridshell.atomic.atomic_path`
+        Output ``.png`` file (written directly; wrap in :func:`gridshell.core.atomic.atomic_path`
         or a bundle's ``extra`` for atomicity).
     V : (n, 3) float
         Surface vertices, metres.
@@ -49,7 +49,7 @@ def net_preview(path: str | Path, V: np.ndarray, F: np.ndarray, joints: np.ndarr
     import matplotlib
     from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
 
-    from .figure import cube_limits, png_bytes, pyplot
+    from gridshell.render.figure import cube_limits, png_bytes, pyplot
 
     plt = pyplot()
 

@@ -24,8 +24,8 @@ from typing import Any
 
 import numpy as np
 
-from ..strips3d import strip_frames
-from ..vectors import unit_rows as _unit
+from gridshell.geometry.strips3d import strip_frames
+from gridshell.geometry.vectors import unit_rows as _unit
 
 __all__ = ["Camera", "Painter", "grow_polygons", "strip_faces", "strips_faces"]
 
@@ -62,7 +62,7 @@ class Camera:
 
 def strip_faces(axis: np.ndarray, normals: np.ndarray, width: float, thickness: float,
                 tangent: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The four long sides of a strip (:func:`gridshell.strips3d.strip_solid`) as quads, each
+    """The four long sides of a strip (:func:`gridshell.geometry.strips3d.strip_solid`) as quads, each
     side split in two along its width: ``Q (8(k-1), 4, 3)``; ``side (8(k-1),)``, the signed
     distance of each quad's centre from the surface along the normal (metres; 0 for a quad in
     the surface); and that unit normal under each quad ``(8(k-1), 3)``."""

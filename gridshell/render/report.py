@@ -19,9 +19,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Iterable
 
-from ..atomic import write_text
-from ..errors import InputError
-from ..quality import THRESHOLDS
+from gridshell.core.atomic import write_text
+from gridshell.core.errors import InputError
+from gridshell.measure.quality import THRESHOLDS
 
 __all__ = ["Check", "CHECKS", "metric_checks", "report_html", "write_report"]
 
@@ -241,16 +241,16 @@ def _fabrication_section(d: Path) -> str:
 
 def _structure_section(d: Path) -> str:
     """The structural check's section when ``structure.json`` exists (``gridshell check``)."""
-    from .structure import structure_section
+    from gridshell.render.utilisation import structure_section
 
     return structure_section(d)
 
 
 def report_html(bundle_dir: str | os.PathLike) -> str:
     """The HTML text of the report of ``bundle_dir`` (see :func:`write_report`)."""
-    from .. import __version__
-    from ..bundle import read_design_json
-    from .viewer.page import viewer_css, viewer_section
+    from gridshell.core.version import __version__
+    from gridshell.design.bundle import read_design_json
+    from gridshell.render.viewer.page import viewer_css, viewer_section
 
     d = Path(bundle_dir)
     design = read_design_json(d)

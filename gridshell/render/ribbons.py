@@ -9,7 +9,7 @@ divided by the model scale: 20 x 1 mm at 1:10 = 200 x 10 mm, :mod:`.section`), w
   surface, Fig. 6 left),
 
 with ``n`` the vertex normal of the surface vertex closest to each axis point
-(:mod:`gridshell.strips3d`). Strips are coloured by family on an opaque surface; all polygons
+(:mod:`gridshell.geometry.strips3d`). Strips are coloured by family on an opaque surface; all polygons
 are painted far to near in one list (:mod:`.painter`), so no strip shows through the surface
 and none vanishes under it. The camera is chosen from the principal axes of the geometry
 (orthographic). Plain arrays in, one PNG out; :func:`render_bundle` does the same for a design
@@ -23,10 +23,10 @@ from typing import Sequence
 
 import numpy as np
 
-from ..atomic import atomic_path
-from ..errors import InputError
-from ..strips3d import TANGENT_KINDS, nearest_vertex_normals, strip_frame
-from ..vectors import row_norms, unit_rows as _unit
+from gridshell.core.atomic import atomic_path
+from gridshell.core.errors import InputError
+from gridshell.geometry.strips3d import TANGENT_KINDS, nearest_vertex_normals, strip_frame
+from gridshell.geometry.vectors import row_norms, unit_rows as _unit
 
 __all__ = ["FAMILY_COLOURS", "TANGENT_KINDS", "nearest_vertex_normals",
            "ribbon_polygons", "view_angles", "render_ribbons", "render_bundle"]
@@ -52,7 +52,7 @@ def ribbon_polygons(axis: np.ndarray, normals: np.ndarray, width: float,
     tangent : bool
         True: offset along ``n x t`` (in the surface, GG); False: along ``n`` made
         orthogonal to the axis (standing on the surface, NCP / CNC / AA);
-        :func:`gridshell.strips3d.strip_frame`.
+        :func:`gridshell.geometry.strips3d.strip_frame`.
     """
     P = np.asarray(axis, float).reshape(-1, 3)
     n_normals = len(np.asarray(normals).reshape(-1, 3))
@@ -168,8 +168,8 @@ def render_ribbons(path: str | os.PathLike, axes: Sequence[np.ndarray],
     from matplotlib.figure import Figure
     from matplotlib.patches import Patch
 
-    from .painter import Camera, Painter, strips_faces
-    from .section import bundle_section
+    from gridshell.render.painter import Camera, Painter, strips_faces
+    from gridshell.render.section import bundle_section
 
     axes = [np.asarray(a, float).reshape(-1, 3) for a in axes]
     fams = [int(f) for f in families]
@@ -326,15 +326,15 @@ def render_bundle(bundle, path: str | os.PathLike | None = None, *,
                   width: float | None = None, thickness: float | None = None,
                   **kwargs) -> Path:
     """Render the strips of a design bundle (a directory or a
-    :class:`~gridshell.bundle.DesignBundle`) to ``path`` (default ``DIR/render.png``).
+    :class:`~gridshell.design.bundle.DesignBundle`) to ``path`` (default ``DIR/render.png``).
 
     ``width`` and ``thickness`` are the strip's real section in metres (default the cut strip
     of the bundle's ``fabrication/fabrication.json`` divided by its scale, else 20 x 1 mm at
     1:10 = 200 x 10 mm: :func:`gridshell.render.section.bundle_section`); the title says it.
     Further keyword arguments go to :func:`render_ribbons`.
     """
-    from ..bundle import read_bundle
-    from .section import bundle_section
+    from gridshell.design.bundle import read_bundle
+    from gridshell.render.section import bundle_section
 
     directory = None
     if isinstance(bundle, (str, os.PathLike)):

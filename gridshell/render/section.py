@@ -4,7 +4,7 @@ The strips that are cut are ``width x thickness`` mm at a model scale (``1:10`` 
 gridshell they stand for has strips ``width / scale`` wide (20 mm at 1:10 = 200 mm). The values
 come from the bundle's ``fabrication/fabrication.json`` when ``gridshell fabricate`` has run,
 else from the fabrication defaults (:data:`DEFAULT_CUT`, the same as
-``fabrication.params.FabParams``; a test keeps the two equal). The pictures
+``gridshell.fabrication.params.FabParams``; a test keeps the two equal). The pictures
 (:mod:`.ribbons`) and the WebGL viewer (:mod:`.viewer`) draw this section.
 """
 from __future__ import annotations
@@ -15,7 +15,7 @@ import os
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..strips3d import real_section_m
+from gridshell.geometry.strips3d import real_section_m
 
 __all__ = ["DEFAULT_CUT", "StripSection", "bundle_section"]
 

@@ -15,8 +15,8 @@ from typing import Callable, Sequence
 
 import numpy as np
 
-from ..atomic import write_bytes
-from ..errors import InputError, MeshError
+from gridshell.core.atomic import write_bytes
+from gridshell.core.errors import InputError, MeshError
 
 __all__ = ["sequence_files", "read_sequence", "render_sequence", "render_bundle_sequence"]
 
@@ -37,14 +37,14 @@ def read_sequence(bundle_dir: str | os.PathLike) -> tuple[list[np.ndarray], np.n
 
     The faces come from the first frame; every frame must have the same vertex count. The
     collapsed frames are degenerate meshes by design, so the files are read without the mesh
-    checks of :func:`gridshell.meshfile.read_mesh`.
+    checks of :func:`gridshell.geometry.meshfile.read_mesh`.
 
     Raises
     ------
     InputError
         No ``sequence/frame_*.obj`` in the bundle, or frames of different sizes.
     """
-    from ..meshfile import read_configuration
+    from gridshell.geometry.meshfile import read_configuration
 
     files = sequence_files(bundle_dir)
     if not files:
@@ -93,9 +93,9 @@ def render_sequence(frames: Sequence[np.ndarray], F: np.ndarray, *,
         ``frames``: list of written PNG paths, ``gif``: the GIF path or None, ``pngs``: the
         PNG bytes of every frame.
     """
-    from ..quadmesh import mesh_edges
-    from . import ncp_maps
-    from .ribbons import view_angles
+    from gridshell.geometry.quadmesh import mesh_edges
+    from gridshell.render import ncp_maps
+    from gridshell.render.ribbons import view_angles
 
     frames = [np.asarray(V, float).reshape(-1, 3) for V in frames]
     if not frames:

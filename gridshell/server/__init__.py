@@ -4,4 +4,6 @@
 :mod:`.components` registers the components (GG design, NCP design, verify, fabricate) on a
 ``ghhops-server`` Flask app; errors reach the component as its message, never a dead
 component.
+
+May import: :mod:`gridshell.api` and every floor below; never the CLI.
 """

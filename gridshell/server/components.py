@@ -31,8 +31,8 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import GridshellError, InputError
-from . import rhino
+from gridshell.core.errors import GridshellError, InputError
+from gridshell.server import rhino
 
 #: the keywords ``Options`` may give, per component (the others are inputs of their own)
 GG_OPTIONS = ("meridians", "direction", "spacing", "crossing_angle", "at_parallel", "offsets",
@@ -78,7 +78,7 @@ def options(text: str, allowed: tuple[str, ...], what: str) -> dict[str, Any]:
 def _net_outputs(bundle, out: Path, warnings: list[str]) -> Reply:
     """Net (mesh of the joints and loops), lamella axes and aligned polylines (m), metrics
     (JSON) and the bundle's path."""
-    from ..bundle import finite_json
+    from gridshell.design.bundle import finite_json
 
     net = bundle.net
     mesh = rhino.to_mesh(net.joints, net.loops)
@@ -133,7 +133,7 @@ def register(hops, workdir: Path) -> None:
                               optional=True)],
         outputs=net_outputs())
     def gg(target, lamellae=6, grid=12, opts="{}"):
-        from ..api import design_gg, write
+        from gridshell.api import design_gg, write
 
         kw = options(opts, GG_OPTIONS, "GG design")
         kw.setdefault("frames", 0)
@@ -157,7 +157,7 @@ def register(hops, workdir: Path) -> None:
                               optional=True)],
         outputs=net_outputs())
     def ncp(reference, mode="cnc", curves=8, opts="{}"):
-        from ..api import design_ncp, write
+        from gridshell.api import design_ncp, write
 
         kw = options(opts, NCP_OPTIONS, "NCP design")
         V, F = rhino.target_arrays(reference)
@@ -176,8 +176,8 @@ def register(hops, workdir: Path) -> None:
                                access=hs.HopsParamAccess.LIST),
                  hs.HopsString("Report", "R", "the recomputed figures (JSON)")])
     def verify(bundle_dir):
-        from ..bundle import finite_json
-        from ..verification import verify_bundle
+        from gridshell.design.bundle import finite_json
+        from gridshell.design.verification import verify_bundle
 
         res = verify_bundle(_bundle_path(bundle_dir))
         warnings = [] if res["ok"] else ["the design fails its checks: " + "; ".join(
@@ -210,15 +210,15 @@ def register(hops, workdir: Path) -> None:
     def fab(bundle_dir, scale="1:10", sheet="600x400", width=20.0, opts="{}", force=False):
         from dataclasses import fields
 
-        from fabrication import FabParams, fabricate
+        from gridshell.fabrication import FabParams, fabricate
 
-        from ..cli.fabricate import check_design
+        from gridshell.design.verification import require_design
 
         names = tuple(f.name for f in fields(FabParams) if f.name not in
                       ("scale", "sheet", "width"))
         kw = options(opts, names, "Fabricate")
         path = _bundle_path(bundle_dir)
-        verdict = check_design(str(path), bool(force))
+        verdict = require_design(str(path), bool(force), "set Force to cut it anyway")
         params = FabParams(scale=scale, sheet=sheet, width=float(width), **kw)
         out = path / "fabrication"
         rep = fabricate(path, out, params, plan=False, keep_layout=True)
@@ -236,7 +236,7 @@ def register(hops, workdir: Path) -> None:
             x0 = k * (W + SHEET_SPACING)
             sheets.append(rhino.to_polyline(np.array([[x0, 0], [x0 + W, 0], [x0 + W, H],
                                                       [x0, H], [x0, 0]], float)))
-        warnings = [] if verdict["ok"] else ["the design fails its checks; cut anyway (Force)"]
+        warnings = [] if verdict.ok else ["the design fails its checks; cut anyway (Force)"]
         if rep.get("joints_fallback"):
             warnings.append(rep["joints_fallback"])
         summary = {k: rep[k] for k in ("kind", "shape", "n_strips", "n_pieces", "n_sheets",
@@ -261,7 +261,7 @@ def make_app(workdir: str | Path | None = None):
 
     from flask import Flask
 
-    from .hops import GridshellHops
+    from gridshell.server.hops import GridshellHops
 
     wd = Path(workdir) if workdir else Path(tempfile.mkdtemp(prefix="gridshell-hops-"))
     wd.mkdir(parents=True, exist_ok=True)

@@ -3,7 +3,7 @@ that always reach the component.
 
 ``ghhops-server`` answers a failing handler with HTTP 404/500 and a traceback, which Hops
 shows as a dead component. Here every solve answers 200 with the tool's message in
-``errors`` (a :class:`~gridshell.errors.GridshellError`: its one line; anything else: its
+``errors`` (a :class:`~gridshell.core.errors.GridshellError`: its one line; anything else: its
 type and message) and the warnings of the handler's :class:`~.components.Reply` in
 ``warnings``; missing optional inputs take the handler's defaults.
 """
@@ -25,7 +25,7 @@ for _h in [h for h in _root.handlers if h not in _handlers]:   # undo its basicC
     _root.removeHandler(_h)
 _root.setLevel(_level)
 
-from ..errors import GridshellError  # noqa: E402
+from gridshell.core.errors import GridshellError  # noqa: E402
 
 
 class GridshellHops(HopsFlask):

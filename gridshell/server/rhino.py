@@ -11,8 +11,8 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import InputError
-from ..export.rhino_geometry import mesh as _mesh
+from gridshell.core.errors import InputError
+from gridshell.export.rhino_geometry import mesh as _mesh
 
 #: grid of points a surface is sampled on
 SURFACE_SAMPLES = 24
@@ -52,7 +52,7 @@ def mesh_arrays(m) -> tuple[np.ndarray, np.ndarray]:
 def surface_arrays(srf, samples: int = SURFACE_SAMPLES) -> tuple[np.ndarray, np.ndarray]:
     """A quad mesh ``(V, F)`` of ``samples x samples`` points of a rhino3dm surface (or the
     first face of a Brep) on its parameter domain."""
-    from ..grid import grid_quads
+    from gridshell.geometry.grid import grid_quads
 
     if hasattr(srf, "Faces") and hasattr(srf, "Surfaces"):       # a Brep
         if len(srf.Faces) != 1:

@@ -6,8 +6,8 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
-from .layout import Layout
-from .terms import TermFn
+from gridshell.solver.layout import Layout
+from gridshell.solver.terms import TermFn
 
 
 def term_jacobian(fn: TermFn, x: np.ndarray, layout: Layout, data: Any) -> sp.csr_matrix:

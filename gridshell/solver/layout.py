@@ -5,7 +5,7 @@ from typing import Iterable, Mapping
 
 import numpy as np
 
-from ..errors import InputError
+from gridshell.core.errors import InputError
 
 
 class Layout:

@@ -41,9 +41,9 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..errors import InputError
-from .iterative import pcg
-from .ordering import dense_last, permuted
+from gridshell.core.errors import InputError
+from gridshell.solver.iterative import pcg
+from gridshell.solver.ordering import dense_last, permuted
 
 #: backends in order of preference (the first one that imports is the default)
 BACKENDS = ("cholmod", "superlu")

@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from .linear import pattern_key
+from gridshell.solver.linear import pattern_key
 
 
 class NormalEquations:

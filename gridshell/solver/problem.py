@@ -7,9 +7,9 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
-from ..errors import InputError
-from .layout import Layout
-from .terms import TermFn, TermResult, registered_name
+from gridshell.core.errors import InputError
+from gridshell.solver.layout import Layout
+from gridshell.solver.terms import TermFn, TermResult, registered_name
 
 
 @dataclass

@@ -16,11 +16,11 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..errors import ConvergenceError, InputError
-from .linear import LinearSolver, NotPositiveDefinite, shared_solver
-from .normal import NormalEquations
-from .problem import Problem
-from .threads import one_blas_thread
+from gridshell.core.errors import ConvergenceError, InputError
+from gridshell.solver.linear import LinearSolver, NotPositiveDefinite, shared_solver
+from gridshell.solver.normal import NormalEquations
+from gridshell.solver.problem import Problem
+from gridshell.solver.threads import one_blas_thread
 
 Method = Literal["lm", "gn", "guided"]
 

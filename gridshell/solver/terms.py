@@ -11,7 +11,7 @@ from typing import Any, Callable, NamedTuple
 import numpy as np
 import scipy.sparse as sp
 
-from .layout import Layout
+from gridshell.solver.layout import Layout
 
 
 class TermResult(NamedTuple):

@@ -35,7 +35,7 @@ def _controller() -> Any:
     once :mod:`.linear` has imported it, CHOLMOD's)."""
     from threadpoolctl import ThreadpoolController
 
-    from .linear import available
+    from gridshell.solver.linear import available
     available("cholmod")  # loads CHOLMOD's BLAS (when installed) before the controller looks
     return ThreadpoolController()
 

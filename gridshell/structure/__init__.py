@@ -2,9 +2,12 @@
 
 Reads a design bundle and the fabrication parameters (width, thickness, scale); never imports
 a pipeline (gg/, ncp/, fabrication/) nor the CLI. SI units inside: metres, pascals, kg/m^3.
+
+May import: :mod:`gridshell.core`, :mod:`gridshell.geometry`, :mod:`gridshell.measure`,
+:mod:`gridshell.design`; never a pipeline, render or fabrication.
 """
-from .materials import MATERIALS, Material, get_material, material_names, user_material
-from .section import Section
+from gridshell.structure.materials import MATERIALS, Material, get_material, material_names, user_material
+from gridshell.structure.section import Section
 
 __all__ = ["MATERIALS", "Material", "Section", "get_material", "material_names",
            "user_material"]

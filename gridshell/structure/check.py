@@ -15,14 +15,14 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..bundle import DesignBundle, finite_json, read_bundle
-from ..errors import InputError
-from .cutshape import collapse_curvature, cut_curvature, cut_shape
-from .frames import darboux_curvatures, surface_normals
-from .materials import Material
-from .section import Section
-from .states import bundle_states
-from .stresses import (KIND_ORIENTATION, StripCurvatures, max_elastic_thickness,
+from gridshell.design.bundle import DesignBundle, finite_json, read_bundle
+from gridshell.core.errors import InputError
+from gridshell.structure.cutshape import collapse_curvature, cut_curvature, cut_shape
+from gridshell.structure.frames import darboux_curvatures, surface_normals
+from gridshell.structure.materials import Material
+from gridshell.structure.section import Section
+from gridshell.structure.states import bundle_states
+from gridshell.structure.stresses import (KIND_ORIENTATION, StripCurvatures, max_elastic_thickness,
                        strip_curvatures, strip_stresses)
 
 FILENAME = "structure.json"
@@ -174,7 +174,7 @@ def check_bundle(bundle: DesignBundle | str | Path, material: Material, section:
 def write_structure_json(bundle_dir: str | Path, result: dict[str, Any]) -> Path:
     """Write ``result`` as ``bundle_dir/structure.json`` (atomically, listed in the bundle's
     manifest; strict JSON: an infinite radius of a straight strip is ``null``)."""
-    from ..atomic import write_text
+    from gridshell.core.atomic import write_text
 
     out = Path(bundle_dir) / FILENAME
     write_text(out, json.dumps(finite_json(result), indent=1, allow_nan=False) + "\n")

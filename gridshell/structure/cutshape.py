@@ -1,7 +1,7 @@
 """The in-plane curvature of each strip as cut (orthogonal lamellae), along its axis.
 
-The shapes :mod:`fabrication.strips` cuts (one rule for both:
-:func:`gridshell.bundle.strip_cut_shape` and :func:`gridshell.bundle.collapse_radius`): AA and
+The shapes :mod:`gridshell.fabrication.strips` cuts (one rule for both:
+:func:`gridshell.design.bundle.strip_cut_shape` and :func:`gridshell.design.bundle.collapse_radius`): AA and
 GG strips are straight;
 CNC strips are arcs of radius ``collapse.radius`` (or ``1 / metrics.n``); NCP strips are pieces
 of the planar collapse curve, joint 0 at ``collapse_s[0]`` and the axis following at its own arc
@@ -12,11 +12,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..bundle import DesignBundle, collapse_radius
-from ..bundle import strip_cut_shape as cut_shape
-from ..diffgeo import polyline_curvature
-from ..errors import InputError
-from ..net import Lamella, polyline_arclength
+from gridshell.design.bundle import DesignBundle, collapse_radius
+from gridshell.design.bundle import strip_cut_shape as cut_shape
+from gridshell.geometry.diffgeo import polyline_curvature
+from gridshell.core.errors import InputError
+from gridshell.geometry.net import Lamella, polyline_arclength
 
 
 def collapse_curvature(bundle: DesignBundle) -> tuple[np.ndarray, np.ndarray]:

@@ -23,14 +23,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import InputError
-from ..net import polyline_arclength
-from . import rod
-from .cutshape import collapse_curvature, collapse_radius, cut_curvature, cut_shape
-from .frames import joint_normals
-from .materials import Material
-from .rodnet import JointSpec, RodNetwork, RodSpec
-from .section import Section
+from gridshell.core.errors import InputError
+from gridshell.geometry.net import polyline_arclength
+from gridshell.structure import rod
+from gridshell.structure.cutshape import collapse_curvature, collapse_radius, cut_curvature, cut_shape
+from gridshell.structure.frames import joint_normals
+from gridshell.structure.materials import Material
+from gridshell.structure.rodnet import JointSpec, RodNetwork, RodSpec
+from gridshell.structure.section import Section
 
 #: standard gravity, m/s^2
 GRAVITY = 9.81
@@ -78,7 +78,7 @@ class DeployedModel:
 def boundary_joints(net) -> np.ndarray:
     """Joints on the boundary of the net's loops (an edge of one loop only); the lamellae's end
     joints when the net has no loops."""
-    from ..quadmesh import boundary_vertices_of
+    from gridshell.geometry.quadmesh import boundary_vertices_of
 
     if len(net.loops):
         return boundary_vertices_of(net.loops, len(net.joints))
@@ -121,7 +121,7 @@ def build_model(bundle, material: Material, section: Section, *,
                 supports: str | np.ndarray = "boundary", gravity: bool = False,
                 per_bay: int = 3, stiffness: Stiffness | None = None,
                 joint_factor: float = 100.0) -> DeployedModel:
-    """The rod network of a design bundle (:class:`~gridshell.bundle.DesignBundle`) built as
+    """The rod network of a design bundle (:class:`~gridshell.design.bundle.DesignBundle`) built as
     ``section`` of ``material`` (module docstring). ``supports``: "boundary" or joint indices;
     ``joint_factor``: joint stiffness relative to the strips' stiffest rotation (a penalty)."""
     net = bundle.net

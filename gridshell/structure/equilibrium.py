@@ -14,12 +14,12 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..errors import ConvergenceError
-from . import rod
-from .deployed import DeployedModel, Stiffness, build_model
-from .jet import Jet
-from .newton import NewtonResult, minimize
-from .rodnet import RodNetwork
+from gridshell.core.errors import ConvergenceError
+from gridshell.structure import rod
+from gridshell.structure.deployed import DeployedModel, Stiffness, build_model
+from gridshell.structure.jet import Jet
+from gridshell.structure.newton import NewtonResult, minimize
+from gridshell.structure.rodnet import RodNetwork
 
 
 def force_scale(net: RodNetwork, q: np.ndarray) -> float:
@@ -74,7 +74,7 @@ def node_stresses(net: RodNetwork, q: np.ndarray, material, section) -> dict[str
     """Per interior vertex of the network at ``q``: curvature changes from the rest state
     (weak / strong axis, 1/m), twist rate (rad/m) and the stresses and utilisation of the strip
     (:func:`gridshell.structure.stresses.strip_stresses`)."""
-    from .stresses import StripCurvatures, strip_stresses
+    from gridshell.structure.stresses import StripCurvatures, strip_stresses
 
     V = Jet.variables(q[net.bend_idx], 0)
     d = net.bend_data()
@@ -115,7 +115,7 @@ def simulate(bundle, material, section, *, supports: str | np.ndarray = "boundar
              rtol: float = 1e-9, max_iter: int = 200, time_limit: float | None = None,
              progress: Callable[[str], None] | None = None, require: bool = True
              ) -> Equilibrium:
-    """The static equilibrium of a design bundle (:class:`~gridshell.bundle.DesignBundle`)
+    """The static equilibrium of a design bundle (:class:`~gridshell.design.bundle.DesignBundle`)
     built in ``section`` of ``material`` (see :mod:`gridshell.structure.deployed`).
 
     Raises :class:`ConvergenceError` if Newton does not converge (``require``)."""

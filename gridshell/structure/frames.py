@@ -12,9 +12,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..diffgeo import normal_geodesic_curvature
-from ..errors import InputError
-from ..net import polyline_arclength
+from gridshell.geometry.diffgeo import normal_geodesic_curvature
+from gridshell.core.errors import InputError
+from gridshell.geometry.net import polyline_arclength
 
 
 @dataclass
@@ -22,7 +22,7 @@ class DarbouxCurvatures:
     """Curvatures along a polyline, one value per point (design units).
 
     s : (k,) arc length, m;  kn, kg : (k,) normal / geodesic curvature, 1/m (signs of
-    :func:`gridshell.diffgeo.normal_geodesic_curvature`);  tau_g : (k,) geodesic torsion, 1/m.
+    :func:`gridshell.geometry.diffgeo.normal_geodesic_curvature`);  tau_g : (k,) geodesic torsion, 1/m.
     """
 
     s: np.ndarray
@@ -68,7 +68,7 @@ def geodesic_torsion(P: np.ndarray, normals: np.ndarray) -> np.ndarray:
 
 
 def darboux_curvatures(P: np.ndarray, normals: np.ndarray) -> DarbouxCurvatures:
-    """``kn``, ``kg`` (:func:`gridshell.diffgeo.normal_geodesic_curvature`) and ``tau_g``
+    """``kn``, ``kg`` (:func:`gridshell.geometry.diffgeo.normal_geodesic_curvature`) and ``tau_g``
     (:func:`geodesic_torsion`) at every point of the polyline ``P (k,3)``, metres, with unit
     surface normals ``normals (k,3)``; the end values repeat their neighbours'.
 
@@ -99,12 +99,12 @@ def surface_normals(P: np.ndarray, V: np.ndarray, F: np.ndarray) -> np.ndarray:
     """Unit surface normals ``(k,3)`` at points ``P (k,3)`` on or near the mesh ``(V, F)``.
 
     On a structured quad grid (the surfaces of design bundles) the normals of the smooth
-    bicubic surface through the grid (:func:`gridshell.metrics.smooth_grid_normals`, second
+    bicubic surface through the grid (:func:`gridshell.measure.metrics.smooth_grid_normals`, second
     order); otherwise the per-vertex normals of the mesh interpolated at the closest point
     (first order in the mesh size). Oriented like the mesh's faces.
     """
-    from ..igl_adapter import closest_points_with_normals
-    from ..metrics import smooth_grid_normals
+    from gridshell.geometry.igl_adapter import closest_points_with_normals
+    from gridshell.measure.metrics import smooth_grid_normals
 
     P = np.asarray(P, float).reshape(-1, 3)
     if not len(P):
@@ -119,7 +119,7 @@ def joint_normals(V: np.ndarray, loops: np.ndarray) -> np.ndarray:
     """Unit normals ``(n,3)`` of a joint mesh ``V (n,3)`` with quad ``loops (m,4)``: the sum of
     the vector areas of the loops around each joint; zero rows where they vanish (a collapsed
     net whose loops have no area)."""
-    from ..quadmesh import polygon_vector_areas
+    from gridshell.geometry.quadmesh import polygon_vector_areas
 
     V = np.asarray(V, float)
     L = np.asarray(loops, np.int64).reshape(-1, 4)

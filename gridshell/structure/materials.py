@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass, replace
 
-from ..errors import InputError
+from gridshell.core.errors import InputError
 
 
 @dataclass(frozen=True)

@@ -34,7 +34,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .jet import Jet, atan2, cross, dot, norm, stack
+from gridshell.structure.jet import Jet, atan2, cross, dot, norm, stack
 
 
 # ---------------------------------------------------------------------------------------------

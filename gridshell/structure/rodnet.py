@@ -13,9 +13,9 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
-from ..errors import InputError
-from . import rod
-from .jet import Jet
+from gridshell.core.errors import InputError
+from gridshell.structure import rod
+from gridshell.structure.jet import Jet
 
 
 @dataclass

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError
+from gridshell.core.errors import InputError
 
 
 #: odd n of the Saint-Venant series; for b/a <= 1 every neglected term is below sech(41 pi/2)
@@ -73,7 +73,7 @@ class Section:
 
     @classmethod
     def from_params(cls, params) -> "Section":
-        """The section of :class:`fabrication.params.FabParams` (``width``, ``thickness`` in mm,
+        """The section of :class:`gridshell.fabrication.params.FabParams` (``width``, ``thickness`` in mm,
         ``scale`` as a ratio); any object with those three attributes will do."""
         return cls(float(params.width), float(params.thickness), float(params.scale))
 

@@ -21,12 +21,12 @@ from typing import Any
 
 import numpy as np
 
-from ..bundle import DesignBundle
-from .cutshape import collapse_curvature, cut_curvature, cut_shape
-from .frames import joint_curvatures, joint_normals
-from .materials import Material
-from .section import Section
-from .stresses import KIND_ORIENTATION, strip_curvatures, strip_stresses
+from gridshell.design.bundle import DesignBundle
+from gridshell.structure.cutshape import collapse_curvature, cut_curvature, cut_shape
+from gridshell.structure.frames import joint_curvatures, joint_normals
+from gridshell.structure.materials import Material
+from gridshell.structure.section import Section
+from gridshell.structure.stresses import KIND_ORIENTATION, strip_curvatures, strip_stresses
 
 METHOD = ("joints only: a cubic spline (not-a-knot) through each lamella's joints at the design's "
           "arc lengths; section normals from the joint mesh (NCP: the joint axes, deployed and "
@@ -43,7 +43,7 @@ FOLD_DEG = 30.0
 def _frames(path: Path | None, n: int) -> list[np.ndarray]:
     """The joints of every frame of ``path/sequence`` in order (empty if none or unreadable
     as a configuration of ``n`` joints)."""
-    from ..meshfile import read_configuration
+    from gridshell.geometry.meshfile import read_configuration
 
     if path is None or not (path / "sequence").is_dir():
         return []

@@ -30,14 +30,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError
-from .frames import DarbouxCurvatures
-from .materials import Material
-from .section import Section, torsion_stress_factor
+from gridshell.core.errors import InputError
+from gridshell.structure.frames import DarbouxCurvatures
+from gridshell.structure.materials import Material
+from gridshell.structure.section import Section, torsion_stress_factor
 
 ORIENTATIONS = ("tangent", "orthogonal")
 
-#: design kind -> lamella orientation (as fabrication.strips.ORIENTATION)
+#: design kind -> lamella orientation (as gridshell.fabrication.strips.ORIENTATION)
 KIND_ORIENTATION = {"GG": "tangent", "AA": "orthogonal", "CNC": "orthogonal",
                     "NCP": "orthogonal"}
 

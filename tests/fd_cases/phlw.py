@@ -1,4 +1,4 @@
-"""FD cases of the PHLW surface-design terms (gridshell.ncp.phlw_terms, paper 4.2.1).
+"""FD cases of the PHLW surface-design terms (gridshell.ncp.phlw.terms, paper 4.2.1).
 
 A small bi-cubic B-spline (5 x 4 control points, 3 x 4 samples) with random control points
 and random auxiliary variables near their consistent values, so every product term is active;
@@ -6,7 +6,7 @@ one case per mode (phlw, cnc, aa) for every term over the mode-dependent layout.
 """
 import numpy as np
 
-from gridshell.bspline import BSplineSurface, uniform_params
+from gridshell.geometry.bspline import BSplineSurface, uniform_params
 from gridshell.ncp import phlw as P
 
 
@@ -49,10 +49,10 @@ def _gliding(rng):
 MODE_TERMS = ("normal_eq", "first_form_eq", "delta_eq", "sqrt_delta_eq", "second_form_eq",
               "curvature_eq", "principal_eq", "phlw_target", "beta_fairness")
 
-CASES = {f"gridshell.ncp.phlw_terms.{name}[{mode}]": _case(mode)
+CASES = {f"gridshell.ncp.phlw.terms.{name}[{mode}]": _case(mode)
          for name in MODE_TERMS for mode in P.MODES}
 # sample_gliding reads only the control points, at the same place in every mode
-CASES["gridshell.ncp.phlw_terms.sample_gliding"] = _gliding
+CASES["gridshell.ncp.phlw.terms.sample_gliding"] = _gliding
 
 
 def _guard(mode):
@@ -66,7 +66,7 @@ def _guard(mode):
 
 
 for _mode in P.MODES:
-    CASES[f"gridshell.ncp.phlw_terms.parametrization_guard[{_mode}]"] = _guard(_mode)
+    CASES[f"gridshell.ncp.phlw.terms.parametrization_guard[{_mode}]"] = _guard(_mode)
 
 
 def _umbilic(mode):
@@ -80,7 +80,7 @@ def _umbilic(mode):
 
 
 for _mode in P.MODES:
-    CASES[f"gridshell.ncp.phlw_terms.umbilic_guard[{_mode}]"] = _umbilic(_mode)
+    CASES[f"gridshell.ncp.phlw.terms.umbilic_guard[{_mode}]"] = _umbilic(_mode)
 
 
 def _inward(rng):
@@ -91,4 +91,4 @@ def _inward(rng):
     return lay, x, P.SampleGliding(data.A, S + shift, data.normal)
 
 
-CASES["gridshell.ncp.phlw_terms.boundary_inward"] = _inward
+CASES["gridshell.ncp.phlw.terms.boundary_inward"] = _inward

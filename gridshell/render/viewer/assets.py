@@ -17,7 +17,7 @@ import re
 from functools import lru_cache
 from importlib import resources
 
-from ...errors import GridshellError
+from gridshell.core.errors import GridshellError
 
 __all__ = ["THREE_VERSION", "asset_text", "three_script", "viewer_script", "viewer_css"]
 

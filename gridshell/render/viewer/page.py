@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import os
 
-from .assets import THREE_VERSION, three_script, viewer_css, viewer_script
-from .scene import scene_json
+from gridshell.render.viewer.assets import THREE_VERSION, three_script, viewer_css, viewer_script
+from gridshell.render.viewer.scene import scene_json
 
 __all__ = ["viewer_section", "viewer_css"]
 

@@ -6,7 +6,7 @@ Everything the page draws, in metres, as little-endian float32 / uint32 arrays i
 - the **surface** (``surface.obj``, triangulated);
 - the **strips**: each lamella axis resampled to ``m`` points by arc length and swept by the
   real section (:func:`gridshell.render.section.bundle_section`) into a closed solid
-  (:func:`gridshell.strips3d.strip_solid`), one vertex array per **state** of the alignment
+  (:func:`gridshell.geometry.strips3d.strip_solid`), one vertex array per **state** of the alignment
   sequence (``sequence/frame_*.obj``, else the deployed and the aligned joints), one face array;
 - the **joints** of every state and the **net-loops** (quads of joint indices) with their
   Delta_a;
@@ -14,7 +14,7 @@ Everything the page draws, in metres, as little-endian float32 / uint32 arrays i
   5.1, in %, the largest of the loops at each joint, interpolated along the lamella) and, when
   ``structure.json`` exists, ``utilisation`` (its per-axis-point values, by arc length).
 
-In a state ``k > 0`` the axes are carried with the joints (:func:`gridshell.net.move_joints`),
+In a state ``k > 0`` the axes are carried with the joints (:func:`gridshell.geometry.net.move_joints`),
 sampled at the same arc-length fractions as in the deployed state, and the strip frame takes
 the normals of the net-loops at the joints of that state (oriented as in the state before; where
 the loops have collapsed, the normal of the state before). The deployed state takes the
@@ -32,12 +32,12 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ...errors import InputError
-from ...net import polyline_arclength
-from ...strips3d import (is_tangent, nearest_vertex_normals, packed_strip_frames, strip_frames,
+from gridshell.core.errors import InputError
+from gridshell.geometry.net import polyline_arclength
+from gridshell.geometry.strips3d import (is_tangent, nearest_vertex_normals, packed_strip_frames, strip_frames,
                          strip_solid_faces)
-from ...vectors import row_norms, unit_rows as _unit
-from ..section import bundle_section
+from gridshell.geometry.vectors import row_norms, unit_rows as _unit
+from gridshell.render.section import bundle_section
 
 __all__ = ["encode", "decode", "build_scene", "scene_json", "strip_solids_vertices",
            "MAX_SAMPLES", "MAX_STATES"]
@@ -146,7 +146,7 @@ def joint_normals(states: list[np.ndarray], loops: np.ndarray, n0: np.ndarray) -
 def joint_delta_a(J: np.ndarray, loops: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Delta_a (paper 5.1, %) per net-loop ``(m,)`` and per joint ``(n,)`` (the largest of its
     loops; 0 at a joint without loops)."""
-    from ...metrics import alignability_error
+    from gridshell.measure.metrics import alignability_error
 
     loops = np.asarray(loops, np.int64).reshape(-1, 4)
     da = 100.0 * np.asarray(alignability_error(J, loops), float) if len(loops) else np.zeros(0)
@@ -173,7 +173,7 @@ def _structure(bundle_dir: Path) -> dict[int, np.ndarray] | None:
 
 
 def _states(bundle_dir: Path, bundle) -> tuple[list[np.ndarray], list[str]]:
-    from ..sequence import read_sequence, sequence_files
+    from gridshell.render.sequence import read_sequence, sequence_files
 
     if sequence_files(bundle_dir):
         frames, _ = read_sequence(bundle_dir)
@@ -188,7 +188,7 @@ def _states(bundle_dir: Path, bundle) -> tuple[list[np.ndarray], list[str]]:
 
 def strip_solids_vertices(axes: list[np.ndarray], normals: list[np.ndarray], width: float,
                           thickness: float, tangent: bool) -> np.ndarray:
-    """The vertices of :func:`gridshell.strips3d.strip_solid` of every axis ``(k_i,3)`` (metres,
+    """The vertices of :func:`gridshell.geometry.strips3d.strip_solid` of every axis ``(k_i,3)`` (metres,
     ``k_i >= 2``) with its normals, concatenated ``(4 sum k_i, 3)``: the same numbers, in one
     vectorized pass instead of one call per lamella (the frame's tangent is ``np.gradient``'s
     at unit spacing: central differences inside, one-sided at each axis's ends)."""
@@ -208,7 +208,7 @@ def _check_section(width: float, thickness: float) -> None:
 def _solids_vertices(P: np.ndarray, W: np.ndarray, H: np.ndarray, width: float,
                      thickness: float) -> np.ndarray:
     """The corners ``-W-H, +W-H, +W+H, -W+H`` of the sections at the axis points ``P``
-    (:func:`gridshell.strips3d.strip_solid`'s vertices), ``(4 len(P), 3)``, metres."""
+    (:func:`gridshell.geometry.strips3d.strip_solid`'s vertices), ``(4 len(P), 3)``, metres."""
     _check_section(width, thickness)
     w, h = 0.5 * float(width) * W, 0.5 * float(thickness) * H
     return np.stack([P - w - h, P + w - h, P + w + h, P - w + h], axis=1).reshape(-1, 3)
@@ -219,9 +219,9 @@ def _axis_samples(net, use: list[int], states: list[np.ndarray], arcs: list[np.n
     """The points ``(K, T, 3)`` (metres) of the lamellae ``net.lamellae[i]``, ``i`` in ``use``,
     at their arc-length fractions ``fracs`` in each of the ``K`` states: on the axes in the
     first state (arc lengths ``arcs``), on the axes carried with the joints
-    (:func:`gridshell.net.carried_axes`) in the others; samples of all lamellae one after the
+    (:func:`gridshell.geometry.net.carried_axes`) in the others; samples of all lamellae one after the
     other (``T = sum len(fracs)``). A lamella of zero length gives its first point."""
-    from ...net import carried_axes
+    from gridshell.geometry.net import carried_axes
 
     K, n = len(states), len(use)
     every = carried_axes(net, list(states[1:]))
@@ -286,7 +286,7 @@ def build_scene(bundle_dir: str | os.PathLike) -> dict[str, Any]:
     Returns a JSON-ready dict; arrays are base64 strings (:func:`decode` them with the dtype
     in their key's ``*_dtype`` companion or as documented: vertices ``f4``, faces ``u4``).
     """
-    from ...bundle import read_bundle
+    from gridshell.design.bundle import read_bundle
 
     d = Path(bundle_dir)
     b = read_bundle(d)
@@ -396,7 +396,7 @@ def build_scene(bundle_dir: str | os.PathLike) -> dict[str, Any]:
 
 def scene_json(bundle_dir: str | os.PathLike) -> str:
     """:func:`build_scene` as compact JSON, safe inside an HTML ``<script>`` element."""
-    from ...bundle import finite_json
+    from gridshell.design.bundle import finite_json
 
     text = json.dumps(finite_json(build_scene(bundle_dir)), separators=(",", ":"),
                       allow_nan=False)
