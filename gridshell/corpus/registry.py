@@ -296,7 +296,7 @@ REFERENCES: tuple[Reference, ...] = _build()
 _BY_NAME = {r.name: r for r in REFERENCES}
 
 #: a small subset spanning families, sizes (0.5 m to 60 m), quads and triangles: the
-#: references of tests/test_corpus_pipelines.py
+#: references of tests/corpus/test_corpus_pipelines.py
 FAST: tuple[str, ...] = ("hill-06", "saddle-04", "revolution-02", "associate-03",
                          "pseudosphere-03", "dome-05")
 
