@@ -186,3 +186,61 @@ def test_select_and_the_fast_subset():
     assert {r.mesh for r in fast} == {"quad", "tri"}
     with pytest.raises(KeyError, match="no reference"):
         get("nope-00")
+
+
+# ---- the shapes architects draw, in the files users bring ---------------------------------
+
+USER_FAMILIES = ("bump", "round-dome", "asym-hill", "pavilion")
+
+
+def test_user_families_come_in_every_format_and_unit():
+    refs = [r for r in REFERENCES if r.family in USER_FAMILIES]
+    assert len(refs) >= 28
+    assert {r.file_format for r in refs} == {"3dm", "obj", "ply", "off"}
+    assert {r.units for r in refs} == {"m", "cm", "mm"}
+    assert sum(r.file_format == "3dm" and r.units == "mm" for r in refs) >= 5
+    assert all(r.file_format == "obj" and r.units == "m" for r in REFERENCES
+               if r.family not in USER_FAMILIES)
+    # every NCP mode a user would try is run: admitted, refused by construction, or tried
+    for r in refs:
+        assert set(r.modes) | set(r.no_net) | set(r.tried) >= {"gg", "ncp-phlw", "ncp-cnc",
+                                                               "ncp-aa"}
+
+
+@pytest.mark.parametrize("name", [r.name for r in REFERENCES if r.family in USER_FAMILIES][::3])
+def test_target_file_reads_back_as_the_reference_in_metres(tmp_path, name):
+    from gridshell.io.read import read_input
+
+    ref = get(name)
+    path = ref.write_target(tmp_path)
+    assert path.suffix == "." + ref.file_format
+    g = read_input(str(path), units=None if ref.file_format == "3dm" else ref.units)
+    V, _ = ref.mesh_arrays()
+    span = np.ptp(V, axis=0).max()
+    # a .3dm mesh keeps single-precision vertices (rhino3dm); the mesh formats 17 digits
+    tol = 1e-6 if ref.file_format == "3dm" else 1e-12
+    assert g.V.shape == V.shape and np.abs(g.V - V).max() <= tol * span
+
+
+def test_round_dome_has_its_umbilic_at_the_crown():
+    t = np.linspace(0.02, 0.98, 97)
+    A, B = np.meshgrid(t, t, indexing="ij")
+    for r in select("round-dome"):
+        k = 2 * r.params["h"] / (1.0 + r.params["Y"] ** 2) / r.scale   # k1 = k2 at the crown
+        k1, k2 = r.principal_curvatures(A, B)
+        i = np.unravel_index(np.argmin(np.abs(k2 - k1)), A.shape)
+        assert abs(k2 - k1)[i] < 0.02 * k and abs(abs(k1[i]) - k) < 0.02 * k
+        P = r.surface(A, B)                     # the umbilic is the crown: the highest point
+        up = np.asarray(r.rotation) @ np.array([0.0, 0.0, 1.0])
+        top = np.unravel_index(np.argmax(P @ up), A.shape)
+        assert np.hypot(A[i] - A[top], B[i] - B[top]) < 0.03
+        assert r.curvature == "K>0" and r.no_net == ("ncp-aa",)
+
+
+def test_pavilion_footprint_is_three_by_two():
+    for r in select("pavilion"):
+        V, _ = r.mesh_arrays()
+        R = np.asarray(r.rotation)
+        base = (V - np.asarray(r.offset)) @ R        # back to the canonical frame (R^T R = I)
+        dx, dy = np.ptp(base[:, 0]), np.ptp(base[:, 1])
+        assert 1.35 < max(dx, dy) / min(dx, dy) < 1.7
