@@ -8,6 +8,8 @@
     gs.write("out/gg", design)                  # the design bundle (same layout for every kind)
     gs.verify("out/gg")["ok"]                   # the figures recomputed from the files
     gs.fabricate("out/gg", "out/gg/fabrication", {"width": 20, "scale": "1:10"})
+    gs.check_structure("out/gg").ok             # the strips stay elastic (structure.json)
+    gs.simulate("out/gg").figures               # the elastic equilibrium (out/gg/equilibrium)
     gs.export_3dm("out/gg", "out/gg/gg.3dm")    # strips, holes, surface, cut sheets for Rhino
     gs.write_outputs("out/gg", report=True, rhino="out/gg/gg.3dm")  # render.png, report.html,
                                                 # and the .3dm built meanwhile (two cores)
@@ -170,56 +172,28 @@ def fabricate(design: Any, out_dir: str | os.PathLike, params: Any = None, *,
     return _fabricate(bundle, out_dir, params, progress=progress, plan=plan)
 
 
-def export_3dm(design: Any, path: str | os.PathLike, **options: Any) -> dict[str, Any]:
-    """Write a design (bundle directory, Design or DesignBundle) to a Rhino ``.3dm`` file
-    (:func:`gridshell.export.rhino.write_3dm`: strips of their real width and thickness,
-    holes, surface, collapsed state and cut sheets, in the input's unit); returns what was
-    written (``path``, ``units``, ``layers`` ...). ``options``: ``width``, ``thickness``,
-    ``hole``, ``scale``, ``sheet``, ``params``, ``units``, ``sheets``, ``force``, ``progress``."""
-    from gridshell.export.rhino import write_3dm
-
-    bundle = design if isinstance(design, (str, os.PathLike)) else _parts(design)[0]
-    return write_3dm(bundle, path, **options)
+#: the names the API takes from their modules as they are (the very functions, real signatures),
+#: imported on first use: name -> module
+_FROM = {"check_structure": "gridshell.workflow.structure",
+         "simulate": "gridshell.workflow.structure",
+         "export_3dm": "gridshell.export.rhino",
+         "write_outputs": "gridshell.workflow.outputs"}
 
 
-def check_structure(bundle: str | os.PathLike, *, material: Any = None,
-                    width: float | None = None, thickness: float | None = None,
-                    scale: Any = None, states: bool = True, write: bool = True,
-                    picture: bool = True, progress: Progress = None) -> Any:
-    """Will the strips bend into the design without breaking? Stresses along every lamella of
-    a bundle directory for a strip ``width`` x ``thickness`` mm at ``scale`` of ``material``
-    (a preset name or a Material; each from the caller, else the bundle's
-    ``fabrication/fabrication.json``, else 20 x 1 mm pp at 1:10), written to
-    ``structure.json`` and ``structure.png`` (``gridshell check``); returns a
-    :class:`gridshell.workflow.structure.StructureCheck` (``ok``, ``result``, ``section``,
-    ``file``, ``picture``). See :func:`gridshell.workflow.structure.check_structure`."""
-    from gridshell.workflow.structure import check_structure as run
+def __getattr__(name: str) -> Any:
+    """The functions of :data:`_FROM`: ``check_structure`` (will the strips bend into the
+    design without breaking: structure.json, ``gridshell check``), ``simulate`` (the elastic
+    equilibrium, ``gridshell simulate``), ``export_3dm`` (the Rhino model, ``gridshell
+    export``) and ``write_outputs`` (render.png, alignment.gif, report.html and a .3dm in one
+    call, ``gridshell render``)."""
+    if name in _FROM:
+        import importlib
 
-    return run(bundle, material=material, width=width, thickness=thickness, scale=scale,
-               states=states, write=write, picture=picture, progress=progress)
+        fn = getattr(importlib.import_module(_FROM[name]), name)
+        globals()[name] = fn
+        return fn
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
-def simulate(bundle: str | os.PathLike, out: str | os.PathLike | None = None, *,
-             material: Any = None, width: float | None = None, thickness: float | None = None,
-             scale: Any = None, supports: Any = "boundary", gravity: bool = False,
-             per_bay: int = 3, max_iter: int = 100, write: bool = True,
-             progress: Progress = None) -> Any:
-    """The elastic equilibrium of a bundle's deployed gridshell (discrete elastic rods of the
-    real strip, resolved as in :func:`check_structure`), written to ``out`` (default
-    ``DIR/equilibrium``; ``gridshell simulate``); returns a
-    :class:`gridshell.workflow.structure.Simulation` (``figures``, ``equilibrium``,
-    ``record``, ``out``). See :func:`gridshell.workflow.structure.simulate`."""
-    from gridshell.workflow.structure import simulate as run
-
-    return run(bundle, out, material=material, width=width, thickness=thickness, scale=scale,
-               supports=supports, gravity=gravity, per_bay=per_bay, max_iter=max_iter,
-               write=write, progress=progress)
-
-
-def write_outputs(bundle: str | os.PathLike, **options: Any) -> dict[str, Any]:
-    """render.png, alignment.gif, report.html and a .3dm of a bundle directory in one call
-    (``gridshell render``), the .3dm built in a second process meanwhile; options and result of
-    :func:`gridshell.workflow.outputs.write_outputs`."""
-    from gridshell.workflow.outputs import write_outputs as run
-
-    return run(bundle, **options)
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_FROM))
