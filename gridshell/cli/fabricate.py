@@ -34,8 +34,8 @@ def add_args(p: argparse.ArgumentParser) -> None:
                    help=f"strip width (default {DEFAULTS['width']:g})")
     g.add_argument("--thickness", type=float, default=None,
                    help=f"sheet thickness (default {DEFAULTS['thickness']:g})")
-    g.add_argument("--margin", type=float, default=15.0,
-                   help="strip length beyond the end joints (default 15)")
+    g.add_argument("--margin", type=float, default=FabParams.margin,
+                   help=f"strip length beyond the end joints (default {FabParams.margin:g})")
     g.add_argument("--axis", choices=AXIS_PLACES, default=FabParams.axis,
                    help="place of the lamella axis on the strip: "
                         + choice_help(AXIS_HELP, AXIS_PLACES, FabParams.axis))
@@ -46,14 +46,16 @@ def add_args(p: argparse.ArgumentParser) -> None:
                    help=choice_help(JOINT_HELP, JOINT_STYLES, FabParams.joints) +
                    "; by default joints too close for holes at this scale are engraved as "
                    "marks (with a warning), an explicit --joints refuses them instead")
-    g.add_argument("--hole", type=float, default=3.0, help="hole diameter, mm (default 3)")
-    g.add_argument("--clearance", type=float, default=0.2,
-                   help="slot width = thickness + clearance, mm (default 0.2)")
+    g.add_argument("--hole", type=float, default=FabParams.hole,
+                   help=f"hole diameter, mm (default {FabParams.hole:g})")
+    g.add_argument("--clearance", type=float, default=FabParams.clearance,
+                   help=f"slot width = thickness + clearance, mm (default {FabParams.clearance:g})")
     g = p.add_argument_group("sheets and cutting")
-    g.add_argument("--sheet", default="600x400",
-                   help="sheet size WIDTHxHEIGHT mm (default 600x400)")
-    g.add_argument("--gap", type=float, default=2.0,
-                   help="gap between parts and to the sheet edges, mm (default 2)")
+    sheet = "x".join(f"{v:g}" for v in FabParams.sheet)
+    g.add_argument("--sheet", default=sheet,
+                   help=f"sheet size WIDTHxHEIGHT mm (default {sheet})")
+    g.add_argument("--gap", type=float, default=FabParams.gap,
+                   help=f"gap between parts and to the sheet edges, mm (default {FabParams.gap:g})")
     g.add_argument("--rotation", choices=ROTATIONS, default=FabParams.rotation,
                    help="how parts may turn on the sheet: free (any angle, isotropic sheets such "
                         "as polypropylene; default) or grain (along the sheet's long side, "
@@ -62,8 +64,9 @@ def add_args(p: argparse.ArgumentParser) -> None:
                    help="splice overlap of lamellae split to fit a sheet, mm (default: at a joint, "
                         "one joint spacing plus two margins, so the pieces share two joints; "
                         "between joints, two widths plus two margins)")
-    g.add_argument("--kerf", type=float, default=0.0,
-                   help="laser kerf, mm: outlines move out and holes in by kerf/2 (default 0: off)")
+    g.add_argument("--kerf", type=float, default=FabParams.kerf,
+                   help="laser kerf, mm: outlines move out and holes in by kerf/2 (default "
+                        f"{FabParams.kerf:g}: off)")
     g.add_argument("--dxf-version", choices=DXF_VERSIONS, default=FabParams.dxf_version,
                    help="DXF version: " + choice_help(DXF_HELP, DXF_VERSIONS,
                                                       FabParams.dxf_version))
