@@ -16,7 +16,7 @@ from tests.helpers.render_cases import make_bundle, write_case
 from gridshell.core.aside import Aside, can_fork
 from gridshell.design.bundle import write_bundle
 from gridshell.core.errors import GridshellError, InputError
-from gridshell.export.rhino import write_3dm
+from gridshell.export.rhino import export_3dm as write_3dm
 
 @pytest.fixture
 def forking():

@@ -16,7 +16,7 @@ from tests.helpers.render_cases import N, make_bundle, write_case
 from gridshell.design.bundle import write_bundle
 from gridshell.core.errors import InputError
 from gridshell.export import export_3dm
-from gridshell.export.rhino import write_3dm
+from gridshell.export.rhino import export_3dm as write_3dm
 from gridshell.core.units import parse_units
 from gridshell.core.units import Units
 
@@ -212,7 +212,7 @@ def test_units_override_and_unknown(tmp_path):
 
 def test_layers_objects_and_user_strings(tmp_path):
     d = write_case(tmp_path / "gg", "GG")
-    out = export_3dm(d, tmp_path / "gg.3dm", force=True)
+    out = export_3dm(d, tmp_path / "gg.3dm", force=True)["path"]
     model, names, objs = _read(out)
     assert names[:8] == ["surface", "family 1", "family 3", "axes", "joints", "holes",
                          "collapsed", "sheet 01"]
@@ -321,7 +321,7 @@ def test_failing_design_has_no_sheets_unless_forced(tmp_path):
 def test_3dm_with_revolution_and_errors(tmp_path):
     b = make_bundle("GG")
     b.revolution_V, b.revolution_F = b.surface_V + [0, 0, 1], b.surface_F
-    out = export_3dm(b, tmp_path / "rev.3dm", sheets=False)
+    out = export_3dm(b, tmp_path / "rev.3dm", sheets=False)["path"]
     _, names, objs = _read(out)
     assert "revolution" in names and len(objs["revolution"]) == 1
     with pytest.raises(InputError, match=".3dm"):

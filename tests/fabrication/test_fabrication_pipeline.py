@@ -309,6 +309,7 @@ def test_fabrication_never_imports_an_optimizer():
             for n in names:
                 assert not n.startswith(("gridshell.gg", "gridshell.ncp", "gridshell.solver")), f
                 if n.startswith("gridshell") and not n.startswith("gridshell.fabrication"):
-                    assert n in ("gridshell.design.bundle", "gridshell.core.errors", "gridshell.core.atomic",
+                    assert n in ("gridshell.design.bundle", "gridshell.design.section",
+                                 "gridshell.core.errors", "gridshell.core.atomic",
                                  "gridshell.core.manifest",
                                  "gridshell.geometry.net"), (f, n)

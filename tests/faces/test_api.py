@@ -138,3 +138,59 @@ def test_export_3dm_of_a_design(designs, tmp_path):
                                     axis=1).sum()
         L = by_id[int(o.Attributes.GetUserString("lamella_id"))].length
         assert area == pytest.approx(2 * L * (w + t) + 2 * w * t, rel=0.01)
+
+
+def test_the_api_shows_the_real_parameters_of_what_it_runs():
+    """design_gg, design_ncp and optimize_phlw spell out their pipeline's parameters (names,
+    kinds and defaults the same); check_structure, simulate, export_3dm and write_outputs are
+    the implementing functions themselves (one name, one result type)."""
+    import inspect
+
+    from gridshell.export import rhino
+    from gridshell.gg import pipeline as gg
+    from gridshell.ncp import phlw, pipeline as ncp
+    from gridshell.workflow import outputs, structure
+
+    def params(f):
+        return [(p.name, p.kind, p.default) for p in inspect.signature(f).parameters.values()]
+
+    for mine, theirs in ((api.design_gg, gg.design_gg), (api.design_ncp, ncp.design_ncp),
+                         (api.optimize_phlw, phlw.optimize_phlw)):
+        names = [p[0] for p in params(mine)]
+        assert "args" not in names and "kwargs" not in names, mine.__name__
+        assert params(mine) == params(theirs), mine.__name__
+    assert [p[0] for p in params(api.design_gg)][:3] == ["target", "meridians", "grid"]
+    assert api.check_structure is structure.check_structure
+    assert api.simulate is structure.simulate
+    assert api.export_3dm is rhino.export_3dm and gridshell.export_3dm is rhino.export_3dm
+    assert api.write_outputs is outputs.write_outputs
+    from gridshell.export import export_3dm
+
+    assert export_3dm is rhino.export_3dm
+    for f in (api.check_structure, api.simulate, api.export_3dm, api.write_outputs):
+        names = [p[0] for p in params(f)]
+        assert "kwargs" not in names and "options" not in names, f.__name__
+    assert {"material", "width", "thickness", "scale"} <= set(
+        inspect.signature(api.check_structure).parameters)
+
+
+def test_check_structure_and_simulate_return_data(tmp_path):
+    d = write_case(tmp_path / "gg", "GG")
+    chk = api.check_structure(d, width=10, states=False, picture=False)
+    assert chk.file == d / "structure.json" and chk.picture is None
+    assert json.loads(chk.file.read_text())["section"]["width_mm"] == 10.0
+    assert chk.ok == (chk.result["verdict"] == "ok") and chk.section.given("width")
+    assert chk.material.name == "pp"
+    sim = api.simulate(d, tmp_path / "eq", per_bay=1, scale="1:2")
+    assert sim.out == tmp_path / "eq" and (sim.out / "equilibrium.json").is_file()
+    assert sim.record["section"]["scale"] == 0.5 and sim.figures["supports"] >= 3
+
+
+def test_export_3dm_and_write_3dm_are_one_function(tmp_path):
+    from gridshell.export import rhino
+
+    with pytest.warns(DeprecationWarning, match="export_3dm"):
+        old = rhino.write_3dm
+    assert old is rhino.export_3dm
+    with pytest.raises(InputError, match="expected a design"):
+        api.export_3dm(42, tmp_path / "x.3dm")

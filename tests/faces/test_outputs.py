@@ -18,7 +18,7 @@ from gridshell.workflow import outputs
 from gridshell.core.aside import can_fork
 from gridshell.design.bundle import write_bundle
 from gridshell.core.errors import InputError
-from gridshell.export.rhino import write_3dm
+from gridshell.export.rhino import export_3dm as write_3dm
 from gridshell.render.report import write_report
 from gridshell.render.ribbons import render_bundle
 from gridshell.render.sequence import render_bundle_sequence

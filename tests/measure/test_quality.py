@@ -44,3 +44,36 @@ def test_ncp_kinds_have_their_collapse_gate():
 def test_thresholds_are_the_papers():
     assert THRESHOLDS["delta_a_mean"][1] == 1.0 and THRESHOLDS["delta_a_max"][1] == 3.0
     assert THRESHOLDS["delta_l_max"][1] == 1.0 and THRESHOLDS["delta_n_max"][1] == 1.0
+
+
+def test_the_phlw_step_gates_are_gates_with_their_records_and_lines():
+    """One Gate class: the PHLW step's gates (own rule, no % limit) are quality.Gate, their
+    records and printed lines as before, and a record reads back to the same gate."""
+    from gridshell.measure.quality import Gate
+    from gridshell.ncp.phlw.gates import phlw_gates
+
+    before = {"E_PHLW": {"total": 2000.0}, "relation_max_rel": 0.5, "angle_max_deg": 10.0}
+    after = {"E_PHLW": {"total": 120.0}, "relation_max_rel": 0.7, "angle_max_deg": 1.0}
+    gates = phlw_gates(before, after, converged=True)
+    assert all(type(g) is Gate for g in gates)
+    assert [g.ok for g in gates] == [True, True, False, True]
+    assert gates[1].line() == "pass  E_PHLW not higher than at the start: 2e+03 -> 120 (<= start 2e+03)"
+    assert gates[2].line().startswith("FAIL  relation error (eq. 4.8) not higher than at the start: 0.5 -> 0.7 (> ")
+    d = gates[2].as_dict()
+    assert list(d) == ["name", "label", "ok", "detail", "line"] and d["line"] == gates[2].line()
+    assert Gate.from_dict(d) == gates[2]
+    t = design_gates("GG", _gg(0.2, 7.05))[1]
+    assert list(t.as_dict()) == ["name", "label", "value", "limit", "ok"]
+    assert Gate.from_dict(t.as_dict()) == t
+    assert "2 of 4 figures fail" not in gate_summary(gates) and "1 of 4 figures fail: relation" \
+        in gate_summary(gates)
+
+
+def test_the_former_check_class_warns_and_makes_a_gate():
+    from gridshell.measure.quality import Gate
+    from gridshell.ncp.phlw import gates as phlw
+
+    with pytest.warns(DeprecationWarning, match="Gate"):
+        check = phlw.Check
+    g = check("converged", "optimizer converged", False, "no")
+    assert type(g) is Gate and not g.ok and g.line() == "FAIL  optimizer converged: no"

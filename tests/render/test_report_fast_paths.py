@@ -80,11 +80,11 @@ def _former_strips(d: Path) -> dict:
     """The strips, Delta_a samples and centres of build_scene as computed before 2026-12-02:
     move_joints_states' nets, one _sample / np.interp / strip_solid per lamella and state."""
     from gridshell.geometry.net import move_joints_states
-    from gridshell.render.section import bundle_section
+    from gridshell.design.section import resolve_section
     from gridshell.geometry.strips3d import is_tangent, nearest_vertex_normals, strip_solid
 
     b = read_bundle(d)
-    section = bundle_section(d)
+    section = resolve_section(d)
     w, t = section.width_m, section.thickness_m
     tangent = is_tangent(b.kind)
     net = b.net

@@ -18,7 +18,7 @@ from tests.helpers.render_cases import write_case
 from gridshell.design.bundle import read_bundle
 from gridshell.core.errors import InputError
 from gridshell.render.report import write_report
-from gridshell.render.section import DEFAULT_CUT, bundle_section
+from gridshell.design.section import DEFAULT_CUT, resolve_section
 from gridshell.render.viewer import assets
 from gridshell.render.viewer.scene import build_scene, decode, strip_solids_vertices
 from gridshell.geometry.strips3d import nearest_vertex_normals, strip_solid
@@ -94,18 +94,19 @@ def test_section_from_fabrication_json_or_defaults(tmp_path, gg):
     p = FabParams()
     assert (p.width, p.thickness, p.scale) == (DEFAULT_CUT["width"], DEFAULT_CUT["thickness"],
                                                DEFAULT_CUT["scale"])
-    s = bundle_section(gg)
-    assert s.source == "fabrication defaults"
+    s = resolve_section(gg)
+    assert s.source == "defaults"
     assert s.width_m == pytest.approx(0.2) and s.thickness_m == pytest.approx(0.01)
     assert s.text() == "200 x 10 mm (20 x 1 mm cut at 1:10)"
     (gg / "fabrication").mkdir()
     (gg / "fabrication" / "fabrication.json").write_text(json.dumps(
         {"params": {"width": 30.0, "thickness": 2.0, "scale": 0.05}}))
-    s = bundle_section(gg)
+    s = resolve_section(gg)
     assert (s.width_m, s.thickness_m) == pytest.approx((0.6, 0.04))
     assert s.source.endswith("fabrication.json") and "1:20" in s.text()
     (gg / "fabrication" / "fabrication.json").write_text("{not json")
-    assert bundle_section(gg).source == "fabrication defaults"
+    with pytest.raises(InputError, match="fabrication.json is not a readable fabrication report"):
+        resolve_section(gg)   # one error policy: a corrupt report is named, never skipped
 
 
 def test_scene_decodes_to_the_bundle_geometry(gg):
