@@ -3,7 +3,7 @@ error policy for a broken report, and the same strip for check, simulate, render
 import json
 
 import pytest
-from render_cases import write_case
+from tests.helpers.render_cases import write_case
 
 from gridshell.cli.main import main
 from gridshell.core.errors import InputError
