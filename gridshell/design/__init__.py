@@ -1,6 +1,7 @@
 """The design bundle (the directory every pipeline writes) and its verification.
 
 - :mod:`.bundle`: write_bundle / read_bundle; DesignBundle, Design
+- :mod:`.stages`: Stage, run_stages (a pipeline as named, timed stages)
 - :mod:`.verification`: every figure of a bundle recomputed from its files and gated
 - :mod:`.section`: the strip's section, scale and material (caller, else the bundle's
   fabrication report, else the defaults; one error policy)
