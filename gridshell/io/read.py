@@ -87,7 +87,8 @@ def read_input(source: Any, *, units: Units | str | None = None, clean: bool = T
     Parameters
     ----------
     source : path of an OBJ / PLY / OFF / 3DM file, an :class:`InputGeometry` (returned as it
-        is), a QuadMesh / TriMesh or a ``(V, F)`` pair (in ``units``)
+        is), a QuadMesh / TriMesh or a ``(V, F)`` pair (in ``units``), or one Rhino object as
+        :func:`gridshell.io.rhino.object_input` reads it (a .3dm's object, read the same way)
     units : the unit the geometry is drawn in (``"m"``, ``"cm"``, ``"mm"``, ``"in"``, ``"ft"``);
         None: a .3dm's own unit system, else metres after :func:`check_plausible`
     clean : weld, de-duplicate and orient first (:func:`gridshell.io.clean.clean_mesh`)
@@ -112,10 +113,7 @@ def read_input(source: Any, *, units: Units | str | None = None, clean: bool = T
 
             r = read_3dm(path, obj)
             file_u, obj_label, notes = r.units, r.object.label(), list(r.notes)
-            if r.surface is not None:
-                surface = r.surface
-            else:
-                V, P, sizes = r.V, r.P, r.sizes
+            surface, V, P, sizes = r.surface, r.V, r.P, r.sizes
         else:
             if obj is not None:
                 raise InputError(f"{name}: --object picks an object of a .3dm file; a mesh file "
@@ -124,6 +122,10 @@ def read_input(source: Any, *, units: Units | str | None = None, clean: bool = T
 
             V, P, sizes = read_polygons(path)
         path_s = str(path.resolve())
+    elif _is_rhino_input(source):  # one Rhino object already read (the Grasshopper server's)
+        name, path_s, file_u, notes = source.name or "(Rhino object)", None, source.units, \
+            list(source.notes)
+        surface, V, P, sizes = source.surface, source.V, source.P, source.sizes
     else:
         name, path_s = "(V, F)", None
         V, P, sizes = _arrays(source)
@@ -175,6 +177,12 @@ def read_input(source: Any, *, units: Units | str | None = None, clean: bool = T
         check_disk(V, F, name, report, what=what)
     return InputGeometry(V=V, F=F, units=u, name=name, path=path_s, object=obj_label,
                          object_query=obj, clean=report, notes=notes, units_source=src)
+
+
+def _is_rhino_input(source: Any) -> bool:
+    from gridshell.io.rhino import RhinoInput
+
+    return isinstance(source, RhinoInput)
 
 
 def _arrays(source: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
