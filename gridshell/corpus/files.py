@@ -42,20 +42,14 @@ def write_target(ref: Any, folder: Path) -> Path:
 
 
 def _write_3dm_mesh(path: Path, V: np.ndarray, F: np.ndarray, units: str, name: str) -> None:
-    """A version-7 .3dm holding one mesh object named ``name`` in model units ``units``
-    (double-precision vertices kept where rhino3dm stores them)."""
-    import rhino3dm
+    """A version-7 .3dm holding one mesh object named ``name`` (layer ``target``) in model
+    units ``units``, its vertices in double precision
+    (:mod:`gridshell.geometry.rhino_adapter`)."""
+    from gridshell.geometry import rhino_adapter as rh
 
-    mesh = rhino3dm.Mesh()
-    for x, y, z in V:
-        mesh.Vertices.Add(float(x), float(y), float(z))
-    for f in F:
-        mesh.Faces.AddFace(*(int(i) for i in f))
-    model = rhino3dm.File3dm()
-    model.Settings.ModelUnitSystem = getattr(rhino3dm.UnitSystem, _RHINO_UNITS[units])
-    attr = rhino3dm.ObjectAttributes()
-    attr.Name = name
-    model.Objects.AddMesh(mesh, attr)
+    m = rh.Model3dm(_RHINO_UNITS[units], 1e-5 / parse_units(units).metres_per_unit)
+    m.layer("target", (150, 160, 175, 255))
+    m.model.Objects.AddMesh(rh.mesh(V, F, what=name), m.attrs("target", name))
     with atomic_path(path) as tmp:
-        if not model.Write(str(tmp), 7):
+        if not rh.write_file(m.model, tmp, 7):
             raise OSError(f"rhino3dm could not write {path}")

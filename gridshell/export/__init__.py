@@ -1,4 +1,6 @@
-"""Exports of a design bundle to other tools' formats (Rhino ``.3dm``: :mod:`.rhino`).
+"""Exports of a design bundle to other tools' formats (Rhino ``.3dm``: :mod:`.rhino`, its
+objects built from arrays by :mod:`.rhino_geometry` over :mod:`gridshell.geometry.rhino_adapter`,
+the one module that imports rhino3dm).
 
 Heavy third-party modules are imported inside the functions, so importing this package is cheap.
 

@@ -56,6 +56,7 @@ import numpy as np
 from gridshell.core.atomic import atomic_path
 from gridshell.core.errors import GridshellError, InputError, OutputError
 from gridshell.export import rhino_geometry as geo
+from gridshell.geometry import rhino_adapter as rh
 from gridshell.core.units import METRES, Units, bundle_units, parse_units
 
 __all__ = ["LAYERS", "RHINO_UNITS", "bundle_to_3dm", "export_3dm"]
@@ -90,60 +91,13 @@ def sheet_layer(k: int) -> str:
     return f"sheet {k + 1:02d}"
 
 
-class _Model:
-    """A File3dm with named layers, object attributes and the user's unit."""
+class _Model(rh.Model3dm):
+    """A File3dm (:class:`gridshell.geometry.rhino_adapter.Model3dm`: named layers, object
+    attributes) in the user's unit, with the conversion of metres to it."""
 
     def __init__(self, units: Units) -> None:
-        import rhino3dm
-
-        self.r = rhino3dm
-        self.model = rhino3dm.File3dm()
+        super().__init__(RHINO_UNITS[units.name], 1e-5 / units.metres_per_unit)
         self.units = units
-        self.model.Settings.ModelUnitSystem = getattr(rhino3dm.UnitSystem,
-                                                      RHINO_UNITS[units.name])
-        self.model.Settings.ModelAbsoluteTolerance = 1e-5 / units.metres_per_unit
-        self.model.ApplicationName = "gridshell"
-        self.layers: dict[str, int] = {}
-        self.counts: dict[str, int] = {}
-
-    def layer(self, name: str, colour: tuple[int, int, int, int]) -> None:
-        layer = self.r.Layer()
-        layer.Name = name
-        layer.Color = colour
-        self.layers[name] = self.model.Layers.Add(layer)
-        self.counts[name] = 0
-
-    def attrs(self, layer: str, name: str = "", **strings: object):
-        a = self.r.ObjectAttributes()
-        a.LayerIndex = self.layers[layer]
-        if name:
-            a.Name = name
-        for k, v in strings.items():
-            a.SetUserString(k, str(v))
-        self.counts[layer] += 1
-        return a
-
-    def shared(self, n: int, layer: str, name: str, **strings: object):
-        """:meth:`attrs` for ``n`` objects at once (counted ``n`` times; 0: each counted as
-        :meth:`again` hands the set out): rhino3dm copies the attributes into each object it
-        adds, so objects with equal attributes (a part's holes, its label strokes) can share
-        one set."""
-        a = self.attrs(layer, name, **strings)
-        self.counts[layer] += n - 1
-        return a
-
-    def again(self, a, layer: str, name: str, **strings: object):
-        """The attributes ``a`` (:meth:`attrs`) for one more object on ``layer`` named
-        ``name``, with the user strings ``strings`` set to new values (keys ``a`` has keep
-        their place, as a new :meth:`attrs` with the same keys in the same order would
-        give) and the others kept: rhino3dm copies the attributes into each object it adds,
-        so one set serves a run of objects whose attributes differ in a few values."""
-        a.LayerIndex = self.layers[layer]
-        a.Name = name
-        for k, v in strings.items():
-            a.SetUserString(k, str(v))
-        self.counts[layer] += 1
-        return a
 
     def u(self, X):
         """Metres -> the user's unit."""
@@ -415,7 +369,7 @@ def _body(bundle, *, name: str, units: Any, params: Any, bspline: Any) -> dict[s
                         joints=" ".join(str(j) for j in lam.joints.tolist())))
     a = m.shared(0, "joints", "", joint_id="-", lamellae="-")     # one set, values per joint
     for j, p in enumerate(m.u(bundle.net.joints).tolist()):
-        m.model.Objects.AddPoint(m.r.Point3d(*p), m.again(
+        m.model.Objects.AddPoint(rh.point(p), m.again(
             a, "joints", f"J{j}", joint_id=j, lamellae=" ".join(map(str, through.get(j, [])))))
 
     return {"m": m, "bundle": bundle, "name": name, "params": params, "units": units,
@@ -437,8 +391,7 @@ def _finish(body: dict[str, Any], *, layout: Any, params_source: str
                "gridshell.hole_mm": f"{params.hole:g}",
                "gridshell.scale": f"{params.scale:g}",
                "gridshell.fabrication_parameters": params_source or "given"}
-    for k, v in strings.items():
-        m.model.Strings[k] = v
+    m.strings(strings)
     info = {"units": units.name, "metres_per_unit": units.metres_per_unit,
             "layers": dict(m.counts), "strips": strips["strips"], "holes": strips["holes"],
             "strip_width_m": strips["width_m"], "strip_thickness_m": strips["thickness_m"],
@@ -593,7 +546,7 @@ def write_model(bundle, path: str | os.PathLike, *, width: float | None = None,
     if info["note"]:
         notes.append(info["note"])
     with atomic_path(path) if publish else nullcontext(path) as tmp:
-        if not model.Write(str(tmp), _FILE_VERSION):
+        if not rh.write_file(model, tmp, _FILE_VERSION):
             raise OutputError(f"rhino3dm could not write {shown}; check the location is "
                               "writable")
     info.update(params=fab.to_json(), params_source=source, notes=notes)

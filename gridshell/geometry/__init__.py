@@ -10,6 +10,9 @@
 - :mod:`.net`: Net (joints, loops, lamellae) and Lamella
 - :mod:`.strips3d`: the strip as built (material frame, width, thickness)
 - :mod:`.igl_adapter`: the only module that calls libigl
+- :mod:`.rhino_adapter`: the only module that imports rhino3dm: Rhino meshes as double-precision
+  arrays (polygons as Rhino keeps them), NURBS surfaces as B-splines exactly and back, curves,
+  .3dm files (the reader, the server and the export all go through it)
 
 May import: :mod:`gridshell.core`, :mod:`gridshell.solver`.
 """

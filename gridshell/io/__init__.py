@@ -2,7 +2,8 @@
 
 - :mod:`.units`: ``--units`` (m, cm, mm, in, ft), conversion to metres, the plausibility check
 - :mod:`.clean`: weld, de-duplicate, orient (pymeshlab), polygons kept
-- :mod:`.rhino`: .3dm meshes, NURBS surfaces and single-face Breps (rhino3dm)
+- :mod:`.rhino`: .3dm meshes, NURBS surfaces and single-face Breps, and one Rhino object (the
+  Grasshopper server's) read the same way, through :mod:`gridshell.geometry.rhino_adapter`
 - :mod:`.read`: :func:`read_input`, the one entry for a user's surface
 
 Light at import: pymeshlab and rhino3dm load when a file needs them.

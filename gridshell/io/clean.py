@@ -125,12 +125,30 @@ def clean_mesh(V: np.ndarray, P: np.ndarray, sizes: np.ndarray, *, name: str = "
     weld = coincident_vertices(V, tol, P) > 0
     if not weld and not needs_cleaning(V, P, sizes, tol, check_weld=False):  # the usual case: welded, oriented
         return V, P, sizes, CleanReport(vertices=(n0, n0), faces=(m0, m0), tolerance=tol)
+    T, owner = _fan(P, sizes)
+    keep, Tn, born = _pymeshlab_clean(V, T, owner, weld, tol, name)
+    vmap = _vertex_map(V, keep, tol)
+    kept, Pm, sz, flipped = _oriented_polygons(P, sizes, T, Tn, born, vmap)
+    keep_rows, dup, degenerate = _collapsed_and_repeated(P[kept], Pm, sz)
+    dup += m0 - len(kept)
+    Pm, sz, flipped = Pm[keep_rows], sz[keep_rows], flipped[keep_rows]
+    Vout, Pout = _first_copy_numbering(V, Pm, vmap, len(keep))
+    rep = _report(P, len(keep), (n0, len(Vout)), (m0, len(Pout)), tol, dup, degenerate,
+                  int(flipped.sum()))
+    return Vout, Pout, sz, rep
+
+
+def _pymeshlab_clean(V: np.ndarray, T: np.ndarray, owner: np.ndarray, weld: bool, tol: float,
+                     name: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """pymeshlab's weld (within ``tol`` m when ``weld``), duplicate faces, unreferenced
+    vertices and coherent orientation of the fan triangles ``T`` (of the polygons ``owner``):
+    ``(keep, Tn, born)``, the original index of each surviving vertex, the surviving
+    triangles in survivor numbering and the polygon each came from."""
     import pymeshlab
 
-    T, owner = _fan(P, sizes)
     ms = pymeshlab.MeshSet()
     ms.add_mesh(pymeshlab.Mesh(vertex_matrix=V, face_matrix=T.astype(np.int32),
-                               v_scalar_array=np.arange(n0, dtype=np.float64),
+                               v_scalar_array=np.arange(len(V), dtype=np.float64),
                                f_scalar_array=owner.astype(np.float64)))
     try:
         if weld:  # exact copies first: fast, and fewer to merge
@@ -151,9 +169,13 @@ def clean_mesh(V: np.ndarray, P: np.ndarray, sizes: np.ndarray, *, name: str = "
     keep = np.rint(cm.vertex_scalar_array()).astype(np.int64)  # original index of survivors
     Tn = cm.face_matrix().astype(np.int64)                     # in survivor numbering
     born = np.rint(cm.face_scalar_array()).astype(np.int64)    # polygon of each triangle
-    del ms, cm
-    # every original vertex -> a survivor: itself, or the nearest survivor (a welded one)
-    vmap = np.full(n0, -1, np.int64)
+    return keep, Tn, born
+
+
+def _vertex_map(V: np.ndarray, keep: np.ndarray, tol: float) -> np.ndarray:
+    """Every original vertex -> a survivor (index into ``keep``): itself, or the nearest
+    survivor within ``tol`` m (a welded one); -1 for none."""
+    vmap = np.full(len(V), -1, np.int64)
     vmap[keep] = np.arange(len(keep))
     lost = np.flatnonzero(vmap < 0)
     if len(lost) and len(keep):
@@ -161,59 +183,77 @@ def clean_mesh(V: np.ndarray, P: np.ndarray, sizes: np.ndarray, *, name: str = "
 
         dist, near = cKDTree(V[keep]).query(V[lost])
         vmap[lost] = np.where(dist <= max(tol, 0.0) * (1 + 1e-9), near, -1)
-    # polygons with a surviving triangle, flipped as pymeshlab flipped that triangle
-    first = np.full(m0, -1, np.int64)
+    return vmap
+
+
+def _oriented_polygons(P: np.ndarray, sizes: np.ndarray, T: np.ndarray, Tn: np.ndarray,
+                       born: np.ndarray, vmap: np.ndarray
+                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """``(kept, Pm, sz, flipped)``: the polygons with a surviving triangle (their rows of
+    ``P``), in survivor numbering, reversed where pymeshlab flipped that triangle (the side
+    most faces of the input face kept), their sizes and whether each was flipped."""
+    first = np.full(len(P), -1, np.int64)
     first[born[::-1]] = np.arange(len(born))[::-1]
     kept = np.flatnonzero(first >= 0)
     Pm = np.where(P[kept] >= 0, vmap[np.maximum(P[kept], 0)], -1)
     Pm[P[kept] < 0] = -1
     sz = sizes[kept]
     tri_orig = T[first[kept]]  # the surviving triangle, original numbering and orientation
-    tri_new = Tn[first[kept]]
-    mapped = vmap[tri_orig]
-    flipped = ~_same_cycle(mapped, tri_new)
+    flipped = ~_same_cycle(vmap[tri_orig], Tn[first[kept]])
     if flipped.sum() > len(flipped) / 2:  # keep the side most faces of the input face
         flipped = ~flipped
     j = np.arange(Pm.shape[1])[None, :]
-    inside = j < sz[:, None]
-    rev = np.where(inside, sz[:, None] - 1 - j, j)
+    rev = np.where(j < sz[:, None], sz[:, None] - 1 - j, j)
     Pm = np.where(flipped[:, None], np.take_along_axis(Pm, rev, axis=1), Pm)
-    # polygons a weld collapsed (a vertex twice) or that pymeshlab's duplicates left twice
-    valid = np.ones(len(Pm), bool)
+    return kept, Pm, sz, flipped
+
+
+def _collapsed_and_repeated(P0: np.ndarray, Pm: np.ndarray, sz: np.ndarray
+                            ) -> tuple[np.ndarray, int, int]:
+    """``(keep_rows, duplicates, degenerate)`` of the polygons ``Pm`` (``P0`` the same rows
+    before the weld): drop those the weld collapsed (a vertex twice; a face repeating a vertex
+    in the file is left for the checks to name) or without a vertex, and the second copy of
+    each polygon pymeshlab's duplicates left twice."""
+    inside = np.arange(Pm.shape[1])[None, :] < sz[:, None]
     big = np.iinfo(np.int64).max
     S = np.sort(np.where(inside, Pm, big), axis=1)
-    S0 = np.sort(np.where(inside, P[kept], big), axis=1)
+    S0 = np.sort(np.where(inside, P0, big), axis=1)
     repeat = ((np.diff(S, axis=1) == 0) & (S[:, 1:] != big)).any(axis=1)
-    # a face repeating a vertex in the file is left for the checks to name; only faces the
-    # weld collapsed are dropped
     repeat &= ~((np.diff(S0, axis=1) == 0) & (S0[:, 1:] != big)).any(axis=1)
-    valid &= ~repeat & (np.where(inside, Pm, 0) >= 0).all(axis=1)
-    degenerate = int((~valid).sum())
+    valid = ~repeat & (np.where(inside, Pm, 0) >= 0).all(axis=1)
     _, first_key = np.unique(S, axis=0, return_index=True)
     unique = np.zeros(len(Pm), bool)
     unique[first_key] = True
-    dup = int((valid & ~unique).sum()) + (m0 - len(kept))
-    keep_rows = valid & unique
-    Pm, sz, flipped = Pm[keep_rows], sz[keep_rows], flipped[keep_rows]
-    used = np.zeros(len(keep), bool)
+    return valid & unique, int((valid & ~unique).sum()), int((~valid).sum())
+
+
+def _first_copy_numbering(V: np.ndarray, Pm: np.ndarray, vmap: np.ndarray,
+                          n_keep: int) -> tuple[np.ndarray, np.ndarray]:
+    """``(V, P)`` renumbered canonically: each welded vertex is its first copy in the file (its
+    coordinates, its place in the order), so a grid exported face by face keeps its first
+    corner first (:func:`gridshell.geometry.grid.grid_from_quads` starts from the corner of
+    smallest index); survivors no polygon uses are left out."""
+    used = np.zeros(n_keep, bool)
     used[Pm[Pm >= 0]] = True
-    # canonical numbering: each welded vertex is its first copy in the file (its coordinates,
-    # its place in the order), so a grid exported face by face keeps its first corner first
-    # (gridshell.geometry.grid.grid_from_quads starts from the corner of smallest index)
-    first_copy = np.full(len(keep), np.iinfo(np.int64).max)
+    first_copy = np.full(n_keep, np.iinfo(np.int64).max)
     ok = vmap >= 0
     np.minimum.at(first_copy, vmap[ok], np.flatnonzero(ok))
     surv = np.flatnonzero(used)
     order = surv[np.argsort(first_copy[surv], kind="stable")]
-    renum = np.full(len(keep), -1, np.int64)
+    renum = np.full(n_keep, -1, np.int64)
     renum[order] = np.arange(len(order))
-    Pout = np.where(Pm >= 0, renum[np.maximum(Pm, 0)], -1)
-    Vout = V[first_copy[order]]
-    welded = n0 - len(keep) - _unreferenced_count(P, n0)
-    rep = CleanReport(vertices=(n0, len(Vout)), faces=(m0, len(Pout)), tolerance=tol,
-                      duplicate_faces=dup, degenerate_faces=degenerate,
-                      unreferenced=_unreferenced_count(P, n0), flipped=int(flipped.sum()))
-    rep.welded = max(welded, 0)
+    return V[first_copy[order]], np.where(Pm >= 0, renum[np.maximum(Pm, 0)], -1)
+
+
+def _report(P: np.ndarray, n_keep: int, vertices: tuple[int, int], faces: tuple[int, int],
+            tol: float, dup: int, degenerate: int, flipped: int) -> CleanReport:
+    """The :class:`CleanReport` of a cleaning (``vertices``, ``faces``: counts before and
+    after; ``n_keep`` vertices survived pymeshlab) with its summary lines."""
+    n0 = vertices[0]
+    unref = _unreferenced_count(P, n0)
+    rep = CleanReport(vertices=vertices, faces=faces, tolerance=tol, duplicate_faces=dup,
+                      degenerate_faces=degenerate, unreferenced=unref, flipped=flipped)
+    rep.welded = max(n0 - n_keep - unref, 0)
     if rep.welded:
         rep.lines.append(f"welded {n0} -> {n0 - rep.welded} vertices")
     if rep.unreferenced:
@@ -224,7 +264,7 @@ def clean_mesh(V: np.ndarray, P: np.ndarray, sizes: np.ndarray, *, name: str = "
         rep.lines.append(f"dropped {degenerate} faces the weld collapsed")
     if rep.flipped:
         rep.lines.append(f"flipped {rep.flipped} faces to a consistent orientation")
-    return Vout, Pout, sz, rep
+    return rep
 
 
 def needs_cleaning(V: np.ndarray, P: np.ndarray, sizes: np.ndarray, tol: float,

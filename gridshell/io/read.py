@@ -87,7 +87,8 @@ def read_input(source: Any, *, units: Units | str | None = None, clean: bool = T
     Parameters
     ----------
     source : path of an OBJ / PLY / OFF / 3DM file, an :class:`InputGeometry` (returned as it
-        is), a QuadMesh / TriMesh or a ``(V, F)`` pair (in ``units``)
+        is), a QuadMesh / TriMesh or a ``(V, F)`` pair (in ``units``), or one Rhino object as
+        :func:`gridshell.io.rhino.object_input` reads it (a .3dm's object, read the same way)
     units : the unit the geometry is drawn in (``"m"``, ``"cm"``, ``"mm"``, ``"in"``, ``"ft"``);
         None: a .3dm's own unit system, else metres after :func:`check_plausible`
     clean : weld, de-duplicate and orient first (:func:`gridshell.io.clean.clean_mesh`)
@@ -102,79 +103,119 @@ def read_input(source: Any, *, units: Units | str | None = None, clean: bool = T
     """
     if isinstance(source, InputGeometry):
         return source
-    given = resolve_units(units)
-    surface, notes, obj_label, file_u = None, [], None, None
+    raw = _parse(source, obj)
+    u, src = _pick_units(raw.name, raw.units, resolve_units(units))
+    made = dict(units=u, name=raw.name, path=raw.path, object=raw.object, object_query=obj,
+                notes=raw.notes, units_source=src)
+    if raw.surface is not None:
+        surface = _scaled_surface(raw.surface, u.metres_per_unit)
+        if src == "default":
+            from gridshell.geometry.quadmesh import bbox_diagonal
+
+            check_plausible(bbox_diagonal(surface.ctrl.reshape(-1, 3)), raw.name)
+        mesh = _sample_surface(surface)
+        return InputGeometry(V=mesh.V, F=mesh.F, surface=surface, clean=None, **made)
+    if src == "default":
+        from gridshell.geometry.quadmesh import bbox_diagonal
+
+        check_plausible(bbox_diagonal(raw.V), raw.name)
+    V, F, report = _checked_mesh(to_metres(raw.V, u), raw.P, raw.sizes, raw.name, clean)
+    if require_disk:
+        check_disk(V, F, raw.name, report, what=what)
+    return InputGeometry(V=V, F=F, clean=report, **made)
+
+
+@dataclass
+class _Parsed:
+    """What a source holds before units and checks: a polygon mesh (``V``, ``P``, ``sizes``)
+    or a B-spline ``surface``, in the source's units (``units``: a .3dm's own, else None)."""
+
+    name: str
+    path: str | None = None
+    units: Units | None = None
+    notes: list[str] = field(default_factory=list)
+    object: str | None = None
+    surface: Any = None
+    V: Any = None
+    P: Any = None
+    sizes: Any = None
+
+
+def _parse(source: Any, obj: str | None) -> _Parsed:
+    """The :class:`_Parsed` of a path (a .3dm through :func:`gridshell.io.rhino.read_3dm`,
+    OBJ / PLY / OFF through :func:`gridshell.geometry.meshfile.read_polygons`), of one Rhino
+    object already read (the Grasshopper server's) or of a mesh / ``(V, F)`` pair."""
     if isinstance(source, (str, os.PathLike)):
         path = Path(source)
-        name = path.name
+        out = _Parsed(name=path.name, path=str(path.resolve()))
         if path.suffix.lower() == ".3dm":
             from gridshell.io.rhino import read_3dm
 
             r = read_3dm(path, obj)
-            file_u, obj_label, notes = r.units, r.object.label(), list(r.notes)
-            if r.surface is not None:
-                surface = r.surface
-            else:
-                V, P, sizes = r.V, r.P, r.sizes
-        else:
-            if obj is not None:
-                raise InputError(f"{name}: --object picks an object of a .3dm file; a mesh file "
-                                 "holds one mesh - drop --object")
-            from gridshell.geometry.meshfile import read_polygons
+            _take_rhino(out, r)
+            out.object = r.object.label()
+            return out
+        if obj is not None:
+            raise InputError(f"{path.name}: --object picks an object of a .3dm file; a mesh "
+                             "file holds one mesh - drop --object")
+        from gridshell.geometry.meshfile import read_polygons
 
-            V, P, sizes = read_polygons(path)
-        path_s = str(path.resolve())
-    else:
-        name, path_s = "(V, F)", None
-        V, P, sizes = _arrays(source)
-    # the unit: the file's own, the option's, or metres if plausible
+        out.V, out.P, out.sizes = read_polygons(path)
+        return out
+    if _is_rhino_input(source):
+        out = _Parsed(name=source.name or "(Rhino object)")
+        _take_rhino(out, source)
+        return out
+    out = _Parsed(name="(V, F)")
+    out.V, out.P, out.sizes = _arrays(source)
+    return out
+
+
+def _take_rhino(out: _Parsed, r: Any) -> None:
+    """Copy a :class:`gridshell.io.rhino.RhinoInput`'s units, notes and geometry into ``out``."""
+    out.units, out.notes = r.units, list(r.notes)
+    out.surface, out.V, out.P, out.sizes = r.surface, r.V, r.P, r.sizes
+
+
+def _pick_units(name: str, file_u: Units | None, given: Units | None) -> tuple[Units, str]:
+    """``(unit, source)``: the file's own (``"file"``; :class:`InputError` when ``--units``
+    says another), the option's (``"option"``) or metres (``"default"``)."""
     if file_u is not None:
         if given is not None and given != file_u:
             raise InputError(f"{name}: the model is drawn in {file_u.long_name} (its unit "
                              f"system) but --units {given.name} was given; drop --units or set "
                              "the model's units in Rhino")
-        u, src = file_u, "file"
-    elif given is not None:
-        u, src = given, "option"
-    else:
-        u, src = METRES, "default"
-    if surface is not None:
-        surface = _scaled_surface(surface, u.metres_per_unit)
-        if src == "default":
-            from gridshell.geometry.quadmesh import bbox_diagonal
+        return file_u, "file"
+    if given is not None:
+        return given, "option"
+    return METRES, "default"
 
-            check_plausible(bbox_diagonal(surface.ctrl.reshape(-1, 3)), name)
-        mesh = _sample_surface(surface)
-        return InputGeometry(V=mesh.V, F=mesh.F, units=u, name=name, path=path_s,
-                             surface=surface, object=obj_label, object_query=obj, clean=None,
-                             notes=notes, units_source=src)
-    if src == "default":
-        from gridshell.geometry.quadmesh import bbox_diagonal
 
-        check_plausible(bbox_diagonal(V), name)
-    V = to_metres(V, u)
+def _checked_mesh(V: np.ndarray, P: np.ndarray, sizes: np.ndarray, name: str,
+                  clean: bool) -> tuple[np.ndarray, np.ndarray, Any]:
+    """``(V, F, report)`` of a polygon mesh in metres: coordinates checked, cleaned
+    (:func:`gridshell.io.clean.clean_mesh`; ``report`` None when not), validated, its extent
+    checked, and its faces as :func:`_faces` gives them."""
     from gridshell.geometry.meshfile import _check_extent, check_coordinates
+    from gridshell.geometry.quadmesh import check_face_areas, validate_mesh
 
     check_coordinates(V, name)
     report = None
     if clean:
         from gridshell.io.clean import clean_mesh
 
-        from gridshell.geometry.quadmesh import check_face_areas
-
         if len(P):  # a weld must not hide a degenerate face of the file (welding its corners
             check_face_areas(V, P, name)  # would drop it; a mesh at one point would vanish)
-
         V, P, sizes, report = clean_mesh(V, P, sizes, name=name)
-    from gridshell.geometry.quadmesh import validate_mesh
-
     validate_mesh(V, P, name=name)
     _check_extent(V, name)
-    F = _faces(V, P, sizes)
-    if require_disk:
-        check_disk(V, F, name, report, what=what)
-    return InputGeometry(V=V, F=F, units=u, name=name, path=path_s, object=obj_label,
-                         object_query=obj, clean=report, notes=notes, units_source=src)
+    return V, _faces(V, P, sizes), report
+
+
+def _is_rhino_input(source: Any) -> bool:
+    from gridshell.io.rhino import RhinoInput
+
+    return isinstance(source, RhinoInput)
 
 
 def _arrays(source: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -1,8 +1,11 @@
-"""Rhino ``.3dm`` input through rhino3dm: a mesh, a NURBS surface or a single-face Brep, picked
-by name, id or layer when the file holds several, in the file's unit system.
+"""Rhino ``.3dm`` input: a mesh, a NURBS surface or a single-face Brep, picked by name, id or
+layer when the file holds several, in the file's unit system; one Rhino object as input
+(:func:`object_input`, also the Grasshopper server's). Rhino objects become arrays in
+:mod:`gridshell.geometry.rhino_adapter` (double-precision vertices, polygons as Rhino keeps
+them).
 
-A NURBS surface becomes a :class:`~gridshell.geometry.bspline.BSplineSurface` (still in file units; the
-caller converts): Rhino stores ``count + order - 2`` knots per direction (no end knots), so one
+A NURBS surface becomes the :class:`~gridshell.geometry.bspline.BSplineSurface` it is (still in file
+units; the caller converts): Rhino stores ``count + order - 2`` knots per direction (no end knots), so one
 knot is added at each end, and the knot vectors are mapped onto ``[0, 1]`` (an affine change of
 parameter: the surface is the same). A rational surface (weights not all equal) has no exact
 non-rational form: it is fitted by a non-rational one of the same degrees with as
@@ -19,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from gridshell.core.errors import InputError, MeshError
+from gridshell.geometry import rhino_adapter as rh
 from gridshell.core.units import Units, parse_units
 
 #: Rhino unit system name -> our unit name
@@ -61,18 +65,12 @@ class RhinoInput:
     surface: Any = None
     rational_error: float | None = None
     notes: list[str] = field(default_factory=list)
-
-
-def _rhino():
-    import rhino3dm
-
-    return rhino3dm
+    name: str = ""  # the file's name (or what names the object) in messages
 
 
 def file_units(model: Any, name: str) -> Units | None:
     """The :class:`Units` of a File3dm's model unit system, None when it has none."""
-    us = model.Settings.ModelUnitSystem
-    key = getattr(us, "name", str(us)).split(".")[-1]
+    key = rh.unit_system_name(model)
     if key in ("None", "Unset"):
         return None
     if key not in RHINO_UNITS:
@@ -83,31 +81,11 @@ def file_units(model: Any, name: str) -> Units | None:
 
 
 def _objects(model: Any) -> list[RhinoObject]:
-    r = _rhino()
     out = []
-    for obj in model.Objects:
-        g, a = obj.Geometry, obj.Attributes
-        try:
-            layer = model.Layers[a.LayerIndex].FullPath or model.Layers[a.LayerIndex].Name
-        except Exception:  # noqa: BLE001 - a file without layer table
-            layer = "?"
-        rec = RhinoObject(kind=type(g).__name__, name=a.Name or "", id=str(a.Id), layer=layer,
-                          geometry=g, usable=False)
-        if isinstance(g, r.Mesh):
-            rec.kind, rec.usable = "mesh", True
-        elif isinstance(g, r.Brep):
-            n = len(g.Faces)
-            rec.kind, rec.usable = (("Brep (1 face)", True) if n == 1 else
-                                    (f"Brep of {n} faces", False))
-        elif isinstance(g, r.Extrusion):
-            rec.kind, rec.usable = "extrusion", False
-        elif isinstance(g, r.Surface):
-            rec.kind, rec.usable = "NURBS surface", True
-        else:
-            rec.kind = {"LineCurve": "curve", "NurbsCurve": "curve", "PolylineCurve": "curve",
-                        "ArcCurve": "curve", "PolyCurve": "curve", "Point": "point",
-                        "PointCloud": "point cloud"}.get(rec.kind, rec.kind)
-        out.append(rec)
+    for g, name, id_, layer in rh.model_objects(model):
+        kind, usable = rh.geometry_kind(g)
+        out.append(RhinoObject(kind=kind, name=name, id=id_, layer=layer, geometry=g,
+                               usable=usable))
     return out
 
 
@@ -156,75 +134,54 @@ def _count_kinds(objs: list[RhinoObject]) -> str:
 
 
 def _mesh_arrays(mesh: Any, name: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``V (n,3)`` (double precision), padded faces and sizes of a rhino3dm Mesh."""
-    pts = mesh.Vertices.ToPoint3dArray()
-    V = np.array([[p.X, p.Y, p.Z] for p in pts], dtype=np.float64).reshape(-1, 3)
-    F = np.array([tuple(mesh.Faces[i]) for i in range(len(mesh.Faces))],
-                 dtype=np.int64).reshape(-1, 4)
-    if len(V) == 0 or len(F) == 0:
+    """``V (n,3)`` (double precision), padded faces and sizes of a Rhino mesh
+    (:func:`gridshell.geometry.rhino_adapter.mesh_arrays`)."""
+    V, P, sizes = rh.mesh_arrays(mesh)
+    if len(V) == 0 or len(P) == 0:
         raise MeshError(f"{name}: the mesh is empty; export it again")
-    tri = F[:, 2] == F[:, 3]
-    P = F.copy()
-    P[tri, 3] = -1
-    sizes = np.where(tri, 3, 4)
     return V, P, sizes
 
 
 def nurbs_to_bspline(ns: Any, name: str) -> tuple[Any, float | None]:
-    """The :class:`BSplineSurface` of a rhino3dm NurbsSurface (file units, knots on [0, 1]),
-    and for a rational surface the largest distance of the non-rational fit (file units;
-    None for a non-rational surface)."""
-    from gridshell.geometry.bspline import BSplineSurface
-
-    du, dv = ns.OrderU - 1, ns.OrderV - 1
-    nu, nv = ns.Points.CountU, ns.Points.CountV
-    ku = np.array([ns.KnotsU[i] for i in range(len(ns.KnotsU))], dtype=np.float64)
-    kv = np.array([ns.KnotsV[i] for i in range(len(ns.KnotsV))], dtype=np.float64)
-    if len(ku) != nu + du - 1 or len(kv) != nv + dv - 1:  # Rhino: count + order - 2
-        raise InputError(f"{name}: the NURBS surface has {len(ku)} x {len(kv)} knots for "
-                         f"{nu} x {nv} control points of order {du + 1} x {dv + 1}; the file is "
-                         "corrupt, export it again")
-    full_u = np.concatenate([[ku[0]], ku, [ku[-1]]])
-    full_v = np.concatenate([[kv[0]], kv, [kv[-1]]])
-    W = np.array([[ns.Points[i, j].W for j in range(nv)] for i in range(nu)], dtype=np.float64)
-    rational = bool(ns.IsRational) and not np.allclose(W, W.flat[0], rtol=1e-12, atol=0)
-    (u0, u1), (v0, v1) = _domain(full_u, du), _domain(full_v, dv)
-    if not rational:
-        C = np.array([[[ns.Points[i, j].X, ns.Points[i, j].Y, ns.Points[i, j].Z]
-                       for j in range(nv)] for i in range(nu)], dtype=np.float64)
-        if bool(ns.IsRational):
-            C = C / W[..., None]  # equal weights: homogeneous coordinates, one scale
-        surf = BSplineSurface(du, dv, (full_u - u0) / (u1 - u0), (full_v - v0) / (v1 - v0), C)
-        return surf, None
-    return _fit_rational(ns, du, dv, full_u, full_v, name)
+    """The :class:`BSplineSurface` of a rhino3dm NurbsSurface (file units, knots on [0, 1]):
+    the surface itself when it is non-rational (:func:`gridshell.geometry.rhino_adapter.
+    nurbs_to_bspline`), else its non-rational fit (:func:`_fit_rational`); and for a rational
+    surface the largest distance of the fit (file units; None for a non-rational surface)."""
+    parts = rh.nurbs_parts(ns, name)
+    if not parts.rational:
+        return rh.nurbs_to_bspline(parts, name), None
+    return _fit_rational(parts)
 
 
-def _domain(knots: np.ndarray, d: int) -> tuple[float, float]:
-    a, b = float(knots[d]), float(knots[len(knots) - d - 1])
-    if not b > a:
-        raise InputError("the NURBS surface has an empty parameter domain; the file is corrupt")
-    return a, b
+def rational_points(parts: rh.NurbsParts, s: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """``S (len(s), len(t), 3)``: the rational surface ``parts`` on the grid ``s x t`` of its
+    parameters mapped onto ``[0, 1]``: ``sum N_i N_j w_ij C_ij / sum N_i N_j w_ij``."""
+    from gridshell.geometry.bspline import basis_matrix
+
+    ku, kv = parts.unit_knots()
+    Bu = basis_matrix(ku, parts.degree_u, np.asarray(s, float)).toarray()
+    Bv = basis_matrix(kv, parts.degree_v, np.asarray(t, float)).toarray()
+    W = parts.weights
+    num = np.einsum("ai,ijk,bj->abk", Bu, W[..., None] * parts.ctrl, Bv)
+    return num / (Bu @ W @ Bv.T)[..., None]
 
 
-def _fit_rational(ns: Any, du: int, dv: int, full_u: np.ndarray, full_v: np.ndarray,
-                  name: str) -> tuple[Any, float]:
+def _fit_rational(parts: rh.NurbsParts) -> tuple[Any, float]:
     """A non-rational surface fitted (least squares, same degrees, uniform knots) to a dense
-    sampling of the rational ``ns``, with 2, 4 or 8 times as many spans: the first whose
+    sampling of the rational ``parts``, with 2, 4 or 8 times as many spans: the first whose
     largest distance on a denser sampling is below :data:`RATIONAL_TOLERANCE` of the
     diagonal of the control net. Returns it and that distance (file units)."""
     import scipy.sparse.linalg as spla
 
     from gridshell.geometry.bspline import BSplineSurface, open_uniform_knots
 
-    (u0, u1), (v0, v1) = _domain(full_u, du), _domain(full_v, dv)
-    spans_u = max(len(np.unique(full_u[du:len(full_u) - du])) - 1, 1)
-    spans_v = max(len(np.unique(full_v[dv:len(full_v) - dv])) - 1, 1)
+    du, dv = parts.degree_u, parts.degree_v
+    spans_u = max(len(np.unique(parts.knots_u[du:len(parts.knots_u) - du])) - 1, 1)
+    spans_v = max(len(np.unique(parts.knots_v[dv:len(parts.knots_v) - dv])) - 1, 1)
 
     def sample(nu: int, nv: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         s, t = np.linspace(0, 1, nu), np.linspace(0, 1, nv)
-        P = np.array([[_xyz(ns.PointAt(u0 + a * (u1 - u0), v0 + b * (v1 - v0))) for b in t]
-                      for a in s], dtype=np.float64)
-        return s, t, P
+        return s, t, rational_points(parts, s, t)
 
     best = None
     for k in (2, 4, 8):
@@ -245,8 +202,40 @@ def _fit_rational(ns: Any, du: int, dv: int, full_u: np.ndarray, full_v: np.ndar
     return best
 
 
-def _xyz(p: Any) -> tuple[float, float, float]:
-    return (p.X, p.Y, p.Z)
+def object_input(g: Any, name: str, obj: RhinoObject | None = None) -> RhinoInput:
+    """The :class:`RhinoInput` (no units) of one Rhino object ``g``: a mesh's arrays, or the
+    B-spline of a NURBS surface or single-face Brep (a reversed face flips ``u``; a trimmed
+    face gives its whole underlying surface, said in the notes). :class:`InputError` for any
+    other object (``name`` names it in messages; ``obj`` is its record, made when None)."""
+    if obj is None:
+        kind, usable = rh.geometry_kind(g)
+        if not usable:
+            raise InputError(f"{name}: a {kind} is not a target surface; connect a mesh, a "
+                             "NURBS surface or a single-face Brep")
+        obj = RhinoObject(kind=kind, name="", id="", layer="", geometry=g)
+    out = RhinoInput(units=None, object=obj, name=name)
+    if obj.kind == "mesh":
+        out.V, out.P, out.sizes = _mesh_arrays(g, name)
+        return out
+    ns, reversed_, trimmed = rh.surface_nurbs(g)
+    if trimmed:
+        out.notes.append("the Brep face is trimmed: its whole underlying surface is used")
+    if ns is None:
+        raise InputError(f"{name}: {obj.label()} has no NURBS form; convert it to a NURBS "
+                         "surface in Rhino (ToNurbs)")
+    surf, err = nurbs_to_bspline(ns, name)
+    if reversed_:  # the face's normal is the surface's reversed: flip u
+        from gridshell.geometry.bspline import BSplineSurface
+
+        surf = BSplineSurface(surf.degree_u, surf.degree_v, 1.0 - surf.knots_u[::-1],
+                              surf.knots_v, surf.ctrl[::-1].copy())
+    out.surface = surf
+    if err is not None:
+        out.notes.append(f"rational surface approximated by a non-rational B-spline "
+                         f"({surf.ctrl.shape[0]} x {surf.ctrl.shape[1]} control points), largest "
+                         f"distance {err:.3g} file units")
+        out.rational_error = err
+    return out
 
 
 def read_3dm(path: str | os.PathLike, obj: str | None = None) -> RhinoInput:
@@ -263,41 +252,12 @@ def read_3dm(path: str | os.PathLike, obj: str | None = None) -> RhinoInput:
         raise InputError(f"{path}: cannot read the file (permission denied); fix its permissions")
     if path.stat().st_size == 0:
         raise InputError(f"{name}: the file is empty; save the model again")
-    model = _rhino().File3dm.Read(str(path))
+    model = rh.read_file(path)
     if model is None:
         raise InputError(f"{name}: not a readable Rhino .3dm file (corrupt or truncated); save "
                          "it again from Rhino (File > Save As, version 7 or 8)")
     units = file_units(model, name)
-    objs = _objects(model)
-    pick = _pick(objs, obj, name)
-    out = RhinoInput(units=units, object=pick)
-    g = pick.geometry
-    if pick.kind == "mesh":
-        out.V, out.P, out.sizes = _mesh_arrays(g, name)
-        return out
-    if pick.kind.startswith("Brep"):
-        face = g.Faces[0]
-        if not bool(g.IsSurface):
-            out.notes.append("the Brep face is trimmed: its whole underlying surface is used")
-        srf = face.UnderlyingSurface()
-        ns = srf.ToNurbsSurface() if not isinstance(srf, _rhino().NurbsSurface) else srf
-        reversed_ = bool(face.OrientationIsReversed)
-    else:
-        ns = g if isinstance(g, _rhino().NurbsSurface) else g.ToNurbsSurface()
-        reversed_ = False
-    if ns is None:
-        raise InputError(f"{name}: {pick.label()} has no NURBS form; convert it to a NURBS "
-                         "surface in Rhino (ToNurbs)")
-    surf, err = nurbs_to_bspline(ns, name)
-    if reversed_:  # the face's normal is the surface's reversed: flip u
-        from gridshell.geometry.bspline import BSplineSurface
-
-        surf = BSplineSurface(surf.degree_u, surf.degree_v, 1.0 - surf.knots_u[::-1],
-                              surf.knots_v, surf.ctrl[::-1].copy())
-    out.surface = surf
-    if err is not None:
-        out.notes.append(f"rational surface approximated by a non-rational B-spline "
-                         f"({surf.ctrl.shape[0]} x {surf.ctrl.shape[1]} control points), largest "
-                         f"distance {err:.3g} file units")
-        out.rational_error = err
+    pick = _pick(_objects(model), obj, name)
+    out = object_input(pick.geometry, name, pick)
+    out.units = units
     return out

@@ -1,6 +1,8 @@
 """Grasshopper components through Hops (``gridshell serve``): a thin layer over the Python API.
 
-:mod:`.rhino` converts between rhino3dm geometry (what Hops sends and receives) and our arrays;
+:mod:`.rhino` converts between Rhino geometry (what Hops sends and receives) and our arrays
+through :mod:`gridshell.geometry.rhino_adapter`, a target read by :mod:`gridshell.io` exactly
+as the CLI reads the same object from a .3dm;
 :mod:`.components` registers the components (GG design, NCP design, verify, fabricate) on a
 ``ghhops-server`` Flask app; errors reach the component as its message, never a dead
 component.

@@ -3,15 +3,20 @@
 =============  ======================================================  ==================
 route          inputs                                                   outputs
 =============  ======================================================  ==================
-``/gg``        Target (mesh or surface, m), Lamellae, Grid, Options     Net, Lamellae,
+``/gg``        Target (mesh, m), Lamellae, Grid, Options, Surface (m)   Net, Lamellae,
                                                                         Aligned, Metrics,
                                                                         Bundle
-``/ncp``       Reference (mesh or surface, m), Mode, Curves, Options    (as ``/gg``)
+``/ncp``       Reference (mesh, m), Mode, Curves, Options, Surface      (as ``/gg``)
 ``/verify``    Bundle                                                   OK, Checks, Report
 ``/fabricate`` Bundle, Scale, Sheet, Width, Options, Force              Cut, Score,
                                                                         Engrave, Sheets,
                                                                         Report, Folder
 =============  ======================================================  ==================
+
+A design component takes a mesh (Target / Reference) or a NURBS surface or single-face Brep
+(Surface: a Grasshopper Mesh input would mesh it), read as ``gridshell gg|ncp model.3dm`` reads
+the same object (:func:`gridshell.server.rhino.target_input`): double-precision vertices,
+polygons kept, a NURBS surface the B-spline itself.
 
 Designs are written as bundles into the server's work directory; ``Bundle`` is the path that
 ``/verify`` and ``/fabricate`` take. ``Options`` is a JSON object of further keywords of
@@ -27,11 +32,11 @@ from __future__ import annotations
 import json
 import uuid
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
-from gridshell.core.errors import GridshellError, InputError
+from gridshell.core.errors import InputError
 from gridshell.server import rhino
 
 #: the keywords ``Options`` may give, per component (the others are inputs of their own)
@@ -105,68 +110,169 @@ def _plain(o: Any) -> Any:
     return str(o)
 
 
-def register(hops, workdir: Path) -> None:
-    """Register the four components on ``hops`` (a ghhops_server Hops middleware)."""
-    import ghhops_server as hs
+def design_gg_component(new_dir: Callable[[str], Path], target: Any = None, lamellae: int = 6,
+                        grid: int = 12, opts: str = "{}", surface: Any = None) -> Reply:
+    """The ``/gg`` component: a GG design of ``target`` (a Rhino mesh) or ``surface`` (a NURBS
+    surface or single-face Brep), both in metres, read as the CLI reads the same object from a
+    .3dm (:func:`gridshell.server.rhino.target_input`), written as a bundle into
+    ``new_dir("gg")``."""
+    from gridshell.api import design_gg, write
 
-    def new_dir(kind: str) -> Path:
-        return workdir / f"{kind}-{uuid.uuid4().hex[:10]}"
+    kw = options(opts, GG_OPTIONS, "GG design")
+    kw.setdefault("frames", 0)
+    geo = rhino.target_input(_one_target(target, surface, "Target"))
+    if int(grid) < 4 or int(lamellae) < 2:
+        raise InputError(f"Grid {grid} and Lamellae {lamellae}: give Grid >= 4 and "
+                         "Lamellae >= 2")
+    design = design_gg(geo, grid=(int(grid), int(grid)), n_lamellae=int(lamellae), **kw)
+    out = write(new_dir("gg"), design, render=False, frames=0)
+    return _net_outputs(design.bundle, out, _quality_warning(design.bundle))
 
-    def net_outputs() -> list:
-        """The outputs of a design component (GG and NCP alike: :func:`_net_outputs`)."""
-        return [hs.HopsMesh("Net", "N", "joints and net loops, metres"),
-                hs.HopsCurve("Lamellae", "L", "lamella axes, metres",
-                             access=hs.HopsParamAccess.LIST),
-                hs.HopsCurve("Aligned", "A", "lamellae through their joints when aligned",
-                             access=hs.HopsParamAccess.LIST),
-                hs.HopsString("Metrics", "M", "figures of the design (JSON)"),
-                hs.HopsString("Bundle", "B", "design bundle folder (for Verify, Fabricate)")]
 
-    @hops.component(
+def design_ncp_component(new_dir: Callable[[str], Path], reference: Any = None,
+                         mode: str = "cnc", curves: int = 8, opts: str = "{}",
+                         surface: Any = None) -> Reply:
+    """The ``/ncp`` component: an NCP / CNC / AA design of ``reference`` (a Rhino mesh) or
+    ``surface`` (a NURBS surface or single-face Brep, used as the B-spline it is), metres,
+    written as a bundle into ``new_dir(kind)``."""
+    from gridshell.api import design_ncp, write
+
+    kw = options(opts, NCP_OPTIONS, "NCP design")
+    geo = rhino.target_input(_one_target(reference, surface, "Reference"), what="the reference")
+    design = design_ncp(geo, mode=str(mode).strip().lower(), curves=int(curves), **kw)
+    bundle = design.bundle
+    out = write(new_dir(bundle.kind.lower()), design, render=False)
+    return _net_outputs(bundle, out, _quality_warning(bundle))
+
+
+def _one_target(mesh: Any, surface: Any, name: str) -> Any:
+    """The one target given: the mesh input ``name`` or the Surface input; InputError for
+    neither or both."""
+    if mesh is None and surface is None:
+        raise InputError(f"input {name} is missing; connect a mesh to {name} or a NURBS "
+                         "surface to Surface")
+    if mesh is not None and surface is not None:
+        raise InputError(f"both {name} and Surface are connected; connect one of them")
+    return mesh if surface is None else surface
+
+
+def verify_component(bundle_dir: str) -> Reply:
+    """The ``/verify`` component: OK, the pass / FAIL lines and the recomputed figures (JSON)
+    of the bundle at ``bundle_dir`` (:func:`gridshell.design.verification.design_verdict`)."""
+    from gridshell.design.bundle import finite_json
+    from gridshell.design.verification import design_verdict
+
+    verdict = design_verdict(_bundle_path(bundle_dir))
+    res = verdict.report
+    warnings = [] if verdict.ok else ["the design fails its checks: " + "; ".join(
+        [g.line() for g in verdict.gates if not g.ok] + list(verdict.problems))]
+    return Reply(bool(res["ok"]), list(res["checks"]) + list(res["problems"]),
+                 json.dumps(finite_json(res), default=_plain, allow_nan=False),
+                 warnings=warnings)
+
+
+def fabricate_component(bundle_dir: str, scale: str | None = None, sheet: str = "600x400",
+                        width: float | None = None, opts: str = "{}",
+                        force: bool = False) -> Reply:
+    """The ``/fabricate`` component: the bundle's cut files (as ``gridshell fabricate``) and
+    its nested parts as curves, mm, the sheets laid out along x (:func:`_sheet_curves`)."""
+    from dataclasses import fields
+
+    from gridshell.design.section import resolve_section
+    from gridshell.design.verification import require_design
+    from gridshell.fabrication import FabParams, fabricate
+
+    names = tuple(f.name for f in fields(FabParams) if f.name not in ("scale", "sheet", "width"))
+    kw = options(opts, names, "Fabricate")
+    path = _bundle_path(bundle_dir)
+    verdict = require_design(str(path), bool(force), "set Force to cut it anyway")
+    strip = resolve_section(path, width=width, thickness=kw.pop("thickness", None),
+                            scale=scale, stored=False)   # as 'gridshell fabricate'
+    params = FabParams(scale=strip.scale, sheet=sheet, width=strip.width_mm,
+                       thickness=strip.thickness_mm, **kw)
+    out = path / "fabrication"
+    rep = fabricate(path, out, params, plan=False, keep_layout=True)
+    cut, score, engrave, sheets = _sheet_curves(rep.pop("layout"), params.tolerance)
+    warnings = [] if verdict.ok else ["the design fails its checks; cut anyway (Force)"]
+    if rep.get("joints_fallback"):
+        warnings.append(rep["joints_fallback"])
+    summary = {k: rep[k] for k in ("kind", "shape", "n_strips", "n_pieces", "n_sheets",
+                                   "utilisation", "utilisation_per_sheet",
+                                   "material_used", "labels_dropped") if k in rep}
+    return Reply(cut, score, engrave, sheets,
+                 json.dumps(summary, default=_plain), str(out), warnings=warnings)
+
+
+def _sheet_curves(layout: Any, tolerance: float) -> tuple[list, list, list, list]:
+    """``(cut, score, engrave, sheets)`` curves (mm) of a nesting layout: each sheet shifted
+    along x by its width and :data:`SHEET_SPACING`; outlines flattened to ``tolerance`` mm."""
+    W, H = layout.sheet
+    cut, score, engrave, sheets = [], [], [], []
+    for p, k in zip(layout.parts, layout.sheet_of):
+        dx = np.array([k * (W + SHEET_SPACING), 0.0])
+        cut.append(rhino.to_polyline(np.vstack([p.outline.flatten(tolerance),
+                                                p.outline.V[:1]]) + dx))
+        cut += [rhino.to_circle(c + dx, r) for c, r in zip(p.holes, p.radii)]
+        score += [rhino.to_polyline(s + dx) for s in p.scores]
+        engrave += [rhino.to_polyline(L + dx) for L in p.engrave]
+    for k in range(layout.n_sheets):
+        x0 = k * (W + SHEET_SPACING)
+        sheets.append(rhino.to_polyline(np.array([[x0, 0], [x0 + W, 0], [x0 + W, H],
+                                                  [x0, H], [x0, 0]], float)))
+    return cut, score, engrave, sheets
+
+
+def _net_params(hs) -> list:
+    """The outputs of a design component (GG and NCP alike: :func:`_net_outputs`)."""
+    return [hs.HopsMesh("Net", "N", "joints and net loops, metres"),
+            hs.HopsCurve("Lamellae", "L", "lamella axes, metres",
+                         access=hs.HopsParamAccess.LIST),
+            hs.HopsCurve("Aligned", "A", "lamellae through their joints when aligned",
+                         access=hs.HopsParamAccess.LIST),
+            hs.HopsString("Metrics", "M", "figures of the design (JSON)"),
+            hs.HopsString("Bundle", "B", "design bundle folder (for Verify, Fabricate)")]
+
+
+def _surface_param(hs) -> Any:
+    """The optional Surface input of the design components (a Grasshopper Mesh input would
+    mesh a surface: this one keeps it a NURBS surface, used as the B-spline it is)."""
+    return hs.HopsSurface("Surface", "S", "or a NURBS surface / single-face Brep, metres "
+                          "(used as the B-spline it is)", optional=True)
+
+
+def _gg_spec(hs) -> dict[str, Any]:
+    """The Hops declaration of ``/gg``."""
+    return dict(
         rule="/gg", name="GG design", nickname="GG",
         description="Design a geodesic alignable lamella gridshell (GG) on a target surface",
         category="Gridshell", subcategory="Design",
-        inputs=[hs.HopsMesh("Target", "T", "target surface, metres (mesh or surface)"),
+        inputs=[hs.HopsMesh("Target", "T", "target mesh, metres", optional=True),
                 hs.HopsInteger("Lamellae", "N", "lamellae per family", optional=True),
                 hs.HopsInteger("Grid", "G", "GG mesh resolution (G x G)", optional=True),
                 hs.HopsString("Options", "O", "JSON object of further design_gg keywords",
-                              optional=True)],
-        outputs=net_outputs())
-    def gg(target, lamellae=6, grid=12, opts="{}"):
-        from gridshell.api import design_gg, write
+                              optional=True),
+                _surface_param(hs)],
+        outputs=_net_params(hs))
 
-        kw = options(opts, GG_OPTIONS, "GG design")
-        kw.setdefault("frames", 0)
-        V, F = rhino.target_arrays(target)
-        if int(grid) < 4 or int(lamellae) < 2:
-            raise InputError(f"Grid {grid} and Lamellae {lamellae}: give Grid >= 4 and "
-                             "Lamellae >= 2")
-        design = design_gg((V, F), grid=(int(grid), int(grid)), n_lamellae=int(lamellae), **kw)
-        bundle = design.bundle
-        out = write(new_dir("gg"), design, render=False, frames=0)
-        return _net_outputs(bundle, out, _quality_warning(bundle))
 
-    @hops.component(
+def _ncp_spec(hs) -> dict[str, Any]:
+    """The Hops declaration of ``/ncp``."""
+    return dict(
         rule="/ncp", name="NCP design", nickname="NCP",
         description="Design a normal-curvature-preserving alignable gridshell (NCP, CNC, AA)",
         category="Gridshell", subcategory="Design",
-        inputs=[hs.HopsMesh("Reference", "R", "reference surface, metres (mesh or surface)"),
+        inputs=[hs.HopsMesh("Reference", "R", "reference mesh, metres", optional=True),
                 hs.HopsString("Mode", "M", "phlw, cnc or aa", optional=True),
                 hs.HopsInteger("Curves", "C", "curves per family", optional=True),
                 hs.HopsString("Options", "O", "JSON object of further design_ncp keywords",
-                              optional=True)],
-        outputs=net_outputs())
-    def ncp(reference, mode="cnc", curves=8, opts="{}"):
-        from gridshell.api import design_ncp, write
+                              optional=True),
+                _surface_param(hs)],
+        outputs=_net_params(hs))
 
-        kw = options(opts, NCP_OPTIONS, "NCP design")
-        V, F = rhino.target_arrays(reference)
-        design = design_ncp((V, F), mode=str(mode).strip().lower(), curves=int(curves), **kw)
-        bundle = design.bundle
-        out = write(new_dir(bundle.kind.lower()), design, render=False)
-        return _net_outputs(bundle, out, _quality_warning(bundle))
 
-    @hops.component(
+def _verify_spec(hs) -> dict[str, Any]:
+    """The Hops declaration of ``/verify``."""
+    return dict(
         rule="/verify", name="Verify design", nickname="Verify",
         description="Recompute every figure of a design bundle from its files",
         category="Gridshell", subcategory="Check",
@@ -175,19 +281,11 @@ def register(hops, workdir: Path) -> None:
                  hs.HopsString("Checks", "C", "pass / FAIL per figure",
                                access=hs.HopsParamAccess.LIST),
                  hs.HopsString("Report", "R", "the recomputed figures (JSON)")])
-    def verify(bundle_dir):
-        from gridshell.design.bundle import finite_json
-        from gridshell.design.verification import design_verdict
 
-        verdict = design_verdict(_bundle_path(bundle_dir))
-        res = verdict.report
-        warnings = [] if verdict.ok else ["the design fails its checks: " + "; ".join(
-            [g.line() for g in verdict.gates if not g.ok] + list(verdict.problems))]
-        return Reply(bool(res["ok"]), list(res["checks"]) + list(res["problems"]),
-                     json.dumps(finite_json(res), default=_plain, allow_nan=False),
-                     warnings=warnings)
 
-    @hops.component(
+def _fabricate_spec(hs) -> dict[str, Any]:
+    """The Hops declaration of ``/fabricate``."""
+    return dict(
         rule="/fabricate", name="Fabricate", nickname="Fab",
         description="Cut curves of a design bundle nested on sheets (mm), with DXF/SVG files",
         category="Gridshell", subcategory="Fabricate",
@@ -208,47 +306,32 @@ def register(hops, workdir: Path) -> None:
                               access=hs.HopsParamAccess.LIST),
                  hs.HopsString("Report", "R", "sheets, material used, pieces (JSON)"),
                  hs.HopsString("Folder", "D", "folder of the DXF / SVG files")])
+
+
+def register(hops, workdir: Path) -> None:
+    """Register the four components on ``hops`` (a ghhops_server Hops middleware); designs
+    go into new folders of ``workdir``. Each handler's parameters are its inputs in order
+    (Hops passes them so, a missing optional input as its default)."""
+    import ghhops_server as hs
+
+    def new_dir(kind: str) -> Path:
+        return workdir / f"{kind}-{uuid.uuid4().hex[:10]}"
+
+    @hops.component(**_gg_spec(hs))
+    def gg(target=None, lamellae=6, grid=12, opts="{}", surface=None):
+        return design_gg_component(new_dir, target, lamellae, grid, opts, surface)
+
+    @hops.component(**_ncp_spec(hs))
+    def ncp(reference=None, mode="cnc", curves=8, opts="{}", surface=None):
+        return design_ncp_component(new_dir, reference, mode, curves, opts, surface)
+
+    @hops.component(**_verify_spec(hs))
+    def verify(bundle_dir):
+        return verify_component(bundle_dir)
+
+    @hops.component(**_fabricate_spec(hs))
     def fab(bundle_dir, scale=None, sheet="600x400", width=None, opts="{}", force=False):
-        from dataclasses import fields
-
-        from gridshell.fabrication import FabParams, fabricate
-
-        from gridshell.design.section import resolve_section
-        from gridshell.design.verification import require_design
-
-        names = tuple(f.name for f in fields(FabParams) if f.name not in
-                      ("scale", "sheet", "width"))
-        kw = options(opts, names, "Fabricate")
-        path = _bundle_path(bundle_dir)
-        verdict = require_design(str(path), bool(force), "set Force to cut it anyway")
-        strip = resolve_section(path, width=width, thickness=kw.pop("thickness", None),
-                                scale=scale, stored=False)   # as 'gridshell fabricate'
-        params = FabParams(scale=strip.scale, sheet=sheet, width=strip.width_mm,
-                           thickness=strip.thickness_mm, **kw)
-        out = path / "fabrication"
-        rep = fabricate(path, out, params, plan=False, keep_layout=True)
-        layout = rep.pop("layout")
-        W, H = layout.sheet
-        cut, score, engrave, sheets = [], [], [], []
-        for p, k in zip(layout.parts, layout.sheet_of):
-            dx = np.array([k * (W + SHEET_SPACING), 0.0])
-            cut.append(rhino.to_polyline(np.vstack([p.outline.flatten(params.tolerance),
-                                                    p.outline.V[:1]]) + dx))
-            cut += [rhino.to_circle(c + dx, r) for c, r in zip(p.holes, p.radii)]
-            score += [rhino.to_polyline(s + dx) for s in p.scores]
-            engrave += [rhino.to_polyline(L + dx) for L in p.engrave]
-        for k in range(layout.n_sheets):
-            x0 = k * (W + SHEET_SPACING)
-            sheets.append(rhino.to_polyline(np.array([[x0, 0], [x0 + W, 0], [x0 + W, H],
-                                                      [x0, H], [x0, 0]], float)))
-        warnings = [] if verdict.ok else ["the design fails its checks; cut anyway (Force)"]
-        if rep.get("joints_fallback"):
-            warnings.append(rep["joints_fallback"])
-        summary = {k: rep[k] for k in ("kind", "shape", "n_strips", "n_pieces", "n_sheets",
-                                       "utilisation", "utilisation_per_sheet",
-                                       "material_used", "labels_dropped") if k in rep}
-        return Reply(cut, score, engrave, sheets,
-                     json.dumps(summary, default=_plain), str(out), warnings=warnings)
+        return fabricate_component(bundle_dir, scale, sheet, width, opts, force)
 
 
 def _bundle_path(text: str) -> Path:

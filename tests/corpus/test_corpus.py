@@ -217,8 +217,8 @@ def test_target_file_reads_back_as_the_reference_in_metres(tmp_path, name):
     g = read_input(str(path), units=None if ref.file_format == "3dm" else ref.units)
     V, _ = ref.mesh_arrays()
     span = np.ptp(V, axis=0).max()
-    # a .3dm mesh keeps single-precision vertices (rhino3dm); the mesh formats 17 digits
-    tol = 1e-6 if ref.file_format == "3dm" else 1e-12
+    # every format keeps the coordinates to the last digits (a .3dm in double precision)
+    tol = 1e-12
     assert g.V.shape == V.shape and np.abs(g.V - V).max() <= tol * span
 
 

@@ -84,7 +84,8 @@ def test_components_are_listed(client):
     uris = {c["Uri"] for c in r.get_json()}
     assert {"/gg", "/ncp", "/verify", "/fabricate"} <= uris
     gg = client.get("/gg").get_json()
-    assert [p["Name"] for p in gg["Inputs"]] == ["Target", "Lamellae", "Grid", "Options"]
+    assert [p["Name"] for p in gg["Inputs"]] == ["Target", "Lamellae", "Grid", "Options",
+                                                 "Surface"]
     assert [p["Name"] for p in gg["Outputs"]] == ["Net", "Lamellae", "Aligned", "Metrics",
                                                   "Bundle"]
 
