@@ -158,6 +158,40 @@ def gg_alignment_sequence(V_star: np.ndarray, aligned: np.ndarray, edges: np.nda
     -------
     GGSequence
     """
+    w, Vs, A, E, L0, L1 = _checked_inputs(V_star, aligned, edges, frames, weights)
+    placed, e, axis = line_frame(Vs, A)
+    rigid = _rigid_motion(placed, e, axis, A)
+    c = placed.mean(axis=0)
+    scale = float(np.linalg.norm(Vs.max(0) - Vs.min(0))) or 1.0
+    Xs, Xa = (Vs - c) / scale, (placed - c) / scale
+    lay, prob, Lap = _state_problem(Xs, E, w)
+    fixed = lay.mask(["L"])
+    ts = np.linspace(0.0, 1.0, int(frames) + 1)
+    out, errs, history = [Vs.copy()], [0.0], []
+    x = lay.pack({"V": Xs, "L": L0 / scale})
+    t0 = time.perf_counter()
+    for f, t in enumerate(ts[1:-1], start=1):
+        Lt = (1 - t) * L0 + t * L1
+        x, sol = _solve_state(lay, prob, Lap, x, (Xs, Xa), (ts[f - 1], t),
+                              Lt / scale, fixed, max_iter)
+        V = rigid(lay.view(x, "V") * scale + c, t)
+        out.append(V)
+        errs.append(float(np.nanmax(edge_length_errors(V, E, Lt))))
+        history.append({"frame": f, "t": float(t), "iterations": sol.iterations,
+                        "energy": sol.energy, "message": sol.message,
+                        "time": time.perf_counter() - t0})
+        if progress is not None:
+            progress(f"GG alignment state {f}/{frames}: edge lengths within "
+                     f"{100 * errs[-1]:.2g} % ({sol.iterations} iterations)")
+    out.append(A.copy())
+    errs.append(float(np.nanmax(edge_length_errors(A, E, L1))))
+    return GGSequence(V=out, t=ts, edges=E, length_error=np.asarray(errs), history=history)
+
+
+def _checked_inputs(V_star, aligned, edges, frames, weights):
+    """The weights (defaults overridden), deployed and collapsed joints, edges and the edge
+    lengths ``L0`` (deployed chords) and ``L1`` (collapsed) of a sequence; InputError naming
+    the problem otherwise."""
     w = dict(GG_SIM_WEIGHTS)
     for key, val in (weights or {}).items():
         if key not in w:
@@ -173,58 +207,53 @@ def gg_alignment_sequence(V_star: np.ndarray, aligned: np.ndarray, edges: np.nda
     E = np.asarray(edges, np.int64).reshape(-1, 2)
     if not len(E):
         raise InputError("the net has no edges between joints; nothing to align")
-    n = len(Vs)
     L0 = np.linalg.norm(Vs[E[:, 1]] - Vs[E[:, 0]], axis=1)
     L1 = np.linalg.norm(A[E[:, 1]] - A[E[:, 0]], axis=1)
     if np.any(L0 <= 0) or np.any(L1 <= 0):
         raise InputError("the net has joints at one place (zero-length edges); remove "
                          "duplicate joints before simulating the alignment")
-    placed, e, axis = line_frame(Vs, A)
-    # rigid motion carrying the placed line onto the given one: rotation about c, translation
+    return w, Vs, A, E, L0, L1
+
+
+def _rigid_motion(placed: np.ndarray, e: np.ndarray, axis: np.ndarray, A: np.ndarray):
+    """``rigid(X, t)``: the motion ``t``-way from the identity to the one carrying the placed
+    line (direction ``e``) onto the given one ``A`` (direction ``axis``): rotation about the
+    centroid by ``t`` times its angle, translation by ``t`` times its vector (metres)."""
     k_rot, theta = _rotation(e, axis)
     c = placed.mean(axis=0)
     shift = A.mean(axis=0) - c
 
     def rigid(X: np.ndarray, t: float) -> np.ndarray:
         return _rotate(X - c, k_rot, t * theta) + c + t * shift
+    return rigid
 
-    scale = float(np.linalg.norm(Vs.max(0) - Vs.min(0))) or 1.0
-    Xs, Xa = (Vs - c) / scale, (placed - c) / scale
+
+def _state_problem(Xs: np.ndarray, E: np.ndarray, w: dict[str, float]):
+    """Layout, problem (lengths, proximity, fairness) and graph Laplacian of one state
+    (scaled units)."""
+    n = len(Xs)
     lay = Layout([("V", (n, 3)), ("L", (len(E),))])
     groups = EdgeGroups("V", "L", E[:, 0], E[:, 1], np.arange(len(E)))
-    Lap = T.laplacian_matrix(n, E)
     prob = Problem(lay)
     prob.add("lengths", w["length"], equal_lengths, groups)
     prob.add("proximity", w["proximity"], T.closeness, T.Closeness("V", Xs))
+    Lap = T.laplacian_matrix(n, E)
     prob.add("fairness", w["fairness"], T.linear, T.Linear("V", Lap))
-    fixed = lay.mask(["L"])
-    ts = np.linspace(0.0, 1.0, int(frames) + 1)
-    out, errs, history = [Vs.copy()], [0.0], []
-    x = lay.pack({"V": Xs, "L": L0 / scale})
-    t0 = time.perf_counter()
-    for f, t in enumerate(ts[1:-1], start=1):
-        Lt = (1 - t) * L0 + t * L1
-        B = (1 - t) * Xs + t * Xa
-        prev = lay.view(x, "V").copy()
-        step = B - ((1 - ts[f - 1]) * Xs + ts[f - 1] * Xa)
-        x = lay.pack({"V": prev + step, "L": Lt / scale})
-        prob.set_data("proximity", T.Closeness("V", B))
-        # the Laplacian of the blend is kept: fairness pulls towards its shape, not flat
-        prob.set_data("fairness", T.Linear("V", Lap, Lap @ B))
-        # a state is a compromise (lengths against the blend): it ends when an iteration
-        # lowers the energy by less than 1e-4 (a 18-lamella dome: the same edge-length errors
-        # within 0.003 % of a length, 4 s instead of 13 s)
-        sol = solve(prob, x, fixed=fixed, method="lm", max_iter=int(max_iter), tol_rel=STATE_TOL)
-        x = sol.x
-        V = rigid(lay.view(x, "V") * scale + c, t)
-        out.append(V)
-        errs.append(float(np.nanmax(edge_length_errors(V, E, Lt))))
-        history.append({"frame": f, "t": float(t), "iterations": sol.iterations,
-                        "energy": sol.energy, "message": sol.message,
-                        "time": time.perf_counter() - t0})
-        if progress is not None:
-            progress(f"GG alignment state {f}/{frames}: edge lengths within "
-                     f"{100 * errs[-1]:.2g} % ({sol.iterations} iterations)")
-    out.append(A.copy())
-    errs.append(float(np.nanmax(edge_length_errors(A, E, L1))))
-    return GGSequence(V=out, t=ts, edges=E, length_error=np.asarray(errs), history=history)
+    return lay, prob, Lap
+
+
+def _solve_state(lay, prob, Lap, x, ends, ts, L_scaled, fixed, max_iter):
+    """One intermediate state at ``t = ts[1]`` from the previous one (at ``ts[0]``), warm
+    started by the blend's increment; returns the new vector and the solver's result."""
+    (Xs, Xa), (t_prev, t) = ends, ts
+    B = (1 - t) * Xs + t * Xa
+    step = B - ((1 - t_prev) * Xs + t_prev * Xa)
+    x = lay.pack({"V": lay.view(x, "V").copy() + step, "L": L_scaled})
+    prob.set_data("proximity", T.Closeness("V", B))
+    # the Laplacian of the blend is kept: fairness pulls towards its shape, not flat
+    prob.set_data("fairness", T.Linear("V", Lap, Lap @ B))
+    # a state is a compromise (lengths against the blend): it ends when an iteration
+    # lowers the energy by less than 1e-4 (a 18-lamella dome: the same edge-length errors
+    # within 0.003 % of a length, 4 s instead of 13 s)
+    sol = solve(prob, x, fixed=fixed, method="lm", max_iter=int(max_iter), tol_rel=STATE_TOL)
+    return sol.x, sol

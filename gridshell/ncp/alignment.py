@@ -172,78 +172,29 @@ def simulate_alignment(V_star: np.ndarray, r_star: np.ndarray, edges: np.ndarray
     max_iter : Levenberg-Marquardt iterations per frame
     project : put the last frame's joints exactly on the plane and its axes exactly in it
     """
-    w = dict(SIM_WEIGHTS)
-    for key, val in (weights or {}).items():
-        if key not in w:
-            raise InputError(f"unknown simulation weight {key!r}; weights are {', '.join(w)}")
-        w[key] = float(val)
-    if int(frames) < 1:
-        raise InputError(f"frames must be >= 1, got {frames}")
-    if int(frames) > MAX_FRAMES:
-        raise InputError(f"{frames} frames are more than the {MAX_FRAMES} supported (each is an "
-                         "optimization); ask for fewer, e.g. 12")
+    w = _checked_weights(weights, frames)
     Vs = np.asarray(V_star, float)
     rs = np.asarray(r_star, float)
-    n = len(Vs)
-    E = np.asarray(edges, np.int64).reshape(-1, 2)
     d = np.asarray(direction, float) / np.linalg.norm(direction)
     c = Vs.mean(axis=0)
     scale = float(np.linalg.norm(Vs.max(0) - Vs.min(0)))
     Xs = (Vs - c) / scale
-    j, k = vertex_pairs(E)
-    lay = Layout([("V", (n, 3)), ("r", (n, 3)), ("Vt", (n, 3)), ("rt", (n, 3))])
+    lay, prob, edge = _frame_problem(Xs, rs, np.asarray(edges, np.int64).reshape(-1, 2), d, w)
     x = lay.pack({"V": Xs, "r": rs, "Vt": Xs, "rt": rs})
     fixed = lay.mask(["Vt", "rt"])
-    inner = interior_vertices(n, E)
-    from gridshell.solver.terms import laplacian_matrix
-    Lap = laplacian_matrix(n, E, fixed_rows=np.setdiff1d(np.arange(n), inner))
-    D = np.tile(d, (n, 1))
-    density = net_density(Xs, E)  # constraints weighted as in the post-optimization
-    edge = EDGE_REF / density     # mean edge length, scaled units
-    prob = Problem(lay)
-    prob.add("length (chi_l)", w["length"] * density ** 4, edge_length_eq,
-             EdgeLength(E, "V", "Vt"))
-    prob.add("axis (chi_r)", w["axis"] * density ** 2, rotation_axis_eq,
-             AxisPairs(j, k, "V", "r", "Vt", "rt"))
-    prob.add("unit (chi_u)", w["unit"], unit_norm_eq, UnitNorm("r"))
-    prob.add("collapse points", 0.0, T.gliding, T.Gliding("V", np.zeros((n, 3)), D))
-    prob.add("collapse axes", 0.0, T.gliding, T.Gliding("r", np.zeros((n, 3)), D))
-    prob.add("proximity points", w["proximity"], T.closeness, T.Closeness("V", Xs))
-    prob.add("proximity axes", w["proximity"], T.closeness, T.Closeness("r", rs))
-    prob.add("fairness points", w["fairness"], T.linear, T.Linear("V", Lap))
-    prob.add("fairness axes", w["fairness"], T.linear, T.Linear("r", Lap))
     ts = np.linspace(0.0, 1.0, int(frames) + 1)
     Vout, rout, history = [Vs.copy()], [rs / np.linalg.norm(rs, axis=1)[:, None]], []
+    ends = None
     if aligned is not None:
         A, RA = embed_aligned(Vs, rs, aligned[0], aligned[1], d, c)
-        A = (A - c) / scale
+        ends = (Xs, rs, (A - c) / scale, RA)
     t0 = time.perf_counter()
     prev = (Xs, rs)                           # the blend of the previous frame
     lam = FRAME_DAMPING
     for f, t in enumerate(ts[1:], start=1):
-        if aligned is not None:
-            rb = (1 - t) * rs + t * RA
-            rb /= np.maximum(np.linalg.norm(rb, axis=1), 1e-12)[:, None]
-            Vb = (1 - t) * Xs + t * A
-            if WARM_START and f > 1 and t < 1:
-                # warm start: the previous frame's state moved on by the blend's increment
-                # (keeps the corrections that frame's iterations found)
-                Vw = lay.view(x, "V") + (Vb - prev[0])
-                rw = lay.view(x, "r") + (rb - prev[1])
-                rw /= np.maximum(np.linalg.norm(rw, axis=1), 1e-12)[:, None]
-            else:
-                Vw, rw = Vb, rb
-            x = lay.pack({"V": Vw, "r": rw, "Vt": Xs, "rt": rs})
-            prev = (Vb, rb)
-            prob.set_data("proximity points", T.Closeness("V", Vb))
-            prob.set_data("proximity axes", T.Closeness("r", rb))
-        for name in ("collapse points", "collapse axes"):
-            prob.set_weight(name, t * w["collapse"])
-        for name in ("proximity points", "proximity axes"):
-            prob.set_weight(name, (0.0 if t >= 1 else 1.0) * w["proximity"] if aligned is not None
-                            else (1.0 - t) * w["proximity"])
-        for name in ("fairness points", "fairness axes"):   # the aligned state is exact
-            prob.set_weight(name, 0.0 if t >= 1 else w["fairness"])
+        if ends is not None:
+            x, prev = _blend_start(lay, prob, x, ends, prev, f, t)
+        _frame_weights(prob, w, t, ends is not None)
         sol = solve(prob, x, fixed=fixed, method="lm", max_iter=int(max_iter), damping=lam,
                     tol_rel=FRAME_TOL_REL if t < 1 else 1e-10,
                     stop=None if t < 1 else still_joints(lay, x, ("V",), LAST_STILL * edge))
@@ -256,15 +207,97 @@ def simulate_alignment(V_star: np.ndarray, r_star: np.ndarray, edges: np.ndarray
         if progress is not None:
             progress(f"alignment frame {f}/{frames}: energy {sol.energy:.3e} "
                      f"({sol.iterations} iterations)")
-        V = lay.view(x, "V") * scale + c
         r = lay.view(x, "r").copy()
-        Vout.append(V)
+        Vout.append(lay.view(x, "V") * scale + c)
         rout.append(r / np.linalg.norm(r, axis=1)[:, None])
+    plane_distance = _onto_plane(Vout, rout, d, c, project)
+    return AlignmentSequence(V=Vout, r=rout, t=ts, direction=d, centroid=c,
+                             plane_distance=plane_distance, history=history)
+
+
+def _checked_weights(weights: dict[str, float] | None, frames: int) -> dict[str, float]:
+    """:data:`SIM_WEIGHTS` with the caller's overrides; InputError for an unknown weight or
+    a number of frames out of range."""
+    w = dict(SIM_WEIGHTS)
+    for key, val in (weights or {}).items():
+        if key not in w:
+            raise InputError(f"unknown simulation weight {key!r}; weights are {', '.join(w)}")
+        w[key] = float(val)
+    if int(frames) < 1:
+        raise InputError(f"frames must be >= 1, got {frames}")
+    if int(frames) > MAX_FRAMES:
+        raise InputError(f"{frames} frames are more than the {MAX_FRAMES} supported (each is an "
+                         "optimization); ask for fewer, e.g. 12")
+    return w
+
+
+def _frame_problem(Xs: np.ndarray, rs: np.ndarray, E: np.ndarray, d: np.ndarray,
+                   w: dict[str, float]):
+    """Layout and problem of one frame (scaled joints ``Xs``, axes ``rs``, collapse direction
+    ``d``) and the mean edge length in scaled units."""
+    from gridshell.solver.terms import laplacian_matrix
+
+    n = len(Xs)
+    j, k = vertex_pairs(E)
+    lay = Layout([("V", (n, 3)), ("r", (n, 3)), ("Vt", (n, 3)), ("rt", (n, 3))])
+    inner = interior_vertices(n, E)
+    Lap = laplacian_matrix(n, E, fixed_rows=np.setdiff1d(np.arange(n), inner))
+    D = np.tile(d, (n, 1))
+    density = net_density(Xs, E)  # constraints weighted as in the post-optimization
+    prob = Problem(lay)
+    prob.add("length (chi_l)", w["length"] * density ** 4, edge_length_eq,
+             EdgeLength(E, "V", "Vt"))
+    prob.add("axis (chi_r)", w["axis"] * density ** 2, rotation_axis_eq,
+             AxisPairs(j, k, "V", "r", "Vt", "rt"))
+    prob.add("unit (chi_u)", w["unit"], unit_norm_eq, UnitNorm("r"))
+    prob.add("collapse points", 0.0, T.gliding, T.Gliding("V", np.zeros((n, 3)), D))
+    prob.add("collapse axes", 0.0, T.gliding, T.Gliding("r", np.zeros((n, 3)), D))
+    prob.add("proximity points", w["proximity"], T.closeness, T.Closeness("V", Xs))
+    prob.add("proximity axes", w["proximity"], T.closeness, T.Closeness("r", rs))
+    prob.add("fairness points", w["fairness"], T.linear, T.Linear("V", Lap))
+    prob.add("fairness axes", w["fairness"], T.linear, T.Linear("r", Lap))
+    return lay, prob, EDGE_REF / density
+
+
+def _blend_start(lay, prob, x, ends, prev, f: int, t: float):
+    """Start of frame ``f`` at ``t`` from the blend of the deployed and the placed aligned
+    state ``ends = (Xs, rs, A, RA)``: the blend, or (warm start) the previous frame's state
+    moved on by the blend's increment; the proximity targets become the blend. Returns the
+    start vector and the blend."""
+    Xs, rs, A, RA = ends
+    rb = (1 - t) * rs + t * RA
+    rb /= np.maximum(np.linalg.norm(rb, axis=1), 1e-12)[:, None]
+    Vb = (1 - t) * Xs + t * A
+    if WARM_START and f > 1 and t < 1:
+        # warm start: keeps the corrections the previous frame's iterations found
+        Vw = lay.view(x, "V") + (Vb - prev[0])
+        rw = lay.view(x, "r") + (rb - prev[1])
+        rw /= np.maximum(np.linalg.norm(rw, axis=1), 1e-12)[:, None]
+    else:
+        Vw, rw = Vb, rb
+    prob.set_data("proximity points", T.Closeness("V", Vb))
+    prob.set_data("proximity axes", T.Closeness("r", rb))
+    return lay.pack({"V": Vw, "r": rw, "Vt": Xs, "rt": rs}), (Vb, rb)
+
+
+def _frame_weights(prob, w: dict[str, float], t: float, blended: bool) -> None:
+    """The weights of frame ``t``: collapse ``t`` times its weight; proximity off in the last
+    frame of a blended sequence, else fading as ``1 - t``; fairness off in the last frame."""
+    for name in ("collapse points", "collapse axes"):
+        prob.set_weight(name, t * w["collapse"])
+    for name in ("proximity points", "proximity axes"):
+        prob.set_weight(name, (0.0 if t >= 1 else 1.0) * w["proximity"] if blended
+                        else (1.0 - t) * w["proximity"])
+    for name in ("fairness points", "fairness axes"):   # the aligned state is exact
+        prob.set_weight(name, 0.0 if t >= 1 else w["fairness"])
+
+
+def _onto_plane(Vout: list, rout: list, d: np.ndarray, c: np.ndarray, project: bool) -> float:
+    """Largest distance (metres) of the last frame's joints from the collapse plane; with
+    ``project``, its joints put on the plane and its axes in it (in place)."""
     off = (Vout[-1] - c) @ d
-    plane_distance = float(np.max(np.abs(off)))
     if project:
         Vout[-1] = Vout[-1] - off[:, None] * d[None, :]
         r = rout[-1] - (rout[-1] @ d)[:, None] * d[None, :]
         rout[-1] = r / np.linalg.norm(r, axis=1)[:, None]
-    return AlignmentSequence(V=Vout, r=rout, t=ts, direction=d, centroid=c,
-                             plane_distance=plane_distance, history=history)
+    return float(np.max(np.abs(off)))
