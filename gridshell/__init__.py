@@ -10,7 +10,7 @@ from gridshell.core.version import __version__  # noqa: F401
 
 _moved.install()
 
-__all__ = ["Design", "DesignBundle", "check_structure", "design_gg", "design_ncp", "export_3dm",
+__all__ = ["Design", "DesignBundle", "analyze", "check_structure", "design_gg", "design_ncp", "export_3dm",
            "fabricate", "optimize_phlw", "read", "simulate", "verify", "write", "write_outputs"]
 
 

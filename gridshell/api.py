@@ -5,6 +5,7 @@
     import gridshell as gs
 
     design = gs.design_gg("target.obj", grid=(16, 16), n_lamellae=8)   # or gs.design_ncp(...)
+    gs.analyze("target.obj").recommendation      # before any design: which pipeline and mode
     gs.write("out/gg", design)                  # the design bundle (same layout for every kind)
     gs.verify("out/gg")["ok"]                   # the figures recomputed from the files
     gs.fabricate("out/gg", "out/gg/fabrication", {"width": 20, "scale": "1:10"})
@@ -27,7 +28,7 @@ from gridshell.design.bundle import Design, DesignBundle, read_bundle, write_bun
 from gridshell.core.errors import InputError
 from gridshell.design.verification import require_design, verify_bundle
 
-__all__ = ["Design", "DesignBundle", "check_structure", "design_gg", "design_ncp", "export_3dm",
+__all__ = ["Design", "DesignBundle", "analyze", "check_structure", "design_gg", "design_ncp", "export_3dm",
            "fabricate", "optimize_phlw", "read", "simulate", "verify", "write", "write_outputs"]
 
 Progress = Callable[[str], None] | None
@@ -37,6 +38,22 @@ Progress = Callable[[str], None] | None
 # NCP nor PHLW: ~0.2 s of a command) and looked up at each call (a test or a plug-in
 # replacing gridshell.gg.pipeline.design_gg reaches the CLI and the API alike). Each function
 # spells out its pipeline's parameters (tests/test_api.py keeps names and defaults the same).
+def analyze(target: Any, *, units: Any = None, clean: bool = True, obj: str | None = None,
+            samples: int = 64, trial: bool = True, min_coverage: float = 50.0,
+            output: str | os.PathLike | None = None) -> Any:
+    """Where each kind of net can exist on ``target`` and which pipeline and mode to run
+    (:func:`gridshell.analysis.analyze.analyze_target`; an
+    :class:`~gridshell.analysis.analyze.Analysis`); with ``output`` also the directory of
+    analysis.json and analysis.png (:func:`~gridshell.analysis.analyze.write_analysis`)."""
+    from gridshell.analysis.analyze import analyze_target, write_analysis
+
+    a = analyze_target(target, units=units, clean=clean, obj=obj, samples=samples, trial=trial,
+                       min_coverage=min_coverage)
+    if output is not None:
+        write_analysis(a, output)
+    return a
+
+
 def design_gg(target: Any, *, meridians: str = "cols", grid: tuple[int, int] | None = None,
               direction: float | None = None, n_lamellae: int | None = 10,
               spacing: float | None = None, crossing_angle: float = 90.0,

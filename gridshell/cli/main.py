@@ -19,6 +19,7 @@ from gridshell.core.errors import GridshellError
 
 #: subcommand name -> module in gridshell.cli with ``HELP``, ``add_args(parser)`` and ``run(args)``
 SUBCOMMANDS: dict[str, str] = {
+    "analyze": "analyze",
     "gg": "gg",
     "phlw": "phlw",
     "ncp": "ncp",

@@ -1,0 +1,89 @@
+"""``gridshell analyze``: before any design, where each kind of net can exist on a target and
+which pipeline and mode to run (:func:`gridshell.api.analyze`)."""
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Any
+
+HELP = ("before any design: where GG and each NCP mode can exist on a target (K sign, umbilic "
+        "regions, the largest admissible patch, a quick GG trial), the pipeline to run; writes "
+        "analysis.json and analysis.png")
+
+
+def add_args(p: argparse.ArgumentParser) -> None:
+    from gridshell.analysis.recommend import MIN_COVERAGE
+    from gridshell.cli.common import add_input_args
+
+    p.add_argument("target", help="target surface: a mesh (OBJ, PLY, OFF) or a Rhino .3dm (mesh, "
+                                  "NURBS surface or single-face Brep), one disk")
+    add_input_args(p)
+    p.add_argument("-o", "--output", metavar="DIR",
+                   help="directory for analysis.json and analysis.png (default: TARGET's name "
+                        "+ '-analysis' in the current directory; replaced only if it is an "
+                        "earlier analysis or empty)")
+    p.add_argument("--samples", type=int, default=64, metavar="N",
+                   help="samples of the fitted surface per parameter direction (8..400; "
+                        "default 64)")
+    p.add_argument("--min-coverage", type=float, default=MIN_COVERAGE, metavar="PCT",
+                   help="share of the target an NCP mode's largest regular patch must cover to "
+                        f"be recommended, %% (default {MIN_COVERAGE:g})")
+    p.add_argument("--no-trial", action="store_true",
+                   help="skip the quick coarse GG design (then GG's deviation is not known)")
+    p.add_argument("--no-files", action="store_true",
+                   help="print the summary only; write nothing")
+
+
+def _check(args: Any) -> Path | None:
+    """Refuse bad options before any work; the output directory (None with --no-files)."""
+    from gridshell.core.atomic import check_output
+    from gridshell.core.errors import InputError
+
+    if not 8 <= args.samples <= 400:
+        raise InputError(f"--samples {args.samples}: give 8 to 400 samples per direction")
+    if not 0.0 <= args.min_coverage <= 100.0:
+        raise InputError(f"--min-coverage {args.min_coverage:g}: give a share from 0 to 100 %")
+    if args.no_files:
+        return None
+    out = Path(args.output) if args.output else Path(f"{Path(args.target).stem}-analysis")
+    return check_output(out, owner="analyze")
+
+
+def run(args: Any) -> int:
+    from gridshell.api import analyze
+    from gridshell.cli.common import Progress, input_options, print_summary
+
+    out = _check(args)
+    progress = Progress(args)
+    progress(f"analysing {args.target}")
+    a = analyze(args.target, **input_options(args), samples=args.samples,
+                trial=not args.no_trial, min_coverage=args.min_coverage, output=out)
+    summary = summary_of(a)
+    if out is not None:
+        summary["files"] = f"{out / 'analysis.json'}, {out / 'analysis.png'}"
+    print_summary(args, f"gridshell analyze: {args.target}", summary)
+    return 0
+
+
+def summary_of(a: Any) -> dict[str, Any]:
+    """The one-screen summary of an :class:`~gridshell.analysis.analyze.Analysis`."""
+    t, rec = a.target, a.recommendation
+    d = {"target": f"{t['vertices']} vertices, {t['faces']} faces, {t['units']}, diagonal "
+                   f"{t['diagonal_m']:.3g} m; {t['surface']}",
+         "classes [%]": {k: round(v, 1) for k, v in a.classes.items()}}
+    big = sorted(a.regions, key=lambda r: -r.share)[:4]
+    d["regions"] = "; ".join(f"{r.kind} {100 * r.share:.0f} % at ({r.centre[0]:.2f}, "
+                             f"{r.centre[1]:.2f}, {r.centre[2]:.2f}) m" for r in big) or "-"
+    d["NCP largest regular patch [%]"] = {m: round(c, 1) for m, c in a.coverage.items()}
+    if a.gg is None:
+        d["GG trial"] = "not run (--no-trial)"
+    elif a.gg.error:
+        d["GG trial"] = f"failed: {a.gg.error}"
+    else:
+        d["GG trial"] = (f"deviation mean {a.gg.deviation_mean:.2f} %, max "
+                         f"{a.gg.deviation_max:.2f} % of the diagonal; net covers "
+                         f"{a.gg.coverage:.0f} % ({a.gg.seconds:.1f} s, coarse)")
+    d["recommended"] = rec.command
+    d["why"] = rec.why
+    d["time [s]"] = round(a.seconds, 2)
+    return d
