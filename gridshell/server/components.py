@@ -7,6 +7,9 @@ route          inputs                                                   outputs
                                                                         Aligned, Metrics,
                                                                         Bundle
 ``/ncp``       Reference (mesh, m), Mode, Curves, Options, Surface      (as ``/gg``)
+``/analyze``   Target (mesh, m), Samples, Surface (m)                   Recommended, Why,
+                                                                        Summary, Report,
+                                                                        Folder
 ``/verify``    Bundle                                                   OK, Checks, Report
 ``/fabricate`` Bundle, Scale, Sheet, Width, Options, Force              Cut, Score,
                                                                         Engrave, Sheets,
@@ -156,6 +159,26 @@ def _one_target(mesh: Any, surface: Any, name: str) -> Any:
     return mesh if surface is None else surface
 
 
+def analyze_component(new_dir: Callable[[str], Path], target: Any = None, samples: int = 64,
+                      surface: Any = None) -> Reply:
+    """The ``/analyze`` component: where each kind of net can exist on ``target`` (a Rhino
+    mesh) or ``surface`` (NURBS), metres, and the pipeline to run
+    (:func:`gridshell.api.analyze`); analysis.json and analysis.png in ``new_dir("analysis")``."""
+    from gridshell.api import analyze
+    from gridshell.cli.analyze import summary_of
+    from gridshell.design.bundle import finite_json
+
+    if not 8 <= int(samples) <= 400:
+        raise InputError(f"Samples {samples}: give 8 to 400 samples per direction")
+    geo = rhino.target_input(_one_target(target, surface, "Target"))
+    out = new_dir("analysis")
+    a = analyze(geo, samples=int(samples), output=out)
+    lines = [f"{k}: {v}" for k, v in summary_of(a).items()]
+    rec = a.recommendation
+    return Reply(rec.command, rec.why, lines,
+                 json.dumps(finite_json(a.as_dict()), default=_plain, allow_nan=False), str(out))
+
+
 def verify_component(bundle_dir: str) -> Reply:
     """The ``/verify`` component: OK, the pass / FAIL lines and the recomputed figures (JSON)
     of the bundle at ``bundle_dir`` (:func:`gridshell.design.verification.design_verdict`)."""
@@ -270,6 +293,25 @@ def _ncp_spec(hs) -> dict[str, Any]:
         outputs=_net_params(hs))
 
 
+def _analyze_spec(hs) -> dict[str, Any]:
+    """The Hops declaration of ``/analyze``."""
+    return dict(
+        rule="/analyze", name="Analyze target", nickname="Analyze",
+        description="Before any design: where GG and each NCP mode can exist on a target, and "
+                    "the pipeline to run",
+        category="Gridshell", subcategory="Check",
+        inputs=[hs.HopsMesh("Target", "T", "target mesh, metres", optional=True),
+                hs.HopsInteger("Samples", "N", "curvature samples per direction (8..400)",
+                               optional=True),
+                _surface_param(hs)],
+        outputs=[hs.HopsString("Recommended", "R", "the command to run"),
+                 hs.HopsString("Why", "W", "why that pipeline and mode"),
+                 hs.HopsString("Summary", "S", "the analysis, one line per item",
+                               access=hs.HopsParamAccess.LIST),
+                 hs.HopsString("Report", "J", "analysis.json (JSON)"),
+                 hs.HopsString("Folder", "D", "folder of analysis.json and analysis.png")])
+
+
 def _verify_spec(hs) -> dict[str, Any]:
     """The Hops declaration of ``/verify``."""
     return dict(
@@ -309,7 +351,7 @@ def _fabricate_spec(hs) -> dict[str, Any]:
 
 
 def register(hops, workdir: Path) -> None:
-    """Register the four components on ``hops`` (a ghhops_server Hops middleware); designs
+    """Register the five components on ``hops`` (a ghhops_server Hops middleware); designs
     go into new folders of ``workdir``. Each handler's parameters are its inputs in order
     (Hops passes them so, a missing optional input as its default)."""
     import ghhops_server as hs
@@ -324,6 +366,10 @@ def register(hops, workdir: Path) -> None:
     @hops.component(**_ncp_spec(hs))
     def ncp(reference=None, mode="cnc", curves=8, opts="{}", surface=None):
         return design_ncp_component(new_dir, reference, mode, curves, opts, surface)
+
+    @hops.component(**_analyze_spec(hs))
+    def analyze(target=None, samples=64, surface=None):
+        return analyze_component(new_dir, target, samples, surface)
 
     @hops.component(**_verify_spec(hs))
     def verify(bundle_dir):
