@@ -22,7 +22,7 @@ from gridshell.analysis.recommend import MIN_COVERAGE, Recommendation, recommend
 from gridshell.analysis.regions import Rectangle, Region, largest_rectangle, regions
 from gridshell.analysis.trial import GGTrial, gg_trial
 
-__all__ = ["ANALYSIS_FACES", "Analysis", "analyze_target", "write_analysis"]
+__all__ = ["ANALYSIS_FACES", "Analysis", "analyze_target", "summary_of", "write_analysis"]
 
 #: faces of the working copy the analysis runs on (a 200k-triangle target is decimated)
 ANALYSIS_FACES = 20000
@@ -160,3 +160,27 @@ def write_analysis(a: Analysis, out: str | Path) -> dict[str, Path]:
         (tmp / "analysis.png").write_bytes(png)
         (tmp / "analysis.json").write_text(text)
     return {"json": out / "analysis.json", "png": out / "analysis.png"}
+
+
+def summary_of(a: Analysis) -> dict[str, Any]:
+    """The one-screen summary of an :class:`Analysis` (the CLI's and the server's)."""
+    t, rec = a.target, a.recommendation
+    d = {"target": f"{t['vertices']} vertices, {t['faces']} faces, {t['units']}, diagonal "
+                   f"{t['diagonal_m']:.3g} m; {t['surface']}",
+         "classes [%]": {k: round(v, 1) for k, v in a.classes.items()}}
+    big = sorted(a.regions, key=lambda r: -r.share)[:4]
+    d["regions"] = "; ".join(f"{r.kind} {100 * r.share:.0f} % at ({r.centre[0]:.2f}, "
+                             f"{r.centre[1]:.2f}, {r.centre[2]:.2f}) m" for r in big) or "-"
+    d["NCP largest regular patch [%]"] = {m: round(c, 1) for m, c in a.coverage.items()}
+    if a.gg is None:
+        d["GG trial"] = "not run (--no-trial)"
+    elif a.gg.error:
+        d["GG trial"] = f"failed: {a.gg.error}"
+    else:
+        d["GG trial"] = (f"deviation mean {a.gg.deviation_mean:.2f} %, max "
+                         f"{a.gg.deviation_max:.2f} % of the diagonal; net covers "
+                         f"{a.gg.coverage:.0f} % ({a.gg.seconds:.1f} s, coarse)")
+    d["recommended"] = rec.command
+    d["why"] = rec.why
+    d["time [s]"] = round(a.seconds, 2)
+    return d

@@ -50,6 +50,7 @@ def _check(args: Any) -> Path | None:
 
 
 def run(args: Any) -> int:
+    from gridshell.analysis.analyze import summary_of
     from gridshell.api import analyze
     from gridshell.cli.common import Progress, input_options, print_summary
 
@@ -63,27 +64,3 @@ def run(args: Any) -> int:
         summary["files"] = f"{out / 'analysis.json'}, {out / 'analysis.png'}"
     print_summary(args, f"gridshell analyze: {args.target}", summary)
     return 0
-
-
-def summary_of(a: Any) -> dict[str, Any]:
-    """The one-screen summary of an :class:`~gridshell.analysis.analyze.Analysis`."""
-    t, rec = a.target, a.recommendation
-    d = {"target": f"{t['vertices']} vertices, {t['faces']} faces, {t['units']}, diagonal "
-                   f"{t['diagonal_m']:.3g} m; {t['surface']}",
-         "classes [%]": {k: round(v, 1) for k, v in a.classes.items()}}
-    big = sorted(a.regions, key=lambda r: -r.share)[:4]
-    d["regions"] = "; ".join(f"{r.kind} {100 * r.share:.0f} % at ({r.centre[0]:.2f}, "
-                             f"{r.centre[1]:.2f}, {r.centre[2]:.2f}) m" for r in big) or "-"
-    d["NCP largest regular patch [%]"] = {m: round(c, 1) for m, c in a.coverage.items()}
-    if a.gg is None:
-        d["GG trial"] = "not run (--no-trial)"
-    elif a.gg.error:
-        d["GG trial"] = f"failed: {a.gg.error}"
-    else:
-        d["GG trial"] = (f"deviation mean {a.gg.deviation_mean:.2f} %, max "
-                         f"{a.gg.deviation_max:.2f} % of the diagonal; net covers "
-                         f"{a.gg.coverage:.0f} % ({a.gg.seconds:.1f} s, coarse)")
-    d["recommended"] = rec.command
-    d["why"] = rec.why
-    d["time [s]"] = round(a.seconds, 2)
-    return d

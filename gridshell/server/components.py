@@ -165,7 +165,7 @@ def analyze_component(new_dir: Callable[[str], Path], target: Any = None, sample
     mesh) or ``surface`` (NURBS), metres, and the pipeline to run
     (:func:`gridshell.api.analyze`); analysis.json and analysis.png in ``new_dir("analysis")``."""
     from gridshell.api import analyze
-    from gridshell.cli.analyze import summary_of
+    from gridshell.analysis.analyze import summary_of
     from gridshell.design.bundle import finite_json
 
     if not 8 <= int(samples) <= 400:
