@@ -26,8 +26,8 @@ surface):
 and per alignment state, the net-loops that **fold** (the loop's vector area turns by more
 than 90 degrees from one state to the next while the loop still has area).
 
-:func:`fairness_gates` turns them into :class:`~gridshell.measure.quality.Gate` objects that
-name the lamella and the position (arc length along it, metres).
+:func:`gridshell.measure.quality.fairness_gates` turns the record into gates that name the
+lamella and the position (arc length along it, metres).
 """
 from __future__ import annotations
 
@@ -38,10 +38,9 @@ from typing import Iterable, Mapping, Sequence
 import numpy as np
 
 from gridshell.geometry.diffgeo import normal_geodesic_curvature, polyline_curvature
-from gridshell.measure.quality import Gate
 
 __all__ = ["BEND_WIDTHS", "CORNER_DEG", "FAIR_RADIUS_WIDTHS", "HAIRPIN_DEG", "HAIRPIN_WIDTHS", "OFF_SURFACE",
-           "LamellaFairness", "fairness_gates", "fairness_metrics", "folded_loops",
+           "LamellaFairness", "fairness_metrics", "folded_loops",
            "lamella_fairness"]
 
 #: smallest in-plane radius of a strip, in strip widths at the built scale
@@ -274,67 +273,3 @@ def fairness_metrics(lamellae: Iterable[tuple[int, np.ndarray]], V: np.ndarray, 
             "lamellae": [f.as_dict() for f in per],
             "folds": [{"state": k, "loop": j} for k, j in folds],
             "n_states": 0 if states is None else len(states)}
-
-
-def _worst(lams: list[Mapping], key: str, largest: bool) -> Mapping | None:
-    vals = [d for d in lams if d.get(key) is not None]
-    if not vals:
-        return None
-    return (max if largest else min)(vals, key=lambda d: d[key])
-
-
-def fairness_gates(fair: Mapping | None) -> list[Gate]:
-    """The gates of ``metrics["fairness"]`` (:func:`fairness_metrics`): smallest in-plane
-    radius, corners, hairpins, loops, distance from the surface, folds; each failing gate
-    names the lamella (or state and loop) and the arc length. None (a design made before
-    fairness was measured) gives no gates."""
-    if not fair:
-        return []
-    lams = list(fair.get("lamellae") or [])
-    lim = fair["limits"]
-    gates = []
-    w = _worst(lams, "radius_in_plane_m", largest=False)
-    rmin = lim["radius_in_plane_m"]
-    if w is None and lams:
-        gates.append(Gate("fair_radius", "smallest in-plane radius", held=True,
-                          detail="no lamella is bent in its plane"))
-    if w is not None:
-        ok = w["radius_in_plane_m"] >= rmin
-        gates.append(Gate("fair_radius", "smallest in-plane radius", held=ok, detail=(
-            f"{w['radius_in_plane_m']:.3g} m (lamella {w['id']} at s = {w['s_in_plane_m']:.3g}"
-            f" m) {'>=' if ok else '<'} {rmin:.3g} m = {FAIR_RADIUS_WIDTHS:g} strip widths")))
-    w = _worst(lams, "radius_m", largest=False)
-    if w is not None and "radius_m" in lim:
-        ok = w["radius_m"] >= lim["radius_m"]
-        gates.append(Gate("fair_bend", "smallest radius in space", held=ok, detail=(
-            f"{w['radius_m']:.3g} m (lamella {w['id']} at s = {w['s_radius_m']:.3g} m) "
-            f"{'>=' if ok else '<'} {lim['radius_m']:.3g} m = {BEND_WIDTHS:g} strip width")))
-    for key, s_key, name, label, limit in (
-            ("corner_deg", "s_corner_m", "fair_corner", "largest turn at one sample",
-             lim["corner_deg"]),
-            ("hairpin_deg", "s_hairpin_m", "fair_hairpin",
-             f"largest turn within {lim['hairpin_window_m']:.3g} m", lim["hairpin_deg"]),
-            ("off_surface_percent", "s_off_m", "fair_surface",
-             "largest distance of a lamella from the surface", lim["off_surface_percent"])):
-        w = _worst(lams, key, largest=True)
-        if w is None:
-            continue
-        unit = " %" if key == "off_surface_percent" else " deg"
-        ok = w[key] <= limit
-        gates.append(Gate(name, label, held=ok, detail=(
-            f"{w[key]:.3g}{unit} (lamella {w['id']} at s = {w[s_key]:.3g} m) "
-            f"{'<=' if ok else '>'} {limit:g}{unit}")))
-    loops = [d for d in lams if d.get("loop_s_m")]
-    gates.append(Gate("fair_loop", "no lamella crosses itself", held=not loops, detail=(
-        "none" if not loops else "; ".join(
-            f"lamella {d['id']} at s = {d['loop_s_m'][0]:.3g} and {d['loop_s_m'][1]:.3g} m"
-            for d in loops[:3]) + (f" (+{len(loops) - 3} more)" if len(loops) > 3 else ""))))
-    if fair.get("n_states", 0) > 1:
-        folds = list(fair.get("folds") or [])
-        states = sorted({f["state"] for f in folds})
-        gates.append(Gate("fair_fold", "no net-loop folds in the alignment", held=not folds,
-                          detail="none" if not folds else (
-                              f"{len(folds)} folds in {len(states)} of "
-                              f"{fair['n_states'] - 1} states (first: state {folds[0]['state']}"
-                              f", loop {folds[0]['loop']})")))
-    return gates

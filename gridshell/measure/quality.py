@@ -19,8 +19,8 @@ import math
 from dataclasses import dataclass
 from typing import Any, Mapping
 
-__all__ = ["THRESHOLDS", "Gate", "design_gates", "failing", "gate_lines", "gate_summary",
-           "passed"]
+__all__ = ["THRESHOLDS", "Gate", "design_gates", "failing", "fairness_gates", "gate_lines",
+           "gate_summary", "passed"]
 
 #: figure -> (label, limit in %); a figure passes when it is finite and strictly below its limit
 THRESHOLDS: dict[str, tuple[str, float]] = {
@@ -106,18 +106,21 @@ def design_gates(kind: str, metrics: Mapping[str, Any]) -> list[Gate]:
 
     GG metrics: ``alignability`` and ``alignability_arc`` (``{"mean", "max"}``). NCP metrics:
     ``delta_a_after`` (or ``alignability``), ``delta_l``, ``delta_n`` (``{"mean", "max"}``),
-    and ``aligned_radius_error`` (CNC) or ``aligned_line_error`` (AA).
+    and ``aligned_radius_error`` (CNC) or ``aligned_line_error`` (AA). Both: ``fairness``
+    (:func:`gridshell.measure.fairness.fairness_metrics`), when measured, adds the fairness
+    gates (:func:`fairness_gates`).
     """
     def gate(name: str, value: float | None) -> Gate:
         label, limit = THRESHOLDS[name]
         return Gate(name, label, value, limit)
 
     kind = str(kind).upper()
+    fair = fairness_gates(metrics.get("fairness"))
     if kind == "GG":
         return [gate("delta_a_mean", _get(metrics, "alignability", "mean")),
                 gate("delta_a_max", _get(metrics, "alignability", "max")),
                 gate("delta_a_arc_mean", _get(metrics, "alignability_arc", "mean")),
-                gate("delta_a_arc_max", _get(metrics, "alignability_arc", "max"))]
+                gate("delta_a_arc_max", _get(metrics, "alignability_arc", "max"))] + fair
     if kind not in ("NCP", "CNC", "AA"):
         raise ValueError(f"unknown design kind {kind!r}; expected GG, NCP, CNC or AA")
     da = "delta_a_after" if "delta_a_after" in metrics else "alignability"
@@ -129,7 +132,7 @@ def design_gates(kind: str, metrics: Mapping[str, Any]) -> list[Gate]:
         gates.append(gate("collapse_error", _get(metrics, "aligned_radius_error")))
     elif kind == "AA":
         gates.append(gate("collapse_error", _get(metrics, "aligned_line_error")))
-    return gates
+    return gates + fair
 
 
 def passed(gates: list[Gate]) -> bool:
@@ -155,3 +158,67 @@ def gate_summary(gates: list[Gate]) -> str:
         return f"all {len(gates)} figures within the paper's thresholds"
     return f"{len(bad)} of {len(gates)} figures fail: " + ", ".join(
         g.line().split("  ", 1)[1] for g in bad)
+
+
+def _worst(lams: list[Mapping], key: str, largest: bool) -> Mapping | None:
+    vals = [d for d in lams if d.get(key) is not None]
+    if not vals:
+        return None
+    return (max if largest else min)(vals, key=lambda d: d[key])
+
+
+def fairness_gates(fair: Mapping | None) -> list[Gate]:
+    """The gates of ``metrics["fairness"]`` (:func:`gridshell.measure.fairness.fairness_metrics`): smallest in-plane
+    radius, corners, hairpins, loops, distance from the surface, folds; each failing gate
+    names the lamella (or state and loop) and the arc length. None (a design made before
+    fairness was measured) gives no gates."""
+    if not fair:
+        return []
+    lams = list(fair.get("lamellae") or [])
+    lim = fair["limits"]
+    gates = []
+    w = _worst(lams, "radius_in_plane_m", largest=False)
+    rmin = lim["radius_in_plane_m"]
+    if w is None and lams:
+        gates.append(Gate("fair_radius", "smallest in-plane radius", held=True,
+                          detail="no lamella is bent in its plane"))
+    if w is not None:
+        ok = w["radius_in_plane_m"] >= rmin
+        gates.append(Gate("fair_radius", "smallest in-plane radius", held=ok, detail=(
+            f"{w['radius_in_plane_m']:.3g} m (lamella {w['id']} at s = {w['s_in_plane_m']:.3g}"
+            f" m) {'>=' if ok else '<'} {rmin:.3g} m = {rmin / fair['width_m']:.3g} strip widths")))
+    w = _worst(lams, "radius_m", largest=False)
+    if w is not None and "radius_m" in lim:
+        ok = w["radius_m"] >= lim["radius_m"]
+        gates.append(Gate("fair_bend", "smallest radius in space", held=ok, detail=(
+            f"{w['radius_m']:.3g} m (lamella {w['id']} at s = {w['s_radius_m']:.3g} m) "
+            f"{'>=' if ok else '<'} {lim['radius_m']:.3g} m = {lim['radius_m'] / fair['width_m']:.3g} strip width")))
+    for key, s_key, name, label, limit in (
+            ("corner_deg", "s_corner_m", "fair_corner", "largest turn at one sample",
+             lim["corner_deg"]),
+            ("hairpin_deg", "s_hairpin_m", "fair_hairpin",
+             f"largest turn within {lim['hairpin_window_m']:.3g} m", lim["hairpin_deg"]),
+            ("off_surface_percent", "s_off_m", "fair_surface",
+             "largest distance of a lamella from the surface", lim["off_surface_percent"])):
+        w = _worst(lams, key, largest=True)
+        if w is None:
+            continue
+        unit = " %" if key == "off_surface_percent" else " deg"
+        ok = w[key] <= limit
+        gates.append(Gate(name, label, held=ok, detail=(
+            f"{w[key]:.3g}{unit} (lamella {w['id']} at s = {w[s_key]:.3g} m) "
+            f"{'<=' if ok else '>'} {limit:g}{unit}")))
+    loops = [d for d in lams if d.get("loop_s_m")]
+    gates.append(Gate("fair_loop", "no lamella crosses itself", held=not loops, detail=(
+        "none" if not loops else "; ".join(
+            f"lamella {d['id']} at s = {d['loop_s_m'][0]:.3g} and {d['loop_s_m'][1]:.3g} m"
+            for d in loops[:3]) + (f" (+{len(loops) - 3} more)" if len(loops) > 3 else ""))))
+    if fair.get("n_states", 0) > 1:
+        folds = list(fair.get("folds") or [])
+        states = sorted({f["state"] for f in folds})
+        gates.append(Gate("fair_fold", "no net-loop folds in the alignment", held=not folds,
+                          detail="none" if not folds else (
+                              f"{len(folds)} folds in {len(states)} of "
+                              f"{fair['n_states'] - 1} states (first: state {folds[0]['state']}"
+                              f", loop {folds[0]['loop']})")))
+    return gates

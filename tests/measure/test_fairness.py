@@ -5,8 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from gridshell.measure.fairness import (FAIR_RADIUS_WIDTHS, fairness_gates, fairness_metrics,
-                                        folded_loops, lamella_fairness)
+from gridshell.measure.fairness import (FAIR_RADIUS_WIDTHS, fairness_metrics, folded_loops,
+                                        lamella_fairness)
+from gridshell.measure.quality import design_gates, fairness_gates
 
 W = 0.2          # strip width at the built scale, metres
 
@@ -129,3 +130,15 @@ def test_folds_of_an_alignment_sequence():
 
 def test_no_fairness_record_no_gates():
     assert fairness_gates(None) == []
+
+
+def test_design_gates_include_fairness_when_measured():
+    P, _ = _plane_circle(0.5)                            # bent in its plane to 0.5 m < 2 m
+    m = {"alignability": {"mean": 0.1, "max": 0.2}, "alignability_arc": {"mean": 0.1, "max": 0.2},
+         "fairness": fairness_metrics([(3, P)], *_plane(), tangent=True, width=W)}
+    gates = design_gates("GG", m)
+    assert [g.name for g in gates][:4] == ["delta_a_mean", "delta_a_max", "delta_a_arc_mean",
+                                          "delta_a_arc_max"]
+    bad = [g for g in gates if not g.ok]
+    assert [g.name for g in bad] == ["fair_radius"] and "lamella 3" in bad[0].line()
+    assert len(design_gates("GG", {k: v for k, v in m.items() if k != "fairness"})) == 4
