@@ -124,16 +124,35 @@ def trace_geodesic(rev: Revolution | Profile, s0: float, phi0: float, xi0: float
     if not (s_range[0] - 1e-12 * length <= s0 <= s_range[1] + 1e-12 * length):
         raise InputError(f"start s0 = {s0} lies outside the profile range {s_range}")
     if both:
-        fw = trace_geodesic(prof, s0, phi0, xi0, s_range=s_range, phi_range=phi_range,
-                            max_length=max_length, step=step, derivatives=True)
-        bw = trace_geodesic(prof, s0, phi0, xi0 + np.pi, s_range=s_range, phi_range=phi_range,
-                            max_length=max_length, step=step, derivatives=True)
-        out = (np.concatenate([bw[0][::-1], fw[0][1:]]),
-               np.concatenate([bw[1][::-1], fw[1][1:]]),
-               np.concatenate([-bw[2][::-1], fw[2][1:]]),
-               np.concatenate([-bw[3][::-1], fw[3][1:]]),
-               np.concatenate([-bw[4][::-1], fw[4][1:]]))
-        return out if derivatives else out[:3]
+        out = _trace_both_ways(prof, s0, phi0, xi0, s_range, phi_range, max_length, step)
+    else:
+        out = _trace_one_way(prof, s0, phi0, xi0, s_range, phi_range, max_length, step)
+    return out if derivatives else out[:3]
+
+
+def _trace_both_ways(prof: Profile, s0: float, phi0: float, xi0: float,
+                     s_range: tuple[float, float], phi_range: tuple[float, float] | None,
+                     max_length: float | None, step: float | None) -> tuple[np.ndarray, ...]:
+    """:func:`trace_geodesic` forwards and backwards (``xi0 + pi``) from the start, joined:
+    ``(s, phi, sigma, ds, dphi)`` with ``sigma`` from negative through 0 at the start."""
+    fw = trace_geodesic(prof, s0, phi0, xi0, s_range=s_range, phi_range=phi_range,
+                        max_length=max_length, step=step, derivatives=True)
+    bw = trace_geodesic(prof, s0, phi0, xi0 + np.pi, s_range=s_range, phi_range=phi_range,
+                        max_length=max_length, step=step, derivatives=True)
+    return (np.concatenate([bw[0][::-1], fw[0][1:]]),
+            np.concatenate([bw[1][::-1], fw[1][1:]]),
+            np.concatenate([-bw[2][::-1], fw[2][1:]]),
+            np.concatenate([-bw[3][::-1], fw[3][1:]]),
+            np.concatenate([-bw[4][::-1], fw[4][1:]]))
+
+
+def _trace_one_way(prof: Profile, s0: float, phi0: float, xi0: float,
+                   s_range: tuple[float, float], phi_range: tuple[float, float] | None,
+                   max_length: float | None, step: float | None) -> tuple[np.ndarray, ...]:
+    """The geodesic equations integrated from ``(s0, phi0)`` at ``xi0`` to the domain's
+    boundary (DOP853, :data:`RTOL`) and sampled every ``step`` of arc length:
+    ``(s, phi, sigma, ds, dphi)``, metres and radians, the last sample the exact end state."""
+    length = s_range[1] - s_range[0]
     max_length = 50.0 * length if max_length is None else float(max_length)
     step = length / 400.0 if step is None else float(step)
     if not step > 0:
@@ -156,12 +175,9 @@ def trace_geodesic(rev: Revolution | Profile, s0: float, phi0: float, xi0: float
     sigma = np.linspace(0.0, end, n + 1)
     Y = sol.sol(sigma)
     Y[:, -1] = sol.y[:, -1]  # the exact end state (event location)
-    s = Y[0]
     # clip round-off at the boundary
-    s = np.clip(s, s_range[0], s_range[1])
-    if derivatives:
-        return s, Y[1], sigma, Y[2], Y[3]
-    return s, Y[1], sigma
+    s = np.clip(Y[0], s_range[0], s_range[1])
+    return s, Y[1], sigma, Y[2], Y[3]
 
 
 def clairaut_constant_for_angle(rev: Revolution | Profile, crossing_angle: float,
@@ -352,70 +368,98 @@ def geodesic_net(rev: Revolution, *, n_lamellae: int | None = None, spacing: flo
     c, xi = clairaut_constant_for_angle(rev, np.radians(crossing_angle), s_star)
     r_star = float(rev.r_of_s(s_star))
     step = (s_hi - s_lo) / 400.0 if step is None else float(step)
+    dstep = (_uniform_spacing(n_lamellae, spacing, Phi, r_star, step)
+             if offsets1 is None or offsets3 is None else None)
+    base, bs, bphi, bsig = _base_geodesic(rev, s_star, xi, (s_lo, s_hi), Phi, step)
+    o1 = (np.asarray(offsets1, float) if offsets1 is not None
+          else _uniform_offsets(bphi, +1, p_lo, p_hi, dstep))
+    o3 = (np.asarray(offsets3, float) if offsets3 is not None
+          else _uniform_offsets(bphi, -1, p_lo, p_hi, dstep))
+    if o1.ndim != 1 or o3.ndim != 1 or len(o1) == 0 or len(o3) == 0:
+        raise InputError("offsets must be non-empty 1D sequences of angles (radians)")
+    o1, o3 = np.sort(o1), np.sort(o3)
+    c1, s1, k1 = _family(base, bsig, bphi, +1, o1, (p_lo, p_hi), step)
+    c3, s3, k3 = _family(base, bsig, bphi, -1, o3, (p_lo, p_hi), step)
+    if not c1 or not c3:
+        raise NoNetError("no curve of the net reaches the surface; check the offsets "
+                         "(radians of the surface of revolution) or the spacing")
+    turning = bool(np.any(np.diff(np.sign(np.diff(bs))) != 0))
+    info = {"base_phi_range": (float(bphi.min()), float(bphi.max())),
+            "base_length": float(bsig[-1] - bsig[0]), "turning_points": turning,
+            "r_star": r_star, "step": step}
+    return IntrinsicNet(curves1=c1, curves3=c3, sigma1=s1, sigma3=s3, offsets1=np.asarray(k1),
+                        offsets3=np.asarray(k3), base=base, c=c, s_star=s_star, xi_star=xi,
+                        s_range=(s_lo, s_hi), phi_range=(p_lo, p_hi), info=info)
 
-    if offsets1 is None or offsets3 is None:
-        if (n_lamellae is None) == (spacing is None):
-            raise InputError("give either n_lamellae or spacing (not both) for evenly spaced "
-                             "curves, or explicit offsets for both families")
-        if n_lamellae is not None:
-            if int(n_lamellae) < 2:
-                raise InputError(f"n_lamellae must be at least 2, got {n_lamellae}")
-            dstep = Phi / (int(n_lamellae) - 1)
-        else:
-            if not float(spacing) > 0:
-                raise InputError(f"spacing must be positive (metres), got {spacing}")
-            dstep = float(spacing) / r_star
-            if dstep > Phi:
-                raise InputError(f"spacing {spacing} m is wider than the reference parallel "
-                                 f"({r_star * Phi:.4g} m); choose a smaller spacing")
-        if dstep * r_star < step:
-            n_max = int(r_star * Phi / step) + 1
-            raise InputError(f"the curves would be {dstep * r_star:.3g} m apart on the reference "
-                             f"parallel, closer than the {step:.3g} m they are sampled at; use at "
-                             f"most {n_max} lamellae or a spacing of at least {step:.3g} m")
+
+def _uniform_spacing(n_lamellae: int | None, spacing: float | None, Phi: float, r_star: float,
+                     step: float) -> float:
+    """The angle between evenly spaced curves of a family, radians: ``Phi / (n - 1)`` for
+    ``n_lamellae``, ``spacing / r(s*)`` for a ``spacing`` in metres along the reference
+    parallel (radius ``r_star``, metres); InputError for both or neither, too few, too wide,
+    or curves closer than their sampling ``step`` (metres)."""
+    if (n_lamellae is None) == (spacing is None):
+        raise InputError("give either n_lamellae or spacing (not both) for evenly spaced "
+                         "curves, or explicit offsets for both families")
+    if n_lamellae is not None:
+        if int(n_lamellae) < 2:
+            raise InputError(f"n_lamellae must be at least 2, got {n_lamellae}")
+        dstep = Phi / (int(n_lamellae) - 1)
+    else:
+        if not float(spacing) > 0:
+            raise InputError(f"spacing must be positive (metres), got {spacing}")
+        dstep = float(spacing) / r_star
+        if dstep > Phi:
+            raise InputError(f"spacing {spacing} m is wider than the reference parallel "
+                             f"({r_star * Phi:.4g} m); choose a smaller spacing")
+    if dstep * r_star < step:
+        n_max = int(r_star * Phi / step) + 1
+        raise InputError(f"the curves would be {dstep * r_star:.3g} m apart on the reference "
+                         f"parallel, closer than the {step:.3g} m they are sampled at; use at "
+                         f"most {n_max} lamellae or a spacing of at least {step:.3g} m")
+    return dstep
+
+
+def _base_geodesic(rev: Revolution, s_star: float, xi: float, s_range: tuple[float, float],
+                   Phi: float, step: float
+                   ) -> tuple[CubicHermiteSpline, np.ndarray, np.ndarray, np.ndarray]:
+    """The base geodesic through ``(s*, 0)`` at ``xi`` to the parallel, traced both ways until
+    it leaves ``s_range`` or ``[-Phi, Phi]``: its cubic Hermite interpolant ``base(sigma)``
+    of ``(s, g)`` and the samples ``s``, ``g`` (radians), ``sigma`` (metres)."""
     bs, bphi, bsig, bds, bdphi = trace_geodesic(
-        rev, s_star, 0.0, xi, s_range=(s_lo, s_hi), phi_range=(-Phi, Phi), both=True,
+        rev, s_star, 0.0, xi, s_range=s_range, phi_range=(-Phi, Phi), both=True,
         step=step, max_length=None, derivatives=True)
     # drop samples forming slivers next to the event end points
     keep = np.concatenate([[True], np.diff(bsig) > 1e-6 * step])
     bs, bphi, bsig, bds, bdphi = (a[keep] for a in (bs, bphi, bsig, bds, bdphi))
     base = CubicHermiteSpline(bsig, np.stack([bs, bphi], 1), np.stack([bds, bdphi], 1))
-    g_min, g_max = float(bphi.min()), float(bphi.max())
+    return base, bs, bphi, bsig
 
-    def uniform(sign: int) -> np.ndarray:
-        # curve phi = sign * g + o meets [p_lo, p_hi] iff o in [p_lo - max(sign g), p_hi - min]
-        sg = sign * bphi
-        o_lo, o_hi = p_lo - sg.max(), p_hi - sg.min()
-        k_lo = int(np.ceil((o_lo - p_lo) / dstep - 1e-9))
-        k_hi = int(np.floor((o_hi - p_lo) / dstep + 1e-9))
-        return p_lo + dstep * np.arange(k_lo, k_hi + 1)
 
-    o1 = np.asarray(offsets1, float) if offsets1 is not None else uniform(+1)
-    o3 = np.asarray(offsets3, float) if offsets3 is not None else uniform(-1)
-    if o1.ndim != 1 or o3.ndim != 1 or len(o1) == 0 or len(o3) == 0:
-        raise InputError("offsets must be non-empty 1D sequences of angles (radians)")
-    o1, o3 = np.sort(o1), np.sort(o3)
+def _uniform_offsets(bphi: np.ndarray, sign: int, p_lo: float, p_hi: float,
+                     dstep: float) -> np.ndarray:
+    """The evenly spaced offsets (radians, ``dstep`` apart from ``p_lo``) of every curve
+    ``phi = sign * g + o`` of a family that meets ``[p_lo, p_hi]``: those with ``o`` in
+    ``[p_lo - max(sign g), p_hi - min(sign g)]``."""
+    sg = sign * bphi
+    o_lo, o_hi = p_lo - sg.max(), p_hi - sg.min()
+    k_lo = int(np.ceil((o_lo - p_lo) / dstep - 1e-9))
+    k_hi = int(np.floor((o_hi - p_lo) / dstep + 1e-9))
+    return p_lo + dstep * np.arange(k_lo, k_hi + 1)
 
-    def family(sign: int, offsets: np.ndarray):
-        curves, sigmas, kept = [], [], []
-        for o in offsets:
-            sig = _clip(base, bsig, bphi, float(sign), float(o), p_lo, p_hi, step)
-            if sig is None:
-                continue
-            b = base(sig)
-            curves.append(np.stack([b[:, 0], sign * b[:, 1] + o], axis=1))
-            sigmas.append(sig)
-            kept.append(float(o))
-        return curves, sigmas, kept
 
-    c1, s1, k1 = family(+1, o1)
-    c3, s3, k3 = family(-1, o3)
-    if not c1 or not c3:
-        raise NoNetError("no curve of the net reaches the surface; check the offsets "
-                         "(radians of the surface of revolution) or the spacing")
-    turning = bool(np.any(np.diff(np.sign(np.diff(bs))) != 0))
-    info = {"base_phi_range": (g_min, g_max), "base_length": float(bsig[-1] - bsig[0]),
-            "turning_points": turning, "r_star": r_star, "step": step}
-    return IntrinsicNet(curves1=c1, curves3=c3, sigma1=s1, sigma3=s3, offsets1=np.asarray(k1),
-                        offsets3=np.asarray(k3), base=base, c=c, s_star=s_star, xi_star=xi,
-                        s_range=(s_lo, s_hi), phi_range=(p_lo, p_hi), info=info)
+def _family(base: Callable[..., np.ndarray], bsig: np.ndarray, bphi: np.ndarray, sign: int,
+            offsets: np.ndarray, phi_range: tuple[float, float], step: float
+            ) -> tuple[list[np.ndarray], list[np.ndarray], list[float]]:
+    """The curves of one family (``sign`` +1: C1, -1: C3) clipped to ``phi_range``: their
+    ``(s, phi)`` samples, their ``sigma`` and the offsets of the curves that reach it."""
+    curves, sigmas, kept = [], [], []
+    for o in offsets:
+        sig = _clip(base, bsig, bphi, float(sign), float(o), phi_range[0], phi_range[1], step)
+        if sig is None:
+            continue
+        b = base(sig)
+        curves.append(np.stack([b[:, 0], sign * b[:, 1] + o], axis=1))
+        sigmas.append(sig)
+        kept.append(float(o))
+    return curves, sigmas, kept

@@ -70,12 +70,13 @@ round (``w_p``) keeps the tangential motion, which nothing else resists, from dr
 
 All length-like residuals are divided by the mean edge length ``L`` of ``P0`` (their weights are
 ``w / L^2``), so the weights of :class:`GGWeights` are dimensionless and mean the same on any
-model; the geodesic residual is in radians.
+model; the geodesic residual is in radians. :class:`GGWeights` and the outcome
+:class:`GGDesign` live in :mod:`gridshell.gg.surface_types` (importable from here too).
 """
 from __future__ import annotations
 
 import time
-from dataclasses import asdict, dataclass, field, fields
+from dataclasses import dataclass
 from typing import Any, Callable, Mapping
 
 import numpy as np
@@ -88,6 +89,7 @@ from gridshell.gg.constraints import (EdgeGroups, GridShape, diagonal_residual_r
                           equal_diagonals, equal_lengths, geodesic_meridians, geodesic_residual,
                           init_group_lengths, length_residual_rel)
 from gridshell.gg.soft_terms import boundary_gliding, boundary_sides, fairness_matrix, surface_gliding
+from gridshell.gg.surface_types import GGDesign, GGWeights
 
 __all__ = ["GGDesign", "GGWeights", "design_gg_surface", "edge_groups", "equal_lengths",
            "fairness_matrix", "geodesic_meridians", "geodesic_residual", "GridShape",
@@ -95,163 +97,6 @@ __all__ = ["GGDesign", "GGWeights", "design_gg_surface", "edge_groups", "equal_l
            "diagonal_residual_rel"]
 
 Progress = Callable[[str], None] | None
-
-
-# ============================================================================ weights, result
-
-@dataclass
-class GGWeights:
-    """Weights of the GG surface design; dimensionless (length residuals are divided by the
-    mean edge length of the initial grid, the geodesic residual is in radians).
-
-    Attributes
-    ----------
-    geodesic : float
-        Geodesic meridians (angle sums), 1.
-    lengths : float
-        Equal edge lengths along parallels and across meridian strips, 1.
-    orthogonal : float
-        Equal diagonals in every quad (meridians orthogonal to the parallels, see
-        :mod:`gridshell.gg.constraints`), 1; in the rounds and the polish like the others.
-    closeness : float
-        Gliding on the target (distance to the tangent plane at the closest point), 0.1:
-        below the constraints so that they dominate.
-    boundary : float
-        Boundary vertices glide on the initial boundary polylines, 0.1.
-    fairness : float
-        Second differences along meridians and parallels in the first round, 1e-4;
-        multiplied by ``fairness_decay`` every round (smooths noise in the target).
-    fairness_decay : float
-        Factor of the fairness weight per round, 0.3.
-    elastic : float
-        Change of the second differences from their values at the start of each round, 3:
-        resists folding (without it the constraints fold the mesh over itself on targets far
-        from a GG surface - on a dome parallels pile up and meridians reverse while every
-        constraint holds) and leaves a GG mesh a fixed point.
-    elastic_decay : float
-        Factor of the elastic weight per round, 0.6.
-    proximity : float
-        Closeness to the positions at the start of each round, 1e-2: resists the tangential
-        drift nothing else resists (and the fairness' pull along the surface).
-    soften : float
-        Factor per round on ``closeness``, ``boundary`` and ``proximity``, 0.5: a penalty
-        continuation, so the constraints dominate more every round and the final polish only
-        has round-off-sized work left.
-    polish_proximity : float
-        Proximity weight of the final projection onto the constraints (to the start of each
-        iteration, so a metric term too), 1e-4: holds the smooth modes that the elastic term
-        leaves nearly free (with 1e-8 a noisy 12 x 10 catenoid drifted to 7.6 % of the
-        diagonal from its target, with 1e-4 it stays at 1.5 %).
-    polish_elastic : float
-        Change of the second differences in each step of the final projection, 3e-3. Its
-        reference is refreshed every iteration, so it never pulls back (a GG mesh stays a
-        fixed point): it only makes the projection take the least-bending correction instead
-        of the least-motion one. The least-motion correction is an odd-even zig-zag (the
-        constraints are most sensitive to it); the edge lengths and angle sums then hold while
-        the smooth surface through the vertices, on which the net is traced, is not isometric
-        to the surface of revolution: with the former 1e-5 halved every iteration, 20 polish
-        iterations took a 40 x 40 height field from Delta_a max 0.52 % to 5.2 % and a
-        rotated 60 x 40 hill from 2.3 % to 5.9 % (7 % with 40 iterations); with 3e-3 kept
-        (and ``polish_proximity`` 1e-4) they reach 0.09 % and 0.62 %. 0: the plain
-        projection.
-    polish_elastic_decay : float
-        Factor of ``polish_elastic`` alone per projection iteration, 1 (kept: a metric whose
-        elastic part decays against the proximity ends in the zig-zag projection above).
-    polish_decay : float
-        Factor of ``polish_proximity`` and ``polish_elastic`` together per projection
-        iteration, 0.3 (on top of their shrinking with the constraint energy, see the module
-        docstring); 1: fixed weights, a linearly converging polish.
-    """
-
-    geodesic: float = 1.0
-    lengths: float = 1.0
-    orthogonal: float = 1.0
-    closeness: float = 0.1
-    boundary: float = 0.1
-    fairness: float = 1e-4
-    fairness_decay: float = 0.3
-    elastic: float = 3.0
-    elastic_decay: float = 0.6
-    proximity: float = 1e-2
-    soften: float = 0.5
-    polish_proximity: float = 1e-4
-    polish_elastic: float = 3e-3
-    polish_elastic_decay: float = 1.0
-    polish_decay: float = 0.3
-
-    @classmethod
-    def coerce(cls, weights: "GGWeights | Mapping[str, float] | None") -> "GGWeights":
-        """``GGWeights`` from ``None`` (defaults), an instance, or a mapping of some fields."""
-        if weights is None:
-            return cls()
-        if isinstance(weights, cls):
-            w = weights
-        elif isinstance(weights, Mapping):
-            names = {f.name for f in fields(cls)}
-            bad = sorted(set(weights) - names)
-            if bad:
-                raise InputError(f"unknown GG design weight(s) {bad}; valid names are "
-                                 f"{sorted(names)}")
-            w = cls(**{k: float(v) for k, v in weights.items()})
-        else:
-            raise InputError(f"weights must be a GGWeights, a dict or None, got {type(weights)}")
-        for k, v in asdict(w).items():
-            if not np.isfinite(v) or v < 0:
-                raise InputError(f"GG design weight {k!r} must be finite and >= 0, got {v}")
-        return w
-
-
-@dataclass
-class GGDesign:
-    """Outcome of :func:`design_gg_surface`.
-
-    Attributes
-    ----------
-    P : (R, C, 3) float
-        The designed mesh, metres; meridians ``P[:, j]``, parallels ``P[i, :]``.
-    l : (R,) float
-        Parallel edge length of each parallel, metres.
-    h : (R-1,) float
-        Meridian edge length between consecutive parallels, metres.
-    history : list of dict
-        Per round (and the polish): weights used, energies, solver iterations and message,
-        geodesic and length residuals, deviation, time.
-    report : dict
-        ``{"before": ..., "after": ...}``: per term (base weights) weight, energy, RMS, max of
-        the unweighted residual at ``P0`` and at ``P``.
-    converged : bool
-        Geodesic residual <= ``tol_geodesic`` and relative length spread <= ``tol_length``
-        (the residuals are at round-off; a design is *accepted* on its figures, see
-        :func:`gridshell.gg.pipeline.design_gg`).
-    stop : str
-        Why the polish ended: ``"tolerance"``, ``"stagnation"``, ``"figures"`` (the score is
-        acceptable and stagnates), ``"no descent"``, ``"iteration limit"``, ``"no polish"``.
-    score : float or None
-        ``evaluate(P)`` of the returned mesh (None without ``evaluate``).
-    checkpoint : str
-        Which iterate is returned: ``"rounds"`` (the end of the rounds) or ``"polish k"``.
-    deviation : dict
-        ``max``, ``mean`` distance of the vertices of ``P`` to the target, % of the target's
-        bounding-box diagonal; ``diagonal`` in metres.
-    geodesic_residual_max : float
-        Largest |angle-sum difference|, radians.
-    length_residual_rel_max : float
-        Largest relative spread of edge lengths within a parallel or a meridian strip, or
-        relative difference of the two diagonals of a quad.
-    """
-
-    P: np.ndarray
-    l: np.ndarray
-    h: np.ndarray
-    history: list[dict] = field(default_factory=list)
-    report: dict = field(default_factory=dict)
-    converged: bool = False
-    deviation: dict = field(default_factory=dict)
-    geodesic_residual_max: float = float("nan")
-    length_residual_rel_max: float = float("nan")
-    stop: str = ""
-    score: float | None = None
-    checkpoint: str = ""
 
 
 # ============================================================================ the optimization
@@ -368,7 +213,8 @@ def design_gg_surface(target_V: Any, target_F: Any, P0: Any, *,
                       check_every: int = 4, coarse: bool = True,
                       progress: Progress = None) -> GGDesign:
     """Optimize ``P0`` into a rotationally isometric geodesic-parallel mesh near a target
-    (paper 4.1.1, Fig. 12a; Wang et al. 2019).
+    (paper 4.1.1, Fig. 12a; Wang et al. 2019): the rounds (:func:`_rounds`), then the polish
+    (:func:`_polish`).
 
     Parameters
     ----------
@@ -385,15 +231,14 @@ def design_gg_surface(target_V: Any, target_F: Any, P0: Any, *,
     outer : int
         Rounds of (closest points -> ``max_iter`` Levenberg-Marquardt iterations).
     max_iter : int
-        Most solver iterations per round (a round ends sooner once a step gains less than
+        Most solver iterations per round (fewer once a step gains less than
         :data:`ROUND_TOL_REL` of its energy).
     polish_iter : int
         Most iterations of the final projection onto the constraints (0: no polish); it
         stops earlier on stagnation (see the module docstring).
-    tol_geodesic : float
-        Round-off tolerance on the geodesic residual, radians: the polish stops below it.
-    tol_length : float
-        Round-off tolerance on the relative spread of edge lengths (dimensionless).
+    tol_geodesic, tol_length : float
+        Round-off tolerances on the geodesic residual (radians) and on the relative spread of
+        edge lengths (dimensionless): the polish stops below them.
     evaluate : callable, optional
         ``evaluate(P (R, C, 3)) -> float``, lower is better, below 1 acceptable (e.g. the
         largest ratio figure / threshold of the net traced on ``P``; ``inf`` if none can be
@@ -404,10 +249,10 @@ def design_gg_surface(target_V: Any, target_F: Any, P0: Any, *,
         Polish iterations between two calls of ``evaluate`` (and one early call after
         :data:`SCORE_EARLY` iterations, which ends the polish only on :data:`SCORE_DONE`).
     coarse : bool
-        Coarse to fine (unless ``P0`` already meets the constraints to :data:`ROUNDS_TOL`):
-        a grid with a side above :data:`COARSE_ABOVE` vertices is first
-        designed at half the resolution (recursively), and the result, interpolated back to
-        ``R x C``, starts the last :data:`FINE_ROUNDS` rounds (see :func:`_coarse_start`).
+        Coarse to fine (unless ``P0`` already meets the constraints to :data:`ROUNDS_TOL`): a
+        grid with a side above :data:`COARSE_ABOVE` vertices is first designed at half the
+        resolution (recursively), and the result, interpolated back to ``R x C``, starts the
+        last :data:`FINE_ROUNDS` rounds (see :func:`_coarse_start`).
     progress : callable, optional
         Receives one line per round.
 
@@ -417,8 +262,26 @@ def design_gg_surface(target_V: Any, target_F: Any, P0: Any, *,
         ``converged=False`` (never an exception) when the tolerances are not met: the caller
         decides.
     """
+    V, Ft, P0, w = _surface_inputs(target_V, target_F, P0, weights, outer, max_iter,
+                                   polish_iter, check_every)
+    t0 = time.perf_counter()
+    gp = _SurfaceProblem.of(V, Ft, P0, w)
+    x = gp.pack(gp.P0flat)
+    prob = gp.build(gp.P0flat)
+    before = prob.report(x)
+    x, history = _rounds(gp, prob, x, outer, int(max_iter), coarse, t0, progress)
+    polished = _polish(x, gp, int(polish_iter), tol_geodesic, tol_length, evaluate,
+                       int(check_every), history, t0, progress)
+    return _surface_result(gp, polished, history, before, tol_geodesic, tol_length, t0,
+                           progress)
+
+
+def _surface_inputs(target_V: Any, target_F: Any, P0: Any, weights: Any, outer: int,
+                    max_iter: int, polish_iter: int, check_every: int
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, GGWeights]:
+    """The checked inputs of :func:`design_gg_surface`: the target triangulated ``(V, Ft)``
+    (metres), the initial grid ``P0 (R, C, 3)`` and the weights; InputError names a bad one."""
     from gridshell.geometry.igl_adapter import triangulate
-    from gridshell.measure.metrics import deviation
 
     if target_F is None:
         if not (hasattr(target_V, "V") and hasattr(target_V, "F")):
@@ -430,103 +293,179 @@ def design_gg_surface(target_V: Any, target_F: Any, P0: Any, *,
     if int(outer) < 1 or int(max_iter) < 1 or int(polish_iter) < 0 or int(check_every) < 1:
         raise InputError(f"outer, max_iter and check_every must be >= 1 and polish_iter >= 0, "
                          f"got {outer}, {max_iter}, {check_every}, {polish_iter}")
-    t0 = time.perf_counter()
-    R, C = P0.shape[:2]
-    P0flat = P0.reshape(-1, 3)
-    L = float(np.mean(np.concatenate([np.linalg.norm(np.diff(P0, axis=a), axis=2).ravel()
-                                      for a in (0, 1)])))
-    s2 = 1.0 / L ** 2
+    return V, Ft, P0, w
 
-    lay = Layout({"P": (R * C, 3), "l": R, "h": R - 1})
-    par, mer = edge_groups((R, C), "parallel"), edge_groups((R, C), "meridian")
-    x = lay.pack({"P": P0flat, "l": init_group_lengths(P0flat, par),
-                  "h": init_group_lengths(P0flat, mer)})
-    sides = boundary_sides(R, C)
-    D = fairness_matrix((R, C))
 
-    def refreshed(X: np.ndarray) -> dict[str, Any]:
+@dataclass
+class _SurfaceProblem:
+    """The fixed data of one GG surface design: the triangulated target ``(V, Ft)`` and the
+    initial grid ``P0 (R, C, 3)`` (metres), the weights, the variables' layout (blocks ``P``,
+    ``l``, ``h``), the edge groups, the boundary sides, the fairness matrix ``D`` and the mean
+    edge length ``L`` of ``P0`` (metres; length residuals are weighted by ``s2 = 1 / L^2``)."""
+
+    V: np.ndarray
+    Ft: np.ndarray
+    P0: np.ndarray
+    w: GGWeights
+    L: float
+    lay: Layout
+    par: EdgeGroups
+    mer: EdgeGroups
+    sides: Any
+    D: sp.csr_matrix
+
+    @classmethod
+    def of(cls, V: np.ndarray, Ft: np.ndarray, P0: np.ndarray, w: GGWeights
+           ) -> "_SurfaceProblem":
+        """The problem data of grid ``P0 (R, C, 3)`` on the target ``(V, Ft)``."""
+        R, C = P0.shape[:2]
+        L = float(np.mean(np.concatenate([np.linalg.norm(np.diff(P0, axis=a), axis=2).ravel()
+                                          for a in (0, 1)])))
+        return cls(V, Ft, P0, w, L, Layout({"P": (R * C, 3), "l": R, "h": R - 1}),
+                   edge_groups((R, C), "parallel"), edge_groups((R, C), "meridian"),
+                   boundary_sides(R, C), fairness_matrix((R, C)))
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return self.P0.shape[0], self.P0.shape[1]
+
+    @property
+    def P0flat(self) -> np.ndarray:
+        return self.P0.reshape(-1, 3)
+
+    @property
+    def s2(self) -> float:
+        return 1.0 / self.L ** 2
+
+    def pack(self, X: np.ndarray) -> np.ndarray:
+        """The variables of vertices ``X (R*C, 3)`` with their group lengths ``l``, ``h``."""
+        return self.lay.pack({"P": X, "l": init_group_lengths(X, self.par),
+                              "h": init_group_lengths(X, self.mer)})
+
+    def mesh(self, x: np.ndarray) -> np.ndarray:
+        """The mesh ``P (R, C, 3)`` of the variables ``x`` (a view), metres."""
+        return self.lay.view(x, "P").reshape(*self.shape, 3)
+
+    def constraints(self) -> Problem:
+        """The constraints 1-3 (and the equal diagonals), base weights."""
+        return _constraints_only(self.lay, self.shape, self.w, self.par, self.mer, self.s2)
+
+    def refreshed(self, X: np.ndarray) -> dict[str, Any]:
         """The data of the terms that follow the mesh, at vertices ``X``."""
-        return {"closeness": surface_gliding(X, V, Ft),
-                "boundary": boundary_gliding(X, P0flat, sides),
-                "elastic": T.Linear("P", D, D @ X), "proximity": T.Closeness("P", X.copy())}
+        return {"closeness": surface_gliding(X, self.V, self.Ft),
+                "boundary": boundary_gliding(X, self.P0flat, self.sides),
+                "elastic": T.Linear("P", self.D, self.D @ X),
+                "proximity": T.Closeness("P", X.copy())}
 
-    def build(X: np.ndarray) -> Problem:
+    def build(self, X: np.ndarray) -> Problem:
         """The problem with base weights and data refreshed at vertices ``X``."""
-        d = refreshed(X)
-        return (_constraints_only(lay, (R, C), w, par, mer, s2)
+        d, w, s2 = self.refreshed(X), self.w, self.s2
+        return (self.constraints()
                 .add("closeness", w.closeness * s2, T.gliding, d["closeness"])
                 .add("boundary", w.boundary * s2, T.gliding, d["boundary"])
-                .add("fairness", w.fairness * s2, T.linear, T.Linear("P", D))
+                .add("fairness", w.fairness * s2, T.linear, T.Linear("P", self.D))
                 .add("elastic", w.elastic * s2, T.linear, d["elastic"])
                 .add("proximity", w.proximity * s2, T.closeness, d["proximity"]))
 
-    prob = build(P0flat)
-    before = prob.report(x)
+
+def _rounds(gp: _SurfaceProblem, prob: Problem, x: np.ndarray, outer: int, max_iter: int,
+            coarse: bool, t0: float, progress: Progress) -> tuple[np.ndarray, list[dict]]:
+    """The ``outer`` continuation rounds (closest points -> Levenberg-Marquardt, see the
+    module docstring), after a coarse start on a big grid; the variables and the history."""
     history: list[dict] = []
-    k0 = 0
-    g0, l0 = _figures(P0)
-    # (a P0 that meets the constraints, e.g. a helicoid grid, ends the rounds after one)
-    if (coarse and max(R, C) > COARSE_ABOVE and int(outer) > FINE_ROUNDS
-            and max(g0, l0) > ROUNDS_TOL):
-        Pc = _coarse_start(V, Ft, P0, w, int(outer), int(max_iter), progress)
-        x = lay.pack({"P": Pc.reshape(-1, 3), "l": init_group_lengths(Pc.reshape(-1, 3), par),
-                      "h": init_group_lengths(Pc.reshape(-1, 3), mer)})
-        k0 = int(outer) - FINE_ROUNDS
-        history.append({"round": "coarse", "shape": list(_coarse_shape(R, C)),
-                        "time": time.perf_counter() - t0})
-    _say(progress, f"GG design {R} x {C}: geodesic residual {g0:.2e} rad, length spread "
-                   f"{l0:.2e} at the start")
+    x, k0 = _coarse_begin(gp, x, outer, max_iter, coarse, history, t0, progress)
     lam = ROUND_DAMPING  # carried from round to round (see ROUND_DAMPING_FLOOR)
     for k in range(k0, int(outer)):
-        X = lay.view(x, "P")
-        if k > 0:  # (after a coarse start: refreshed at the interpolated coarse design)
-            # the same problem with new data (every weight is set below): it keeps its
-            # Jacobian's structure, whose triplets do not move from round to round
-            for name, data in refreshed(X).items():
-                prob.set_data(name, data)
-        wf = w.fairness * w.fairness_decay ** k
-        soft = w.soften ** k
-        prob.set_weight("fairness", wf * s2)
-        prob.set_weight("elastic", w.elastic * w.elastic_decay ** k * s2)
-        for name, wk in (("closeness", w.closeness), ("boundary", w.boundary),
-                         ("proximity", w.proximity)):
-            prob.set_weight(name, wk * soft * s2)
-        res = solve(prob, x, method="lm", max_iter=int(max_iter), damping=lam,
-                    tol_rel=ROUND_TOL_REL)
+        X = gp.lay.view(x, "P")
+        res, wf, soft = _round(gp, prob, x, k, lam, max_iter)
         x = res.x
         if res.history:
             lam = max(float(res.history[-1]["lambda"]), ROUND_DAMPING_FLOOR)
-        g, lr = _figures(lay.view(x, "P").reshape(R, C, 3))
-        history.append({"round": k, "fairness": wf, "soften": soft, "energy0": res.energy0, "energy": res.energy,
-                        "iterations": res.iterations, "message": res.message,
+        g, lr = _figures(gp.mesh(x))
+        history.append({"round": k, "fairness": wf, "soften": soft, "energy0": res.energy0,
+                        "energy": res.energy, "iterations": res.iterations,
+                        "message": res.message,
                         "terms": {n: v["energy"] for n, v in res.report.items()},
                         "geodesic_max": g, "length_rel_max": lr,
                         "time": time.perf_counter() - t0})
         _say(progress, f"round {k + 1}/{outer}: energy {res.energy0:.3e} -> {res.energy:.3e}, "
                        f"geodesic {g:.2e} rad, length spread {lr:.2e}")
-        moved = float(np.max(np.linalg.norm(lay.view(x, "P") - X, axis=1)))
-        if g <= ROUNDS_TOL and lr <= ROUNDS_TOL and moved <= STILL * L:
+        moved = float(np.max(np.linalg.norm(gp.lay.view(x, "P") - X, axis=1)))
+        if g <= ROUNDS_TOL and lr <= ROUNDS_TOL and moved <= STILL * gp.L:
             # the constraints hold and the round left the mesh where it was: the remaining
             # rounds (lower fairness and closeness) would change nothing (an exact GG mesh, such
             # as a helicoid grid, stops after round 1: 100 x 100 in 6 s instead of 55 s)
-            _say(progress, f"stopping after round {k + 1}: the mesh moved {moved / L:.1e} edge "
-                           "lengths in it and meets the constraints")
+            _say(progress, f"stopping after round {k + 1}: the mesh moved {moved / gp.L:.1e} "
+                           "edge lengths in it and meets the constraints")
             break
-    x, stop, score, checkpoint = _polish(
-        x, lay, (R, C), w, par, mer, D, s2, int(polish_iter), tol_geodesic, tol_length,
-        evaluate, int(check_every), history, t0, progress)
-    P = lay.view(x, "P").reshape(R, C, 3).copy()
-    after = build(P.reshape(-1, 3)).report(x)
+    return x, history
+
+
+def _coarse_begin(gp: _SurfaceProblem, x: np.ndarray, outer: int, max_iter: int,
+                  coarse: bool, history: list[dict], t0: float, progress: Progress
+                  ) -> tuple[np.ndarray, int]:
+    """The start of the rounds: the variables and the first round, after a coarse design
+    (:func:`_coarse_start`) of a big grid that does not meet the constraints yet."""
+    R, C = gp.shape
+    k0 = 0
+    g0, l0 = _figures(gp.P0)
+    # (a P0 that meets the constraints, e.g. a helicoid grid, ends the rounds after one)
+    if (coarse and max(R, C) > COARSE_ABOVE and int(outer) > FINE_ROUNDS
+            and max(g0, l0) > ROUNDS_TOL):
+        Pc = _coarse_start(gp.V, gp.Ft, gp.P0, gp.w, int(outer), int(max_iter), progress)
+        x = gp.pack(Pc.reshape(-1, 3))
+        k0 = int(outer) - FINE_ROUNDS
+        history.append({"round": "coarse", "shape": list(_coarse_shape(R, C)),
+                        "time": time.perf_counter() - t0})
+    _say(progress, f"GG design {R} x {C}: geodesic residual {g0:.2e} rad, length spread "
+                   f"{l0:.2e} at the start")
+    return x, k0
+
+
+def _round(gp: _SurfaceProblem, prob: Problem, x: np.ndarray, k: int, lam: float,
+           max_iter: int) -> tuple[Any, float, float]:
+    """Round ``k``: the terms' data refreshed at the mesh of ``x``, the weights of round ``k``
+    set (fairness ``w_f d^k``, softened terms ``s^k``) and at most ``max_iter``
+    Levenberg-Marquardt steps from damping ``lam``; the solver's result, ``w_f d^k``, ``s^k``."""
+    w, s2 = gp.w, gp.s2
+    if k > 0:  # (after a coarse start: refreshed at the interpolated coarse design)
+        # the same problem with new data (every weight is set below): it keeps its
+        # Jacobian's structure, whose triplets do not move from round to round
+        for name, data in gp.refreshed(gp.lay.view(x, "P")).items():
+            prob.set_data(name, data)
+    wf = w.fairness * w.fairness_decay ** k
+    soft = w.soften ** k
+    prob.set_weight("fairness", wf * s2)
+    prob.set_weight("elastic", w.elastic * w.elastic_decay ** k * s2)
+    for name, wk in (("closeness", w.closeness), ("boundary", w.boundary),
+                     ("proximity", w.proximity)):
+        prob.set_weight(name, wk * soft * s2)
+    res = solve(prob, x, method="lm", max_iter=int(max_iter), damping=lam,
+                tol_rel=ROUND_TOL_REL)
+    return res, wf, soft
+
+
+def _surface_result(gp: _SurfaceProblem, polished: tuple, history: list[dict], before: dict,
+                    tol_geodesic: float, tol_length: float, t0: float,
+                    progress: Progress) -> GGDesign:
+    """The :class:`GGDesign` of the polished variables (``polished``: :func:`_polish`'s
+    result): the mesh, its group lengths, residuals, deviation from the target (% of its
+    diagonal) and the terms' report before and after."""
+    from gridshell.measure.metrics import deviation
+
+    x, stop, score, checkpoint = polished
+    P = gp.mesh(x).copy()
+    after = gp.build(P.reshape(-1, 3)).report(x)
     g, lr = _figures(P)
-    dev = deviation(P.reshape(-1, 3), V, Ft)
+    dev = deviation(P.reshape(-1, 3), gp.V, gp.Ft)
     converged = bool(g <= tol_geodesic and lr <= tol_length)
     _say(progress, f"GG surface ({checkpoint}, polish stopped: {stop}): geodesic {g:.2e} rad, "
                    f"length spread {lr:.2e}, deviation max {dev['max']:.3f} % mean "
                    f"{dev['mean']:.3f} % of the diagonal, {time.perf_counter() - t0:.2f} s")
-    return GGDesign(P=P, l=lay.view(x, "l").copy(), h=lay.view(x, "h").copy(), history=history,
-                    report={"before": before, "after": after}, converged=converged,
-                    deviation=dev, geodesic_residual_max=g, length_residual_rel_max=lr,
-                    stop=stop, score=score, checkpoint=checkpoint)
+    return GGDesign(P=P, l=gp.lay.view(x, "l").copy(), h=gp.lay.view(x, "h").copy(),
+                    history=history, report={"before": before, "after": after},
+                    converged=converged, deviation=dev, geodesic_residual_max=g,
+                    length_residual_rel_max=lr, stop=stop, score=score, checkpoint=checkpoint)
 
 
 def _constraint_energy(report: Mapping[str, Mapping[str, float]]) -> float:
@@ -577,65 +516,32 @@ def _coarse_start(V: np.ndarray, F: np.ndarray, P0: np.ndarray, w: GGWeights, ou
     return _resample(d.P, R, C)
 
 
-def _polish(x: np.ndarray, lay: Layout, shape: tuple[int, int], w: GGWeights,
-            par: EdgeGroups, mer: EdgeGroups, D: sp.csr_matrix, s2: float, polish_iter: int,
-            tol_geodesic: float, tol_length: float,
-            evaluate: Callable[[np.ndarray], float] | None, check_every: int,
-            history: list[dict], t0: float,
+def _polish(x: np.ndarray, gp: _SurfaceProblem, polish_iter: int, tol_geodesic: float,
+            tol_length: float, evaluate: Callable[[np.ndarray], float] | None,
+            check_every: int, history: list[dict], t0: float,
             progress: Progress) -> tuple[np.ndarray, str, float | None, str]:
-    """The final projection onto the constraints (see the module docstring).
+    """The final projection onto the constraints (see the module docstring), one
+    Levenberg-Marquardt step at a time (:func:`_polish_problem`), scored at checkpoints by
+    ``evaluate`` (:class:`_Checkpoints`).
 
     Returns the variables (the best-scoring checkpoint with ``evaluate``, else the last
     iterate), why the polish stopped, the score and the checkpoint's name.
     """
-    R, C = shape
-    best: list[Any] = [None, None, ""]  # score, x, name
-
-    def check(name: str, xc: np.ndarray, early: bool = False) -> float:
-        sc = float(evaluate(lay.view(xc, "P").reshape(R, C, 3).copy()))
-        sc = sc if np.isfinite(sc) else float("inf")
-        if (best[0] is None or sc < best[0]) and (not early or sc <= SCORE_DONE):
-            best[:] = [sc, xc.copy(), name]
-        _say(progress, f"{name}: score {sc:.3g} (largest figure / threshold of the traced net)")
-        return sc
-
-    # the end of the rounds is scored only when its score matters (a trace less per design):
-    # as the first check's reference for SCORE_STALL, and as a candidate unless a polish
-    # checkpoint is far inside the thresholds (SCORE_DONE)
-    x_rounds = x.copy() if evaluate is not None else None
-    sc_rounds: list[float] = []
-
-    def rounds_score() -> float:
-        if not sc_rounds:
-            sc_rounds.append(check("rounds", x_rounds))
-        return sc_rounds[0]
-
-    if evaluate is not None and polish_iter == 0:
-        rounds_score()
-    sc_prev = None
-    last_checked = 0
+    w = gp.w
+    cp = _Checkpoints(evaluate, gp, x, progress) if evaluate is not None else None
+    if cp is not None and polish_iter == 0:
+        cp.rounds_score()
     lam = POLISH_DAMPING  # raised where a step would not descend
     stop = "iteration limit" if polish_iter > 0 else "no polish"
     done = 0
-    g, lr = _figures(lay.view(x, "P").reshape(R, C, 3))
-    ec_prev = (_constraint_energy(_constraints_only(lay, (R, C), w, par, mer, s2).report(x))
-               if polish_iter > 0 else 0.0)
+    g, lr = _figures(gp.mesh(x))
+    ec_prev = _constraint_energy(gp.constraints().report(x)) if polish_iter > 0 else 0.0
     while done < polish_iter:
         if g <= tol_geodesic and lr <= tol_length:
             stop = "tolerance"
             break
-        # the references are the start of every step: the proximity and elastic terms change
-        # the metric of the step only (a stale reference would pull back and stall it); both
-        # shrink together (same metric shape, vanishing size) by polish_decay per step and in
-        # proportion to the constraint energy below POLISH_EREF
-        Xs = lay.view(x, "P").copy()
         dk = max(min(w.polish_decay ** done, ec_prev / POLISH_EREF), POLISH_FLOOR)
-        pol = (_constraints_only(lay, (R, C), w, par, mer, s2)
-               .add("proximity", w.polish_proximity * dk * s2, T.closeness,
-                    T.Closeness("P", Xs)))
-        if w.polish_elastic > 0:
-            pol.add("elastic", w.polish_elastic * dk * w.polish_elastic_decay ** done * s2,
-                    T.linear, T.Linear("P", D, D @ Xs))
+        pol = _polish_problem(gp, x, dk, done)
         lam = min(lam, POLISH_DAMPING * dk)  # the LM damping must not take the metric over
         res = solve(pol, x, method="lm", max_iter=1, damping=lam, tol_energy=0.0, tol_rel=0.0,
                     tol_step=0.0, tol_grad=0.0)
@@ -647,7 +553,7 @@ def _polish(x: np.ndarray, lay: Layout, shape: tuple[int, int], w: GGWeights,
             break
         x = res.x
         ec = _constraint_energy(res.report)  # res.report is at res.x
-        g, lr = _figures(lay.view(x, "P").reshape(R, C, 3))
+        g, lr = _figures(gp.mesh(x))
         history.append({"round": "polish", "energy0": res.energy0, "energy": res.energy,
                         "constraint_energy": ec, "regularisation": dk,
                         "iterations": res.iterations, "message": res.message,
@@ -659,31 +565,97 @@ def _polish(x: np.ndarray, lay: Layout, shape: tuple[int, int], w: GGWeights,
         rel = (ec_prev - ec) / max(ec_prev, 1e-300)
         ec_prev = ec
         slow = rel < POLISH_SLOW and dk <= POLISH_GN  # a floor, not the metric's damping
-        regular = done % check_every == 0 or slow
-        if evaluate is not None and not regular and done == SCORE_EARLY:
-            # an early look: a score far inside the thresholds ends the polish here; any other
-            # is forgotten (the checkpoints and the stagnation test stay those of check_every)
-            if check(f"polish {done}", x, early=True) <= SCORE_DONE:
-                last_checked = done
-                stop = "figures"
-                break
-        elif evaluate is not None and regular:
-            sc = check(f"polish {done}", x)
-            last_checked = done
-            if sc_prev is None and SCORE_DONE < sc < 1.0 and not slow:
-                sc_prev = rounds_score()
-            stalled = slow or (sc_prev is not None and sc_prev - sc < SCORE_STALL * sc_prev)
-            if sc <= SCORE_DONE or (sc < 1.0 and stalled):
-                stop = "figures"
-                break
-            sc_prev = sc
+        if cp is not None and cp.after_step(done, x, slow, check_every):
+            stop = "figures"
+            break
         if rel < POLISH_STALL:
             stop = "stagnation"
             break
-    if evaluate is None:
+    if cp is None:
         return x, stop, None, f"polish {done}" if done else "rounds"
-    if done > last_checked:
-        check(f"polish {done}", x)
-    if best[0] is None or best[0] > SCORE_DONE:
-        rounds_score()
-    return best[1], stop, best[0], best[2]
+    return cp.finish(done, x, stop)
+
+
+def _polish_problem(gp: _SurfaceProblem, x: np.ndarray, dk: float, done: int) -> Problem:
+    """The problem of polish step ``done + 1`` from ``x``: the constraints plus proximity and
+    elastic terms at regularisation ``dk`` (a fraction of their base weights).
+
+    The references are the start of every step: the proximity and elastic terms change the
+    metric of the step only (a stale reference would pull back and stall it); both shrink
+    together (same metric shape, vanishing size) by polish_decay per step and in proportion to
+    the constraint energy below POLISH_EREF.
+    """
+    w, s2 = gp.w, gp.s2
+    Xs = gp.lay.view(x, "P").copy()
+    pol = (gp.constraints()
+           .add("proximity", w.polish_proximity * dk * s2, T.closeness, T.Closeness("P", Xs)))
+    if w.polish_elastic > 0:
+        pol.add("elastic", w.polish_elastic * dk * w.polish_elastic_decay ** done * s2,
+                T.linear, T.Linear("P", gp.D, gp.D @ Xs))
+    return pol
+
+
+class _Checkpoints:
+    """The polish' checkpoints scored by ``evaluate(P (R, C, 3))`` (lower is better, below 1
+    acceptable): the best one kept, the stagnation test between regular checks, and the end
+    of the rounds (``x_rounds``) scored only when its score matters (a trace less per design):
+    as the first check's reference for SCORE_STALL, and as a candidate unless a polish
+    checkpoint is far inside the thresholds (SCORE_DONE)."""
+
+    def __init__(self, evaluate: Callable[[np.ndarray], float], gp: _SurfaceProblem,
+                 x_rounds: np.ndarray, progress: Progress) -> None:
+        self.evaluate, self.gp, self.progress = evaluate, gp, progress
+        self.x_rounds = x_rounds.copy()
+        self.best: list[Any] = [None, None, ""]  # score, x, name
+        self.sc_rounds: list[float] = []
+        self.sc_prev: float | None = None
+        self.last_checked = 0
+
+    def check(self, name: str, xc: np.ndarray, early: bool = False) -> float:
+        """The score of the variables ``xc``, kept as the best if it is (an ``early`` one only
+        at SCORE_DONE or below)."""
+        sc = float(self.evaluate(self.gp.mesh(xc).copy()))
+        sc = sc if np.isfinite(sc) else float("inf")
+        if (self.best[0] is None or sc < self.best[0]) and (not early or sc <= SCORE_DONE):
+            self.best[:] = [sc, xc.copy(), name]
+        _say(self.progress, f"{name}: score {sc:.3g} (largest figure / threshold of the traced "
+                            "net)")
+        return sc
+
+    def rounds_score(self) -> float:
+        """The score of the end of the rounds, computed once."""
+        if not self.sc_rounds:
+            self.sc_rounds.append(self.check("rounds", self.x_rounds))
+        return self.sc_rounds[0]
+
+    def after_step(self, done: int, x: np.ndarray, slow: bool, check_every: int) -> bool:
+        """Whether the polish ends on its figures after step ``done`` (at ``x``): a regular
+        check (every ``check_every`` steps, or a ``slow`` step) whose score is far inside the
+        thresholds or acceptable and stagnating, or the early look after SCORE_EARLY steps
+        far inside them (any other early score is forgotten)."""
+        regular = done % check_every == 0 or slow
+        if not regular and done == SCORE_EARLY:
+            if self.check(f"polish {done}", x, early=True) <= SCORE_DONE:
+                self.last_checked = done
+                return True
+        elif regular:
+            sc = self.check(f"polish {done}", x)
+            self.last_checked = done
+            if self.sc_prev is None and SCORE_DONE < sc < 1.0 and not slow:
+                self.sc_prev = self.rounds_score()
+            stalled = slow or (self.sc_prev is not None
+                               and self.sc_prev - sc < SCORE_STALL * self.sc_prev)
+            if sc <= SCORE_DONE or (sc < 1.0 and stalled):
+                return True
+            self.sc_prev = sc
+        return False
+
+    def finish(self, done: int, x: np.ndarray, stop: str
+               ) -> tuple[np.ndarray, str, float | None, str]:
+        """The polish' result: the last iterate checked, the end of the rounds scored unless
+        a checkpoint is far inside the thresholds, and the best-scoring of them."""
+        if done > self.last_checked:
+            self.check(f"polish {done}", x)
+        if self.best[0] is None or self.best[0] > SCORE_DONE:
+            self.rounds_score()
+        return self.best[1], stop, self.best[0], self.best[2]

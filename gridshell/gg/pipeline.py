@@ -10,6 +10,9 @@ Stages (each usable alone):
 3. :func:`collapse_gg`: the aligned (collapsed) configuration, and
    :func:`gridshell.gg.alignment.gg_alignment_sequence`: the states between the two;
 4. :func:`gg_metrics`: paper 5.1 on the result.
+
+:func:`design_gg` runs them as the named stages :data:`GG_STAGES` (read, grid, surface, net,
+collapse, metrics, gate, sequence, bundle; :mod:`gridshell.design.stages`), each timed.
 """
 from __future__ import annotations
 
@@ -22,19 +25,20 @@ from scipy.sparse.csgraph import connected_components
 from scipy.sparse.linalg import lsqr
 
 from gridshell.design.bundle import Design, DesignBundle, report_json, write_bundle
+from gridshell.design.stages import run_stages, stage
 from gridshell.core.errors import ConvergenceError, GridshellError, InputError, NoNetError
 from gridshell.geometry.grid import grid_quads
 from gridshell.measure.metrics import (alignability_error, alignability_error_arc, coverage, delta_l, deviations,
                        geodesic_turning, summary, target_deviation)
 from gridshell.geometry.net import Net
 from gridshell.measure.quality import Gate, design_gates, gate_lines, gate_summary, passed
-from gridshell.gg.clairaut import IntrinsicNet, geodesic_net
+from gridshell.gg.clairaut import geodesic_net
 from gridshell.gg.mapback import map_back, map_to_revolution
 from gridshell.gg.revolution import rebuild_revolution
 from gridshell.gg.alignment import GGSequence, gg_alignment_sequence
 
-__all__ = ["check_offsets", "collapse_gg", "design_gg", "gg_files", "gg_gates", "gg_metrics",
-           "gg_net_from_mesh", "gg_score", "TracedNets", "write_gg"]
+__all__ = ["GG_STAGES", "check_offsets", "collapse_gg", "design_gg", "gg_files", "gg_gates",
+           "gg_metrics", "gg_net_from_mesh", "gg_score", "TracedNets", "write_gg"]
 
 Progress = Callable[[str], None] | None
 
@@ -360,7 +364,8 @@ def design_gg(target: Any, *, meridians: str = "cols", grid: tuple[int, int] | N
               frames: int = 12, units: Any = None, clean: bool = True,
               obj: str | None = None, progress: Progress = None
               ) -> Design:
-    """Design a geodesic alignable gridshell on (an approximation of) a target surface.
+    """Design a geodesic alignable gridshell on (an approximation of) a target surface: the
+    stages :data:`GG_STAGES` run over the parameters, each timed.
 
     Parameters
     ----------
@@ -409,57 +414,114 @@ def design_gg(target: Any, *, meridians: str = "cols", grid: tuple[int, int] | N
         = ``{"ok", "gates" (Gate.as_dict() each), "summary"}``, ``params["surface"]`` = the
         surface optimization's residuals and why its polish stopped.
     report : dict
-        The surface optimization's report, the revolution's info, the collapse info and
+        The surface optimization's report, the revolution's info, the collapse info,
         ``sequence`` (a :class:`~gridshell.gg.alignment.GGSequence`, or None with
-        ``frames=0``). With a sequence the metrics hold ``delta_l`` (``{"mean", "max"}``, %:
-        edge lengths of ``aligned`` against the deployed chords - lamellae straighten, so
-        chords lengthen to the arc lengths) and ``sequence_length_error`` (the largest such
-        change over all states, %).
+        ``frames=0``) and ``timings`` (seconds per stage). With a sequence the metrics hold
+        ``delta_l`` (``{"mean", "max"}``, %: edge lengths of ``aligned`` against the deployed
+        chords, which lengthen to the arc lengths) and ``sequence_length_error`` (the largest
+        such change over all states, %).
     """
+    state = dict(locals())  # the parameters are the stages' initial state
+    timings: dict[str, float] = {}
+    run_stages(GG_STAGES, state, timings)
+    state["report"]["timings"] = timings
+    return Design(state["bundle"], state["report"])
+
+
+#: the net's options, as :func:`gg_net_from_mesh` and :class:`TracedNets` take them
+NET_OPTIONS = ("n_lamellae", "spacing", "crossing_angle", "at_parallel", "offsets", "angle")
+
+
+@stage("read", needs=("target", "units", "clean", "obj", "offsets", "n_lamellae", "spacing",
+                      "progress"),
+       gives=("V", "F", "geo", "offsets", "n_lamellae", "spacing"))
+def _read_stage(s: dict[str, Any]) -> dict[str, Any]:
+    """The target read and cleaned (metres); user-given offsets checked first."""
+    offsets, n_lamellae, spacing = s["offsets"], s["n_lamellae"], s["spacing"]
     if offsets is not None:
         offsets = check_offsets(offsets)  # before the long surface optimization
         n_lamellae = spacing = None       # the offsets place every lamella
-    V, F, geo = _load_target(target, units, clean, obj, progress)
-    target_path = geo.path
-    from gridshell.gg.design import design_gg_surface
-    from gridshell.gg.initial import initial_grid
+    V, F, geo = _load_target(s["target"], s["units"], s["clean"], s["obj"], s["progress"])
+    _say(s["progress"], f"target: {len(V)} vertices, {len(F)} faces")
+    return {"V": V, "F": F, "geo": geo, "offsets": offsets, "n_lamellae": n_lamellae,
+            "spacing": spacing}
 
-    _say(progress, f"target: {len(V)} vertices, {len(F)} faces")
+
+@stage("grid", needs=("V", "F", "meridians", "grid", "direction", "progress"),
+       gives=("Vw", "Fw", "work", "P0"))
+def _grid_stage(s: dict[str, Any]) -> dict[str, Any]:
+    """The initial grid ``P0 (R, C, 3)`` on the target (on a working copy of a big one)."""
+    from gridshell.gg.initial import initial_grid
     from gridshell.io.working import working_mesh
 
+    progress, F = s["progress"], s["F"]
     # a big target: the grid is sampled and projected on a working copy; the deviations
-    # below are measured against the full target
-    Vw, Fw, work = working_mesh(V, F)
+    # are measured against the full target
+    Vw, Fw, work = working_mesh(s["V"], F)
     if work is not None:
         _say(progress, f"designing on a working copy of {work['faces'][1]} faces "
              f"({work['method']}); deviations measured against all {len(F)}")
-    P0 = initial_grid(Vw, Fw, meridians=meridians, grid=grid, direction=direction)
+    P0 = initial_grid(Vw, Fw, meridians=s["meridians"], grid=s["grid"],
+                      direction=s["direction"])
     _say(progress, f"initial grid {P0.shape[0]} x {P0.shape[1]}; designing the GG surface")
-    net_options = {"n_lamellae": n_lamellae, "spacing": spacing,
-                   "crossing_angle": crossing_angle, "at_parallel": at_parallel,
-                   "offsets": offsets, "angle": angle}
-    nets = TracedNets(**net_options)
-    design = design_gg_surface(Vw, Fw, P0, weights=weights, outer=rounds,
-                               polish_iter=polish_iter, progress=progress, evaluate=nets.score)
-    P, design_report = design.P, dict(design.report, converged=design.converged,
-                                      history=design.history, stop=design.stop,
-                                      checkpoint=design.checkpoint, score=design.score,
-                                      deviation=design.deviation)
-    stage = nets.net(P, progress=progress)  # the checkpoint's net, traced by its check
-    net, rev = stage["net"], stage["rev"]
-    _say(progress, f"net: {len(net.joints)} joints, {len(net.loops)} loops, "
+    return {"Vw": Vw, "Fw": Fw, "work": work, "P0": P0}
+
+
+@stage("surface", needs=("Vw", "Fw", "P0", "weights", "rounds", "polish_iter", "progress")
+       + NET_OPTIONS, gives=("surface", "nets", "P"))
+def _surface_stage(s: dict[str, Any]) -> dict[str, Any]:
+    """The GG surface (4.1.1): rounds towards the target, then the polish onto the
+    constraints, its checkpoints scored by the nets traced on them."""
+    from gridshell.gg.design import design_gg_surface
+
+    nets = TracedNets(**{k: s[k] for k in NET_OPTIONS})
+    surface = design_gg_surface(s["Vw"], s["Fw"], s["P0"], weights=s["weights"],
+                                outer=s["rounds"], polish_iter=s["polish_iter"],
+                                progress=s["progress"], evaluate=nets.score)
+    return {"surface": surface, "nets": nets, "P": surface.P}
+
+
+@stage("net", needs=("nets", "P", "progress"), gives=("rev", "inet", "net", "net_rev"))
+def _net_stage(s: dict[str, Any]) -> dict[str, Any]:
+    """The geodesic net (4.1.2) on the surface of revolution of ``P``, mapped back: the net
+    the design's check traced."""
+    traced = s["nets"].net(s["P"], progress=s["progress"])
+    net = traced["net"]
+    _say(s["progress"], f"net: {len(net.joints)} joints, {len(net.loops)} loops, "
          f"{len(net.lamellae)} lamellae; collapsing and measuring")
-    aligned, collapse_info = collapse_gg(net)
-    R, C = P.shape[:2]
-    sV, sF = P.reshape(-1, 3), grid_quads(R, C)
-    metrics = gg_metrics(net, sV, sF, net_rev=stage["net_rev"], target=(V, F),
-                         target_samples=(Vw, Fw) if work is not None else None)
-    metrics["collapse_mismatch_max"] = collapse_info["mismatch_max"]
-    gates = gg_gates(metrics)
+    return {k: traced[k] for k in ("rev", "inet", "net", "net_rev")}
+
+
+@stage("collapse", needs=("net",), gives=("aligned", "collapse_info"))
+def _collapse_stage(s: dict[str, Any]) -> dict[str, Any]:
+    """The aligned (collapsed) configuration of the net (:func:`collapse_gg`)."""
+    aligned, collapse_info = collapse_gg(s["net"])
+    return {"aligned": aligned, "collapse_info": collapse_info}
+
+
+@stage("metrics", needs=("net", "net_rev", "P", "V", "F", "Vw", "Fw", "work", "collapse_info"),
+       gives=("metrics", "surface_V", "surface_F"))
+def _metrics_stage(s: dict[str, Any]) -> dict[str, Any]:
+    """Paper 5.1 on the net and the GG mesh (:func:`gg_metrics`), percentages."""
+    R, C = s["P"].shape[:2]
+    sV, sF = s["P"].reshape(-1, 3), grid_quads(R, C)
+    metrics = gg_metrics(s["net"], sV, sF, net_rev=s["net_rev"], target=(s["V"], s["F"]),
+                         target_samples=(s["Vw"], s["Fw"]) if s["work"] is not None else None)
+    metrics["collapse_mismatch_max"] = s["collapse_info"]["mismatch_max"]
+    return {"metrics": metrics, "surface_V": sV, "surface_F": sF}
+
+
+@stage("gate", needs=("metrics", "surface", "allow_unconverged", "progress"),
+       gives=("quality",))
+def _gate_stage(s: dict[str, Any]) -> dict[str, Any]:
+    """The paper's figures gated (:func:`gg_gates`); a miss raises ConvergenceError unless
+    ``allow_unconverged``."""
+    gates = gg_gates(s["metrics"])
     quality = {"ok": passed(gates), "gates": [g.as_dict() for g in gates],
                "summary": gate_summary(gates)}
-    _say(progress, "quality: " + quality["summary"])
-    if not quality["ok"] and not allow_unconverged:
+    _say(s["progress"], "quality: " + quality["summary"])
+    if not quality["ok"] and not s["allow_unconverged"]:
+        design = s["surface"]
         raise ConvergenceError(
             f"the GG design misses the paper's figures ({quality['summary']}; surface residuals: "
             f"geodesic {design.geodesic_residual_max:.2e} rad, edge-length spread "
@@ -467,35 +529,71 @@ def design_gg(target: Any, *, meridians: str = "cols", grid: tuple[int, int] | N
             "grid (--grid R C: a coarse grid carries the net poorly), fewer lamellae "
             "(--lamellae N), or a target closer to a surface of revolution; "
             "--allow-unconverged writes the design anyway, marked as failing")
+    return {"quality": quality}
+
+
+@stage("sequence", needs=("net", "aligned", "metrics", "frames", "progress"),
+       gives=("sequence", "metrics"))
+def _sequence_stage(s: dict[str, Any]) -> dict[str, Any]:
+    """The alignment sequence from the deployed to the collapsed net (``frames`` steps; none
+    with 0) and its length figures ``delta_l``, ``sequence_length_error`` (%)."""
+    net, aligned, frames, metrics = s["net"], s["aligned"], int(s["frames"]), s["metrics"]
     seq = None
-    if int(frames) > 0:
-        _say(progress, f"alignment sequence: {int(frames)} steps from deployed to collapsed")
-        seq = gg_alignment_sequence(net.joints, aligned, net.edges(), frames=int(frames),
-                                    progress=progress)
+    if frames > 0:
+        _say(s["progress"], f"alignment sequence: {frames} steps from deployed to collapsed")
+        seq = gg_alignment_sequence(net.joints, aligned, net.edges(), frames=frames,
+                                    progress=s["progress"])
         metrics["delta_l"] = _pct(summary(delta_l(net.joints, aligned, seq.edges)))
         metrics["sequence_length_error"] = 100.0 * max(
             float(np.nanmax(delta_l(net.joints, V, seq.edges))) for V in seq.V)
+    return {"sequence": seq, "metrics": metrics}
+
+
+@stage("bundle", needs=("net", "aligned", "surface_V", "surface_F", "metrics", "rev", "inet",
+                        "geo", "surface", "collapse_info", "sequence"),
+       gives=("bundle", "report"))
+def _bundle_stage(s: dict[str, Any]) -> dict[str, Any]:
+    """The design bundle (net, aligned, GG mesh, surface of revolution, metrics, parameters)
+    and the report of the run."""
+    rev, inet, design = s["rev"], s["inet"], s["surface"]
     rV, rF = rev.mesh()
-    inet: IntrinsicNet = stage["inet"]
-    params = {"target": target_path, "meridians": meridians, "grid": [int(R), int(C)],
-              "direction": direction, "n_lamellae": n_lamellae, "spacing": spacing,
-              "crossing_angle": crossing_angle, "at_parallel": at_parallel,
-              "offsets": [list(map(float, o)) for o in offsets] if offsets else None,
-              "weights": weights, "converged": quality["ok"], "quality": quality,
-              "input": {**geo.info(), "working_mesh": work},
-              "surface": {"geodesic_residual_max": design.geodesic_residual_max,
-                          "length_residual_rel_max": design.length_residual_rel_max,
-                          "residuals_at_round_off": design.converged, "polish_stop": design.stop,
-                          "checkpoint": design.checkpoint},
-              "dphi": rev.dphi,
-              "total_angle": rev.total_angle,
-              "clairaut_c": inet.c, "s_star": inet.s_star, "frames": int(frames)}
-    bundle = DesignBundle(kind="GG", net=net, aligned=aligned, surface_V=sV, surface_F=sF,
-                          metrics=metrics, params=params, revolution_V=rV, revolution_F=rF,
-                          units=geo.units)
-    report = {"design": design_report, "revolution": rev.info, "collapse": collapse_info,
-              "net": inet.info, "sequence": seq}
-    return Design(bundle, report)
+    bundle = DesignBundle(kind="GG", net=s["net"], aligned=s["aligned"],
+                          surface_V=s["surface_V"], surface_F=s["surface_F"],
+                          metrics=s["metrics"], params=_gg_params(s), revolution_V=rV,
+                          revolution_F=rF, units=s["geo"].units)
+    design_report = dict(design.report, converged=design.converged, history=design.history,
+                         stop=design.stop, checkpoint=design.checkpoint, score=design.score,
+                         deviation=design.deviation)
+    report = {"design": design_report, "revolution": rev.info, "collapse": s["collapse_info"],
+              "net": inet.info, "sequence": s["sequence"]}
+    return {"bundle": bundle, "report": report}
+
+
+def _gg_params(s: dict[str, Any]) -> dict[str, Any]:
+    """``bundle.params`` of a GG design: its options, the quality, the input, the surface
+    optimization's residuals, the revolution's angles and the net's Clairaut constant."""
+    R, C = s["P"].shape[:2]
+    design, rev, inet, quality = s["surface"], s["rev"], s["inet"], s["quality"]
+    offsets = s["offsets"]
+    return {"target": s["geo"].path, "meridians": s["meridians"], "grid": [int(R), int(C)],
+            "direction": s["direction"], "n_lamellae": s["n_lamellae"],
+            "spacing": s["spacing"], "crossing_angle": s["crossing_angle"],
+            "at_parallel": s["at_parallel"],
+            "offsets": [list(map(float, o)) for o in offsets] if offsets else None,
+            "weights": s["weights"], "converged": quality["ok"], "quality": quality,
+            "input": {**s["geo"].info(), "working_mesh": s["work"]},
+            "surface": {"geodesic_residual_max": design.geodesic_residual_max,
+                        "length_residual_rel_max": design.length_residual_rel_max,
+                        "residuals_at_round_off": design.converged, "polish_stop": design.stop,
+                        "checkpoint": design.checkpoint},
+            "dphi": rev.dphi,
+            "total_angle": rev.total_angle,
+            "clairaut_c": inet.c, "s_star": inet.s_star, "frames": int(s["frames"])}
+
+
+#: the GG pipeline (paper 4.1), in order: :func:`design_gg` runs them over its parameters
+GG_STAGES = (_read_stage, _grid_stage, _surface_stage, _net_stage, _collapse_stage,
+             _metrics_stage, _gate_stage, _sequence_stage, _bundle_stage)
 
 
 def _edge_families(net: Net, edges: np.ndarray) -> np.ndarray:
