@@ -29,10 +29,11 @@ from gridshell.geometry.net import move_joints
 from gridshell.ncp.collapse import (CollapseResult, closest_on_polyline, collapse_curve, fit_circle,
                        line_deviation)
 from gridshell.geometry.bspline import uniform_params
-from gridshell.ncp.directions import net_directions, reference_net_check
+from gridshell.ncp.directions import net_directions
 from gridshell.ncp.levelset import TracedNet, trace
 from gridshell.ncp.postopt import PostOptResult, interior_vertices, post_optimize
 from gridshell.ncp.alignment import AlignmentSequence, collapse_direction, plane_frame, simulate_alignment
+from gridshell.ncp.source import load_surface
 
 __all__ = ["KIND", "NCP_STAGES", "NCPOptions", "NCPState", "crossing_normal_curvature",
            "design_ncp", "ncp_files", "ncp_state", "write_ncp", "load_surface"]
@@ -50,103 +51,6 @@ class NCPState:
     post: PostOptResult
     sequence: AlignmentSequence
     aligned_2d: np.ndarray
-
-
-def load_surface(source: Any, *, mode: str, phlw_options: dict | None = None,
-                 progress: Callable[[str], None] | None = None, units: Any = None,
-                 clean: bool = True, obj: str | None = None
-                 ) -> tuple[BSplineSurface, float | None, dict]:
-    """``(surface, n, info)`` from a B-spline JSON path, a :class:`BSplineSurface`, a
-    ``PHLWResult`` or a reference (mesh or .3dm path, ``InputGeometry`` or ``(V, F)``, read
-    through :func:`gridshell.io.read.read_input` with ``units``, ``clean``, ``obj``; optimized
-    with :func:`gridshell.ncp.phlw.optimize_phlw` first: a .3dm NURBS surface is its initial
-    B-spline directly, a mesh is fitted). ``n`` is the CNC normal curvature when the source
-    provides it. ``info["units"]`` is the unit of the input (:class:`gridshell.io.Units`)."""
-    from gridshell.io.read import InputGeometry, read_input
-    from gridshell.core.units import METRES
-    from gridshell.ncp.phlw import PHLWResult, optimize_phlw
-
-    if isinstance(source, BSplineSurface):
-        return source, None, {"source": "bspline", "units": METRES}
-    if isinstance(source, PHLWResult):
-        n = float(source.n_rows[0]) if source.mode == "cnc" else None
-        return source.surface, n, {"source": "phlw-result", "phlw_mode": source.mode,
-                                   "units": METRES}
-    if isinstance(source, (str, Path)) and str(source).lower().endswith(".json"):
-        if units is not None or obj is not None:
-            raise InputError(f"{Path(source).name} is a B-spline in metres written by 'gridshell "
-                             "phlw' (its input unit is in report.json): drop --units / --object")
-        return BSplineSurface.load(source), None, {"source": str(source),
-                                                   "units": _phlw_units(Path(source))}
-    from gridshell.ncp.reference import initial_surface
-
-    opts = dict(phlw_options or {})
-    if isinstance(source, (str, Path, InputGeometry)) or hasattr(source, "V"):
-        geo = read_input(source, units=units, clean=clean, obj=obj, what="the reference")
-    else:
-        try:
-            V, F = source
-        except (TypeError, ValueError):
-            raise InputError("the NCP source must be a B-spline .json, a mesh file, (V, F), a "
-                             "BSplineSurface or a PHLWResult") from None
-        geo = read_input((V, F), units=units, clean=clean, what="the reference")
-    V, F = geo.V, geo.F
-    name = geo.path or "(V, F)"
-    if progress is not None and geo.path is not None:
-        progress(f"input: {geo.summary()}")
-    ctrl, degree = tuple(opts.pop("ctrl", (9, 9))), tuple(opts.pop("degree", (4, 4)))
-    transpose, align = bool(opts.pop("transpose", False)), bool(opts.pop("align", False))
-    if geo.surface is not None:  # a NURBS surface is the initial B-spline as it is
-        from gridshell.ncp.reference import InitialFit
-
-        from gridshell.io.read import swap_uv
-
-        srf = swap_uv(geo.surface) if transpose else geo.surface
-        init = InitialFit(surface=srf, rms=0.0, method="NURBS")
-        if progress is not None:
-            progress(f"PHLW step: initial B-spline = the NURBS surface ({srf.shape[0]} x "
-                     f"{srf.shape[1]} control points, degree {srf.degree_u} x {srf.degree_v})")
-    else:
-        init = initial_surface(V, F, n_ctrl=ctrl, degree=degree, transpose=transpose,
-                               align=align)
-    if progress is not None and geo.surface is None:
-        turned = (f", parameter plane turned {init.rotated_deg:.1f} deg onto the principal "
-                  "directions" if init.rotated_deg else "")
-        progress(f"PHLW step: initial B-spline ({init.method} fit, rms {init.rms:.3g} m{turned})")
-    # a reference without the net anywhere (umbilic everywhere; K > 0 everywhere for aa) is a
-    # true no-net answer (exit 3); any later no-net answer is the PHLW step's failure (exit 4)
-    reference_net_check(init.surface, mode)
-    try:
-        res = optimize_phlw(init.surface, (V, F), mode=mode, progress=progress, **opts)
-    except NoNetError as exc:
-        if str(exc).startswith("the reference"):
-            raise
-        raise ConvergenceError(
-            f"the PHLW step failed: {exc}. The reference itself has distinct principal "
-            f"curvatures{' and K < 0 somewhere' if mode == 'aa' else ''}, so a net may exist "
-            "near it; raise --phlw-outer / --phlw-max-iter, or run 'gridshell phlw' on it and "
-            "inspect the curvature diagram") from exc
-    n = float(res.n_rows[0]) if mode == "cnc" else None
-    e0 = res.report_before.get("E_PHLW", {}).get("total") if res.report_before else None
-    e1 = res.report_after.get("E_PHLW", {}).get("total") if res.report_after else None
-    return res.surface, n, {"source": name, "phlw_deviation": res.deviation,
-                            "phlw_converged": res.converged, "phlw_diagnostics": res.diagnostics,
-                            "phlw_energy": [e0, e1],
-                            "phlw_figures": {k: f["value"] for k, f in (res.figures or {}).items()},
-                            "phlw_aligned_deg": float(init.rotated_deg),
-                            "units": geo.units, "input": geo.info()}
-
-
-def _phlw_units(path: Path) -> Any:
-    """The input unit recorded in the ``report.json`` beside a ``surface.json`` written by
-    ``gridshell phlw`` (metres when there is none)."""
-    from gridshell.core.units import METRES, Units
-
-    report = path.parent / "report.json"
-    try:
-        return Units.from_json(json.loads(report.read_text()).get("units"))
-    except (OSError, ValueError, AttributeError):
-        return METRES
 
 
 def _phlw_failure(info: dict, mode: str, exc: Exception) -> ConvergenceError:
