@@ -508,7 +508,7 @@ def _axis_kept(Q: np.ndarray, jidx: np.ndarray) -> tuple[np.ndarray, np.ndarray]
 def trace_net(surf: BSplineSurface, fits: dict[int, LevelFit], *, curves: int | tuple[int, int]
               | None = None, spacing: float | None = None, grid: tuple[int, int] = (240, 240),
               axis_points: int = 300, tol: float = 1e-9) -> TracedNet:
-    """Trace both families and build the net (joints, loops, lamellae).
+    """Trace both families and build the net (joints, loops, lamellae) as a :class:`TracedNet`.
 
     Parameters
     ----------
@@ -519,61 +519,23 @@ def trace_net(surf: BSplineSurface, fits: dict[int, LevelFit], *, curves: int | 
     grid : marching-squares grid in ``(u, v)``
     axis_points : about this many vertices along the longest lamella axis
     tol : joint residual ``|xi - level|`` relative to the ``xi`` range accepted as converged
-
-    Returns
-    -------
-    TracedNet
     """
     if curves is not None and spacing is not None:
         raise InputError("give either curves or spacing, not both")
     if curves is None and spacing is None:
         curves = 10
     counts = (curves, curves) if curves is None or np.isscalar(curves) else tuple(curves)
-    (u0, u1), (v0, v1) = surf.domain
-    ug, vg = np.linspace(u0, u1, 120), np.linspace(v0, v1, 120)
-    levels, polys = {}, {}
-    for f, cnt in zip((1, 3), counts):
-        Z = fits[f].F.evaluate_grid(ug, vg)[..., 2]
-        levels[f] = level_values(float(Z.min()), float(Z.max()), cnt, spacing,
-                                 max_count=min(grid) // 2)
-        polys[f] = trace_levels(fits[f].F, levels[f], grid)
-    F1, F3 = fits[1].F, fits[3].F
-    Ffam = {1: F1, 3: F3}
+    levels, polys = _trace_families(surf, fits, counts, spacing, grid)
+    Ffam = {1: fits[1].F, 3: fits[3].F}
     rng = max(float(np.ptp(levels[1])), float(np.ptp(levels[3])), 1.0)
-    # the traced curves of each family: xi of the other family along them and their 3D points,
-    # each evaluated in one call for all curves (every vertex independently)
     live = {f: [a for a, uv in enumerate(polys[f]) if uv is not None] for f in (1, 3)}
-    cross: dict[int, dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]]] = {1: {}, 3: {}}
-    pts: dict[int, dict[int, np.ndarray]] = {1: {}, 3: {}}
-    for f, other in ((1, 3), (3, 1)):
-        if not live[f]:
-            continue
-        lens = [len(polys[f][a]) for a in live[f]]
-        UV = np.concatenate([polys[f][a] for a in live[f]])
-        xi_o = _split(evaluate_xi(Ffam[other], UV[:, 0], UV[:, 1]), lens)
-        cross[f] = {a: _crossings(z, levels[other]) for a, z in zip(live[f], xi_o)}
-        pts[f] = dict(zip(live[f], _split(surf.evaluate(UV[:, 0], UV[:, 1]), lens)))
-    # joints: crossings of xi_3 levels along the traced curves of family 1, refined together
-    found: dict[tuple[int, int], np.ndarray] = {}
-    gi, gj, guess = [], [], []
-    for i in live[1]:
-        lev, seg, t = cross[1][i]
-        uv = polys[1][i]
-        gi.append(np.full(len(lev), i))
-        gj.append(lev)
-        guess.append(uv[seg] + t[:, None] * (uv[seg + 1] - uv[seg]))
-    if gi and sum(len(g) for g in gi):
-        ii, jj = np.concatenate(gi), np.concatenate(gj)
-        sol, res = _newton_joints(F1, F3, np.concatenate(guess), levels[1][ii], levels[3][jj])
-        for i, j, p, r in zip(ii.tolist(), jj.tolist(), sol, res.tolist()):
-            if r <= tol * rng:
-                found[(i, j)] = p
-    # positions along the traced curves of both families (segment, fraction) per joint
+    cross, pts = _along_curves(surf, Ffam, polys, levels, live)
+    found = _joints(Ffam, polys, levels, live[1], cross[1], tol * rng)
+    # the place (segment, fraction) of every joint along its curve of either family
     where: dict[int, dict[tuple[int, int], tuple[int, float]]] = {1: {}, 3: {}}
     for f in (1, 3):
         for a in live[f]:
-            lev, seg, t = cross[f][a]
-            for b, sg, tt in zip(lev.tolist(), seg.tolist(), t.tolist()):
+            for b, sg, tt in zip(*(c.tolist() for c in cross[f][a])):
                 key = (a, b) if f == 1 else (b, a)
                 if key in found:
                     where[f][key] = (sg, tt)
@@ -583,46 +545,15 @@ def trace_net(surf: BSplineSurface, fits: dict[int, LevelFit], *, curves: int | 
                          "curves (--curves) or a smaller spacing")
     index = {k: n for n, k in enumerate(keys)}
     joint_uv = np.array([found[k] for k in keys])
-    joint_ij = np.array(keys, np.int64)
-    P3 = surf.evaluate(joint_uv[:, 0], joint_uv[:, 1])
-    # lamellae
-    longest = 0.0
-    for f in (1, 3):
-        for Q in pts[f].values():
-            longest = max(longest, float(np.linalg.norm(np.diff(Q, axis=0), axis=1).sum()))
+    longest = max([0.0] + [float(np.linalg.norm(np.diff(Q, axis=0), axis=1).sum())
+                           for f in (1, 3) for Q in pts[f].values()])
     h = longest / max(int(axis_points), 10)
     lamellae, axis_uv, axis_jidx, dropped = [], [], [], []
     for f in (1, 3):
-        todo = []
-        for a in live[f]:
-            mine = [k for k in keys if (k[0] if f == 1 else k[1]) == a]
-            if len(mine) < 2:
-                dropped.append(f"family {f} curve {a} (xi = {levels[f][a]:.4g}) has "
-                               f"{len(mine)} joint(s); left out")
-                continue
-            seg = np.array([where[f][k][0] for k in mine])
-            frac = np.array([where[f][k][1] for k in mine])
-            juv = np.array([found[k] for k in mine])
-            order = np.lexsort((frac, seg))
-            mine = [mine[o] for o in order]
-            Q, jidx = _axis_vertices(polys[f][a], pts[f][a], juv, seg, frac, h)
-            free = np.ones(len(Q), bool)
-            free[jidx] = False
-            todo.append((a, mine, Q, jidx, free))
-        if not todo:
-            continue
-        # the axes' vertices between the joints projected onto their levels in one call
-        lev = np.concatenate([np.full(int(fr.sum()), levels[f][a]) for a, _, _, _, fr in todo])
-        moved = project_to_level(Ffam[f], np.concatenate([Q[fr] for _, _, Q, _, fr in todo]),
-                                 lev)
-        axes = []
-        for (a, mine, Q, jidx, fr), q in zip(todo, _split(moved, [int(t[4].sum())
-                                                                   for t in todo])):
-            Q[fr] = q
-            axes.append((mine, *_axis_kept(Q, jidx)))
-        QQ = np.concatenate([Q for _, Q, _ in axes])
-        Xs = _split(surf.evaluate(QQ[:, 0], QQ[:, 1]), [len(Q) for _, Q, _ in axes])
-        for (mine, Q, jidx), X in zip(axes, Xs):
+        todo, notes = _family_axes(f, live[f], keys, where[f], found, polys[f], pts[f],
+                                   levels[f], h)
+        dropped += notes
+        for mine, Q, jidx, X in _projected_axes(surf, Ffam[f], levels[f], todo):
             s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(X, axis=0), axis=1))])
             lamellae.append(Lamella(id=len(lamellae), family=f,
                                     joints=[index[k] for k in mine], joint_s=s[jidx], axis=X))
@@ -633,7 +564,110 @@ def trace_net(surf: BSplineSurface, fits: dict[int, LevelFit], *, curves: int | 
                          "the other family twice, so no lamella has two joints (the net "
                          "directions are nearly parallel, or the curves too few); ask for more "
                          "curves (--curves) or a smaller spacing, or use another mode")
-    # net-loops (i, j), (i+1, j), (i+1, j+1), (i, j+1), A = corner of least u
+    net = Net(joints=surf.evaluate(joint_uv[:, 0], joint_uv[:, 1]),
+              loops=_net_loops(keys, index, joint_uv), lamellae=lamellae)
+    return TracedNet(net=net, joint_uv=joint_uv, joint_ij=np.array(keys, np.int64),
+                     axis_uv=axis_uv, axis_joint_index=axis_jidx, levels=levels, fits=fits,
+                     dropped=dropped)
+
+
+def _trace_families(surf: BSplineSurface, fits: dict[int, LevelFit], counts: tuple,
+                    spacing: float | None, grid: tuple[int, int]) -> tuple[dict, dict]:
+    """Per family the level values (:func:`level_values` over ``xi`` on a 120 x 120 grid) and
+    their polylines in ``(u, v)`` (:func:`trace_levels`)."""
+    ug, vg = (np.linspace(a, b, 120) for a, b in surf.domain)
+    levels, polys = {}, {}
+    for f, cnt in zip((1, 3), counts):
+        Z = fits[f].F.evaluate_grid(ug, vg)[..., 2]
+        levels[f] = level_values(float(Z.min()), float(Z.max()), cnt, spacing,
+                                 max_count=min(grid) // 2)
+        polys[f] = trace_levels(fits[f].F, levels[f], grid)
+    return levels, polys
+
+
+def _along_curves(surf: BSplineSurface, Ffam: dict[int, BSplineSurface], polys: dict,
+                  levels: dict, live: dict) -> tuple[dict, dict]:
+    """Per family and traced curve: the crossings of the other family's levels
+    (:func:`_crossings`) and its 3D points (m), each evaluated in one call for all curves."""
+    cross: dict[int, dict] = {1: {}, 3: {}}
+    pts: dict[int, dict[int, np.ndarray]] = {1: {}, 3: {}}
+    for f, other in ((1, 3), (3, 1)):
+        if not live[f]:
+            continue
+        lens = [len(polys[f][a]) for a in live[f]]
+        UV = np.concatenate([polys[f][a] for a in live[f]])
+        xi_o = _split(evaluate_xi(Ffam[other], UV[:, 0], UV[:, 1]), lens)
+        cross[f] = {a: _crossings(z, levels[other]) for a, z in zip(live[f], xi_o)}
+        pts[f] = dict(zip(live[f], _split(surf.evaluate(UV[:, 0], UV[:, 1]), lens)))
+    return cross, pts
+
+
+def _joints(Ffam: dict[int, BSplineSurface], polys: dict, levels: dict, live1: list[int],
+            cross1: dict, tol: float) -> dict[tuple[int, int], np.ndarray]:
+    """The joints ``(i, j) -> uv``: crossings of the ``xi_3`` levels along the traced curves
+    of family 1, refined together by Newton's method; kept where ``|xi - level| <= tol``."""
+    found: dict[tuple[int, int], np.ndarray] = {}
+    gi, gj, guess = [], [], []
+    for i in live1:
+        lev, seg, t = cross1[i]
+        uv = polys[1][i]
+        gi.append(np.full(len(lev), i))
+        gj.append(lev)
+        guess.append(uv[seg] + t[:, None] * (uv[seg + 1] - uv[seg]))
+    if gi and sum(len(g) for g in gi):
+        ii, jj = np.concatenate(gi), np.concatenate(gj)
+        sol, res = _newton_joints(Ffam[1], Ffam[3], np.concatenate(guess), levels[1][ii],
+                                  levels[3][jj])
+        for i, j, p, r in zip(ii.tolist(), jj.tolist(), sol, res.tolist()):
+            if r <= tol:
+                found[(i, j)] = p
+    return found
+
+
+def _family_axes(f: int, live: list[int], keys: list, where: dict, found: dict, polys: list,
+                 pts: dict, levels: np.ndarray, h: float) -> tuple[list[tuple], list[str]]:
+    """The axes of family ``f`` before projection, per curve with two or more joints
+    ``(curve, joints in order, uv, joint indices, free vertices)`` (:func:`_axis_vertices`,
+    spacing ``h`` m); a note per curve left out."""
+    todo, notes = [], []
+    for a in live:
+        mine = [k for k in keys if (k[0] if f == 1 else k[1]) == a]
+        if len(mine) < 2:
+            notes.append(f"family {f} curve {a} (xi = {levels[a]:.4g}) has {len(mine)} "
+                         "joint(s); left out")
+            continue
+        seg = np.array([where[k][0] for k in mine])
+        frac = np.array([where[k][1] for k in mine])
+        juv = np.array([found[k] for k in mine])
+        order = np.lexsort((frac, seg))
+        mine = [mine[o] for o in order]
+        Q, jidx = _axis_vertices(polys[a], pts[a], juv, seg, frac, h)
+        free = np.ones(len(Q), bool)
+        free[jidx] = False
+        todo.append((a, mine, Q, jidx, free))
+    return todo, notes
+
+
+def _projected_axes(surf: BSplineSurface, F: BSplineSurface, levels: np.ndarray,
+                    todo: list[tuple]) -> list[tuple]:
+    """The axes of :func:`_family_axes` with their vertices between the joints projected onto
+    their levels (one call), repeats removed: ``(joints, uv, joint indices, 3D points m)``."""
+    if not todo:
+        return []
+    lev = np.concatenate([np.full(int(fr.sum()), levels[a]) for a, _, _, _, fr in todo])
+    moved = project_to_level(F, np.concatenate([Q[fr] for _, _, Q, _, fr in todo]), lev)
+    axes = []
+    for (a, mine, Q, jidx, fr), q in zip(todo, _split(moved, [int(t[4].sum()) for t in todo])):
+        Q[fr] = q
+        axes.append((mine, *_axis_kept(Q, jidx)))
+    QQ = np.concatenate([Q for _, Q, _ in axes])
+    Xs = _split(surf.evaluate(QQ[:, 0], QQ[:, 1]), [len(Q) for _, Q, _ in axes])
+    return [(mine, Q, jidx, X) for (mine, Q, jidx), X in zip(axes, Xs)]
+
+
+def _net_loops(keys: list[tuple[int, int]], index: dict, joint_uv: np.ndarray) -> np.ndarray:
+    """Net-loops ``(i, j), (i+1, j), (i+1, j+1), (i, j+1)`` as joint indices ``(m, 4)``, A =
+    the corner of least ``u`` first."""
     loops = []
     for (i, j) in keys:
         quad = [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)]
@@ -641,9 +675,7 @@ def trace_net(surf: BSplineSurface, fits: dict[int, LevelFit], *, curves: int | 
             ids = np.array([index[q] for q in quad])
             start = int(np.argmin(joint_uv[ids, 0]))
             loops.append(np.roll(ids, -start))
-    net = Net(joints=P3, loops=np.array(loops, np.int64).reshape(-1, 4), lamellae=lamellae)
-    return TracedNet(net=net, joint_uv=joint_uv, joint_ij=joint_ij, axis_uv=axis_uv,
-                     axis_joint_index=axis_jidx, levels=levels, fits=fits, dropped=dropped)
+    return np.array(loops, np.int64).reshape(-1, 4)
 
 
 def trace(surf: BSplineSurface, dirs: NetDirections, *, curves: int | tuple[int, int] | None = None,

@@ -1,9 +1,12 @@
 """The NCP pipeline (paper 4.2, 5.1): from a PHLW / CNC / PK surface to a design bundle.
 
-Stages, each timed in the report: PHLW surface (only for a mesh input, :mod:`.phlw`), net
-directions (:mod:`.directions`), level-set tracing (:mod:`.levelset`), collapse curve
-(:mod:`.collapse`), post-optimization (:mod:`.postopt`), alignment simulation
-(:mod:`.simulate`), metrics (:mod:`gridshell.measure.metrics`). The bundle kind follows the mode:
+:func:`design_ncp` runs :data:`NCP_STAGES`, named stages over one state dict
+(:mod:`gridshell.design.stages`), each timed in the report: ``surface`` (read; the PHLW step
+for a reference, :mod:`.phlw`), ``directions`` (:mod:`.directions`), ``tracing`` (level-set
+tracing, :mod:`.levelset`), ``collapse`` (:mod:`.collapse`), ``postopt`` (post-optimization,
+:mod:`.postopt`), ``simulation`` (the alignment, :mod:`.alignment`), ``metrics``
+(:mod:`gridshell.measure.metrics` and the gates), ``gate`` (a design missing the figures
+refused) and ``bundle`` (the design bundle and report). The bundle kind follows the mode:
 ``phlw -> "NCP"``, ``cnc -> "CNC"``, ``aa -> "AA"``.
 """
 from __future__ import annotations
@@ -18,6 +21,7 @@ import numpy as np
 
 from gridshell.geometry.bspline import BSplineSurface
 from gridshell.design.bundle import CollapseCurve, Design, DesignBundle, report_json, write_bundle
+from gridshell.design.stages import Stage, run_stages, stage
 from gridshell.core.errors import ConvergenceError, InputError, NoNetError
 from gridshell.measure.metrics import alignability_error, delta_l, delta_n, deviation, summary
 from gridshell.measure.quality import design_gates, gate_summary, passed
@@ -25,13 +29,14 @@ from gridshell.geometry.net import move_joints
 from gridshell.ncp.collapse import (CollapseResult, closest_on_polyline, collapse_curve, fit_circle,
                        line_deviation)
 from gridshell.geometry.bspline import uniform_params
-from gridshell.ncp.directions import net_directions, reference_net_check
+from gridshell.ncp.directions import net_directions
 from gridshell.ncp.levelset import TracedNet, trace
 from gridshell.ncp.postopt import PostOptResult, interior_vertices, post_optimize
 from gridshell.ncp.alignment import AlignmentSequence, collapse_direction, plane_frame, simulate_alignment
+from gridshell.ncp.source import load_surface
 
-__all__ = ["KIND", "NCPState", "crossing_normal_curvature", "design_ncp", "ncp_files", "write_ncp",
-           "load_surface"]
+__all__ = ["KIND", "NCP_STAGES", "NCPOptions", "NCPState", "crossing_normal_curvature",
+           "design_ncp", "ncp_files", "ncp_state", "write_ncp", "load_surface"]
 
 KIND = {"phlw": "NCP", "cnc": "CNC", "aa": "AA"}
 
@@ -46,103 +51,6 @@ class NCPState:
     post: PostOptResult
     sequence: AlignmentSequence
     aligned_2d: np.ndarray
-
-
-def load_surface(source: Any, *, mode: str, phlw_options: dict | None = None,
-                 progress: Callable[[str], None] | None = None, units: Any = None,
-                 clean: bool = True, obj: str | None = None
-                 ) -> tuple[BSplineSurface, float | None, dict]:
-    """``(surface, n, info)`` from a B-spline JSON path, a :class:`BSplineSurface`, a
-    ``PHLWResult`` or a reference (mesh or .3dm path, ``InputGeometry`` or ``(V, F)``, read
-    through :func:`gridshell.io.read.read_input` with ``units``, ``clean``, ``obj``; optimized
-    with :func:`gridshell.ncp.phlw.optimize_phlw` first: a .3dm NURBS surface is its initial
-    B-spline directly, a mesh is fitted). ``n`` is the CNC normal curvature when the source
-    provides it. ``info["units"]`` is the unit of the input (:class:`gridshell.io.Units`)."""
-    from gridshell.io.read import InputGeometry, read_input
-    from gridshell.core.units import METRES
-    from gridshell.ncp.phlw import PHLWResult, optimize_phlw
-
-    if isinstance(source, BSplineSurface):
-        return source, None, {"source": "bspline", "units": METRES}
-    if isinstance(source, PHLWResult):
-        n = float(source.n_rows[0]) if source.mode == "cnc" else None
-        return source.surface, n, {"source": "phlw-result", "phlw_mode": source.mode,
-                                   "units": METRES}
-    if isinstance(source, (str, Path)) and str(source).lower().endswith(".json"):
-        if units is not None or obj is not None:
-            raise InputError(f"{Path(source).name} is a B-spline in metres written by 'gridshell "
-                             "phlw' (its input unit is in report.json): drop --units / --object")
-        return BSplineSurface.load(source), None, {"source": str(source),
-                                                   "units": _phlw_units(Path(source))}
-    from gridshell.ncp.reference import initial_surface
-
-    opts = dict(phlw_options or {})
-    if isinstance(source, (str, Path, InputGeometry)) or hasattr(source, "V"):
-        geo = read_input(source, units=units, clean=clean, obj=obj, what="the reference")
-    else:
-        try:
-            V, F = source
-        except (TypeError, ValueError):
-            raise InputError("the NCP source must be a B-spline .json, a mesh file, (V, F), a "
-                             "BSplineSurface or a PHLWResult") from None
-        geo = read_input((V, F), units=units, clean=clean, what="the reference")
-    V, F = geo.V, geo.F
-    name = geo.path or "(V, F)"
-    if progress is not None and geo.path is not None:
-        progress(f"input: {geo.summary()}")
-    ctrl, degree = tuple(opts.pop("ctrl", (9, 9))), tuple(opts.pop("degree", (4, 4)))
-    transpose, align = bool(opts.pop("transpose", False)), bool(opts.pop("align", False))
-    if geo.surface is not None:  # a NURBS surface is the initial B-spline as it is
-        from gridshell.ncp.reference import InitialFit
-
-        from gridshell.io.read import swap_uv
-
-        srf = swap_uv(geo.surface) if transpose else geo.surface
-        init = InitialFit(surface=srf, rms=0.0, method="NURBS")
-        if progress is not None:
-            progress(f"PHLW step: initial B-spline = the NURBS surface ({srf.shape[0]} x "
-                     f"{srf.shape[1]} control points, degree {srf.degree_u} x {srf.degree_v})")
-    else:
-        init = initial_surface(V, F, n_ctrl=ctrl, degree=degree, transpose=transpose,
-                               align=align)
-    if progress is not None and geo.surface is None:
-        turned = (f", parameter plane turned {init.rotated_deg:.1f} deg onto the principal "
-                  "directions" if init.rotated_deg else "")
-        progress(f"PHLW step: initial B-spline ({init.method} fit, rms {init.rms:.3g} m{turned})")
-    # a reference without the net anywhere (umbilic everywhere; K > 0 everywhere for aa) is a
-    # true no-net answer (exit 3); any later no-net answer is the PHLW step's failure (exit 4)
-    reference_net_check(init.surface, mode)
-    try:
-        res = optimize_phlw(init.surface, (V, F), mode=mode, progress=progress, **opts)
-    except NoNetError as exc:
-        if str(exc).startswith("the reference"):
-            raise
-        raise ConvergenceError(
-            f"the PHLW step failed: {exc}. The reference itself has distinct principal "
-            f"curvatures{' and K < 0 somewhere' if mode == 'aa' else ''}, so a net may exist "
-            "near it; raise --phlw-outer / --phlw-max-iter, or run 'gridshell phlw' on it and "
-            "inspect the curvature diagram") from exc
-    n = float(res.n_rows[0]) if mode == "cnc" else None
-    e0 = res.report_before.get("E_PHLW", {}).get("total") if res.report_before else None
-    e1 = res.report_after.get("E_PHLW", {}).get("total") if res.report_after else None
-    return res.surface, n, {"source": name, "phlw_deviation": res.deviation,
-                            "phlw_converged": res.converged, "phlw_diagnostics": res.diagnostics,
-                            "phlw_energy": [e0, e1],
-                            "phlw_figures": {k: f["value"] for k, f in (res.figures or {}).items()},
-                            "phlw_aligned_deg": float(init.rotated_deg),
-                            "units": geo.units, "input": geo.info()}
-
-
-def _phlw_units(path: Path) -> Any:
-    """The input unit recorded in the ``report.json`` beside a ``surface.json`` written by
-    ``gridshell phlw`` (metres when there is none)."""
-    from gridshell.core.units import METRES, Units
-
-    report = path.parent / "report.json"
-    try:
-        return Units.from_json(json.loads(report.read_text()).get("units"))
-    except (OSError, ValueError, AttributeError):
-        return METRES
 
 
 def _phlw_failure(info: dict, mode: str, exc: Exception) -> ConvergenceError:
@@ -203,6 +111,332 @@ def _pct(d: dict[str, float]) -> dict[str, float]:
     return {k: 100.0 * v for k, v in d.items()}
 
 
+@dataclass(frozen=True)
+class NCPOptions:
+    """The keywords of :func:`design_ncp` (same names, defaults and units), as one value of the
+    stages' state (``state["opts"]``)."""
+
+    mode: str = "phlw"
+    curves: int | tuple[int, int] | None = None
+    spacing: float | None = None
+    n: float | None = None
+    samples: tuple[int, int] = (48, 48)
+    levelset_ctrl: tuple[int, int] = (12, 12)
+    levelset_degree: tuple[int, int] = (3, 3)
+    omega_f: float = 0.01
+    trace_grid: tuple[int, int] = (240, 240)
+    collapse_samples: tuple[int, int] = (1200, 1200)
+    postopt_weights: dict[str, float] | None = None
+    postopt_rounds: int = 3
+    frames: int = 12
+    sim_weights: dict[str, float] | None = None
+    surface_samples: tuple[int, int] = (100, 100)
+    phlw_options: dict | None = None
+    allow_unconverged: bool = False
+    strict: bool = False
+    units: Any = None
+    clean: bool = True
+    obj: str | None = None
+    progress: Callable[[str], None] | None = None
+
+    def __post_init__(self) -> None:
+        if self.mode not in KIND:
+            raise InputError(f"unknown mode {self.mode!r}; use 'phlw', 'cnc' or 'aa'")
+        if self.n is not None and not np.isfinite(self.n):
+            raise InputError(f"the net normal curvature n must be a finite number (1/m), got "
+                             f"{self.n}")
+
+    def say(self, message: str) -> None:
+        """One line of progress (nothing without a ``progress`` callback)."""
+        if self.progress is not None:
+            self.progress(message)
+
+
+def ncp_state(source: Any, opts: NCPOptions) -> dict[str, Any]:
+    """The initial state of :data:`NCP_STAGES`: the ``source`` and ``opts`` of the run, the
+    user's ``n`` (1/m or None), no ``notes`` yet, the ``timings`` (s) the stages fill, and
+    ``t_all``, the clock at the start (``time.perf_counter``)."""
+    return {"source": source, "opts": opts, "n": opts.n, "notes": [], "timings": {},
+            "t_all": time.perf_counter()}
+
+
+def _guarded(state: dict[str, Any], run: Callable[[], Any]) -> Any:
+    """``run()``; its no-net answer on a surface of the PHLW step is the step's failure (unless
+    the user's ``n`` is the reason: ``state["from_phlw"]`` is False then)."""
+    try:
+        return run()
+    except NoNetError as exc:
+        if state["from_phlw"]:
+            raise _phlw_failure(state["info"], state["opts"].mode, exc) from exc
+        raise
+
+
+@stage("surface", needs=("source", "opts", "n"),
+       gives=("surface", "n_src", "info", "input_units", "from_phlw"))
+def _surface_stage(state: dict[str, Any]) -> dict[str, Any]:
+    """The B-spline surface: read as it is, or the PHLW step on a reference (load_surface)."""
+    o: NCPOptions = state["opts"]
+    surf, n_src, info = load_surface(state["source"], mode=o.mode, phlw_options=o.phlw_options,
+                                     progress=o.progress, units=o.units, clean=o.clean, obj=o.obj)
+    input_units = info.pop("units")
+    if o.strict and info.get("phlw_converged") is False:
+        raise ConvergenceError(
+            "the PHLW step did not converge within its iteration limits (phlw_options outer x "
+            "max_iter; --phlw-outer, --phlw-max-iter); raise them, or run without strict to "
+            "continue from the unconverged surface")
+    # a no-net answer on the PHLW step's surface is the step's failure, unless the user's n
+    # is the reason
+    return {"surface": surf, "n_src": n_src, "info": info, "input_units": input_units,
+            "from_phlw": "phlw_converged" in info and state["n"] is None}
+
+
+@stage("directions", needs=("surface", "opts", "n", "n_src", "info", "from_phlw", "notes"),
+       gives=("dirs", "n", "notes"))
+def _directions_stage(state: dict[str, Any]) -> dict[str, Any]:
+    """The net directions at the samples (CNC: the fitted ``n``, 1/m)."""
+    o: NCPOptions = state["opts"]
+    surf, n, cnc = state["surface"], state["n"], o.mode == "cnc"
+    u, v = uniform_params(surf, o.samples)
+    dirs = _guarded(state, lambda: net_directions(surf, u, v, mode=o.mode, n=n if cnc else None,
+                                                  n_hint=state["n_src"] if cnc else None))
+    if cnc:
+        n = float(dirs.n_rows[0])
+    ok = dirs.valid
+    o.say(f"net directions on {o.samples[0]} x {o.samples[1]} samples: beta in "
+          f"[{np.degrees(dirs.beta[ok].min()):.1f}, {np.degrees(dirs.beta[ok].max()):.1f}] deg")
+    for note in dirs.notes:
+        o.say(f"note: {note}")
+    return {"dirs": dirs, "n": n, "notes": [*state["notes"], *dirs.notes]}
+
+
+@stage("tracing", needs=("surface", "dirs", "opts"), gives=("traced",))
+def _tracing_stage(state: dict[str, Any]) -> dict[str, Any]:
+    """The level functions fitted and the net traced (joints, loops, lamellae)."""
+    o: NCPOptions = state["opts"]
+    traced = trace(state["surface"], state["dirs"], curves=o.curves, spacing=o.spacing,
+                   n_ctrl=o.levelset_ctrl, degree=o.levelset_degree, omega_f=o.omega_f,
+                   grid=o.trace_grid, progress=o.progress)
+    net = traced.net
+    o.say(f"traced {len(net.lamellae)} lamellae, {len(net.joints)} joints, {len(net.loops)} "
+          "loops")
+    for note in traced.dropped:
+        o.say(f"note: {note}")
+    failed = [f for f, fit in traced.fits.items() if not fit.converged]
+    if o.strict and failed:
+        raise ConvergenceError(
+            f"the level-set fit of family {failed[0]} did not converge; use fewer level-set "
+            "control points (--levelset-ctrl) or a larger fairness weight (--omega-f), or run "
+            "without strict")
+    return {"traced": traced}
+
+
+@stage("collapse", needs=("surface", "opts", "n", "notes", "info", "from_phlw"),
+       gives=("collapse", "notes"))
+def _collapse_stage(state: dict[str, Any]) -> dict[str, Any]:
+    """The collapse curve of the surface (eq. 4.14)."""
+    o: NCPOptions = state["opts"]
+    cs = o.collapse_samples
+    col = _guarded(state, lambda: collapse_curve(state["surface"], mode=o.mode, n=state["n"],
+                                                 samples=cs))
+    notes = list(state["notes"])
+    if col.fit.get("invalid_samples"):
+        notes.append(f"the collapse curve counts {col.fit['invalid_samples']} of "
+                     f"{cs[0] * cs[1]} samples without a net direction with the net angle "
+                     "clipped to [0, pi/2]")
+    o.say(f"collapse curve ({cs[0]} x {cs[1]} samples): length {col.s[-1]:.4g} m, shape "
+          f"{col.shape}")
+    return {"collapse": col, "notes": notes}
+
+
+@stage("postopt", needs=("surface", "traced", "collapse", "opts"), gives=("post",))
+def _postopt_stage(state: dict[str, Any]) -> dict[str, Any]:
+    """The joint mesh post-optimized towards exact alignability (paper 4.2.4)."""
+    o: NCPOptions = state["opts"]
+    traced = state["traced"]
+    post = post_optimize(state["surface"], traced.net, traced.joint_uv, state["collapse"],
+                         weights=o.postopt_weights, rounds=o.postopt_rounds,
+                         progress=o.progress)
+    if o.strict and not post.converged:
+        last = post.history[-1]["message"] if post.history else "no round run"
+        raise ConvergenceError(
+            f"the post-optimization did not converge in {o.postopt_rounds} round(s) ({last}); "
+            "give it more rounds (--rounds), or run without strict")
+    return {"post": post}
+
+
+@stage("simulation", needs=("surface", "traced", "post", "opts"),
+       gives=("sequence", "collapse_direction"))
+def _simulation_stage(state: dict[str, Any]) -> dict[str, Any]:
+    """The alignment simulated as a sequence of states (paper 5.1)."""
+    o: NCPOptions = state["opts"]
+    post = state["post"]
+    d = collapse_direction(state["surface"])
+    seq = simulate_alignment(post.V, post.r, state["traced"].net.edges(), d,
+                             aligned=(post.Vt, post.rt), frames=o.frames,
+                             weights=o.sim_weights, progress=o.progress)
+    return {"sequence": seq, "collapse_direction": d}
+
+
+def _design_figures(surf: BSplineSurface, traced: TracedNet, col: CollapseResult,
+                    post: PostOptResult, seq: AlignmentSequence,
+                    mesh: Any) -> dict[str, Any]:
+    """The figures of every mode (paper 5.1; percentages): counts, Delta_a before and after
+    the post-optimization, Delta_l, Delta_n (all joints and the interior ones), deviation from
+    the surface ``mesh``, crossing normal curvature, collapse length (m), the plane distance
+    before projection and the largest edge-length change of the alignment sequence."""
+    net = traced.net
+    E = net.edges()
+    da0 = alignability_error(post.V0, net.loops)
+    da1 = alignability_error(post.V, net.loops)
+    dl = delta_l(post.V, seq.aligned, E)
+    dn = delta_n(post.V, post.r, seq.aligned, seq.aligned_r, E)
+    dev = deviation(post.V, mesh.V, mesh.F)
+    cross = crossing_normal_curvature(surf, traced)
+    inner = interior_vertices(len(net.joints), E)
+    return {
+        "n_joints": int(len(net.joints)), "n_loops": int(len(net.loops)),
+        "n_lamellae": {"C1": len(net.family(1)), "C3": len(net.family(3))},
+        "delta_a_before": _pct(summary(da0)), "delta_a_after": _pct(summary(da1)),
+        "delta_a_reduction": float(np.nanmean(da0) / max(np.nanmean(da1), 1e-300)),
+        "delta_l": _pct(summary(dl)), "delta_n": _pct(summary(dn)),
+        "delta_n_interior": _pct(summary(dn[inner])),
+        "deviation": {"mean": dev["mean"], "max": dev["max"]},
+        "crossing_kn": {"mean": 100 * cross["mean"], "max": 100 * cross["max"],
+                        "joints": int(len(cross["joints"]))},
+        "collapse_length": float(col.s[-1]),
+        "plane_distance_before_projection": seq.plane_distance,
+        # the largest edge-length change of any state of the alignment sequence, %
+        "sequence_length_error": 100.0 * max(float(np.nanmax(np.abs(delta_l(post.V, V, E))))
+                                             for V in seq.V),
+    }
+
+
+def _mode_figures(mode: str, n: float | None, col: CollapseResult,
+                  A2: np.ndarray) -> dict[str, Any]:
+    """The figures of the collapse of CNC (``n`` 1/m, radii m, errors %: a circle) and AA
+    (errors %: a line) designs, from the collapse curve and the aligned joints ``A2 (n, 2)``;
+    none for PHLW."""
+    if mode == "cnc":
+        _, R = fit_circle(A2)
+        return {"n": n, "collapse_radius": col.radius,
+                "collapse_radius_error": 100 * col.fit.get("radius_error", float("nan")),
+                "aligned_radius": R,
+                "aligned_radius_error": 100 * abs(R - col.radius) / col.radius}
+    if mode == "aa":
+        return {"collapse_line_error": 100 * col.fit["line_error"],
+                "aligned_line_error": 100 * line_deviation(A2)}
+    return {}
+
+
+@stage("metrics", needs=("surface", "traced", "collapse", "post", "sequence",
+                         "collapse_direction", "n", "opts"),
+       gives=("metrics", "gates", "mesh", "aligned_2d"))
+def _metrics_stage(state: dict[str, Any]) -> dict[str, Any]:
+    """The design's figures and the paper's gates on them (``metrics["quality"]``)."""
+    o: NCPOptions = state["opts"]
+    surf, post, seq, col = state["surface"], state["post"], state["sequence"], state["collapse"]
+    mesh = surf.sample(*o.surface_samples)
+    B = plane_frame(state["collapse_direction"])
+    A2 = _register_2d((seq.aligned - seq.centroid) @ B.T, post.Vt)
+    metrics = _design_figures(surf, state["traced"], col, post, seq, mesh)
+    metrics.update(_mode_figures(o.mode, state["n"], col, A2))
+    gates = design_gates(KIND[o.mode], metrics)
+    metrics["quality"] = {"ok": passed(gates), "summary": gate_summary(gates),
+                          "gates": [{**g.as_dict(), "line": g.line()} for g in gates]}
+    return {"metrics": metrics, "gates": gates, "mesh": mesh, "aligned_2d": A2}
+
+
+@stage("gate", needs=("metrics", "gates", "info", "traced", "post", "notes", "opts", "timings",
+                      "t_all"), gives=("metrics",))
+def _gate_stage(state: dict[str, Any]) -> dict[str, Any]:
+    """The timings (s, ``total`` since the start) into the figures; a design missing the
+    paper's figures refused unless ``allow_unconverged``."""
+    o: NCPOptions = state["opts"]
+    gates, notes = state["gates"], state["notes"]
+    metrics = {**state["metrics"],
+               "timings": {**state["timings"], "total": time.perf_counter() - state["t_all"]}}
+    if not passed(gates) and not o.allow_unconverged:
+        stopped = _stopped(state["info"], state["traced"], state["post"])
+        raise ConvergenceError(
+            f"the {KIND[o.mode]} design misses the paper's figures: {gate_summary(gates)}"
+            + (f" ({', '.join(stopped)} stopped short of its tolerances)" if stopped else "")
+            + (f"; notes: {'; '.join(notes)}" if notes else "")
+            + "; try more post-optimization rounds (--rounds), more or fewer curves (--curves), "
+            "or pass --allow-unconverged (allow_unconverged=True) to write it anyway, marked as "
+            "failing")
+    return {"metrics": metrics}
+
+
+def _bundle_curve(col: CollapseResult) -> CollapseCurve:
+    """The collapse curve of the bundle: at most about 600 of its points (m), the last kept."""
+    ds = max(1, len(col.points) // 600)
+    keep = np.unique(np.concatenate([np.arange(0, len(col.points), ds), [len(col.points) - 1]]))
+    return CollapseCurve(points=col.points[keep], normals=col.normals[keep], shape=col.shape,
+                         radius=col.radius)
+
+
+def _params(o: NCPOptions, d: np.ndarray, post: PostOptResult, notes: list[str],
+            info: dict) -> dict[str, Any]:
+    """The bundle's ``params``: the options of the run, the collapse direction ``d``, the
+    post-optimization weights, the notes and the source's ``info``."""
+    return {"mode": o.mode, "curves": o.curves, "spacing": o.spacing,
+            "samples": list(o.samples),
+            "levelset": {"ctrl": list(o.levelset_ctrl), "degree": list(o.levelset_degree),
+                         "omega_f": o.omega_f},
+            "collapse_samples": list(o.collapse_samples), "frames": o.frames,
+            "collapse_direction": d.tolist(), "postopt_weights": post.weights,
+            "allow_unconverged": bool(o.allow_unconverged), "notes": notes, **info}
+
+
+def _report(state: dict[str, Any], metrics: dict[str, Any]) -> dict[str, Any]:
+    """The report of the run: figures, the level-set fits, the post-optimization and
+    simulation histories, notes, and ``"state"`` (:class:`NCPState`, the arrays)."""
+    traced, post, seq = state["traced"], state["post"], state["sequence"]
+    return {"metrics": metrics,
+            "levelset": {f: {"align_rms_sin": fit.align_rms, "density": fit.density,
+                             "converged": fit.converged} for f, fit in traced.fits.items()},
+            "postopt": {"history": post.history, "converged": post.converged,
+                        "terms": post.report},
+            "simulation": {"history": seq.history},
+            "dropped": traced.dropped, "notes": state["notes"],
+            "quality": metrics["quality"],
+            "state": NCPState(state["surface"], traced, state["collapse"], post, seq,
+                              state["aligned_2d"])}
+
+
+@stage("bundle", needs=("surface", "traced", "collapse", "post", "sequence",
+                        "collapse_direction", "metrics", "mesh", "aligned_2d", "notes", "info",
+                        "input_units", "opts"), gives=("design",))
+def _bundle_stage(state: dict[str, Any]) -> dict[str, Any]:
+    """The design: the bundle (the lamellae on the post-optimized joints) and the report."""
+    o: NCPOptions = state["opts"]
+    traced, col, post, seq = state["traced"], state["collapse"], state["post"], state["sequence"]
+    metrics, mesh = state["metrics"], state["mesh"]
+    # the lamellae carried onto the post-optimized joints: axes.obj and joint_s (the cut
+    # files' joint positions) describe the gridshell that aligns, not the traced net
+    out_net = move_joints(traced.net, post.V)
+    bundle = DesignBundle(kind=KIND[o.mode], net=out_net, aligned=seq.aligned, surface_V=mesh.V,
+                          surface_F=mesh.F, metrics=metrics,
+                          params=_params(o, state["collapse_direction"], post, state["notes"],
+                                         state["info"]),
+                          collapse=_bundle_curve(col),
+                          collapse_s=_collapse_s(traced, col, state["aligned_2d"]),
+                          units=state["input_units"])
+    o.say(f"Delta_a {metrics['delta_a_before']['mean']:.3g} % -> "
+          f"{metrics['delta_a_after']['mean']:.3g} %, Delta_l max "
+          f"{metrics['delta_l']['max']:.3g} %, Delta_n max {metrics['delta_n']['max']:.3g} %")
+    return {"design": Design(bundle, _report(state, metrics))}
+
+
+#: The NCP pipeline as named stages over one state dict (:func:`ncp_state`), in order. Each
+#: stage's wall time (s) goes to ``state["timings"][name]``; ``metrics["timings"]`` holds those
+#: up to ``metrics`` and the ``total`` (taken by ``gate``). ``run_stages(NCP_STAGES, state,
+#: until=name)`` stops after a stage (e.g. ``"tracing"`` for the traced net alone).
+NCP_STAGES: tuple[Stage, ...] = (_surface_stage, _directions_stage, _tracing_stage,
+                                 _collapse_stage, _postopt_stage, _simulation_stage,
+                                 _metrics_stage, _gate_stage, _bundle_stage)
+
+
 def design_ncp(source: Any, *, mode: str = "phlw", curves: int | tuple[int, int] | None = None,
                spacing: float | None = None, n: float | None = None,
                samples: tuple[int, int] = (48, 48), levelset_ctrl: tuple[int, int] = (12, 12),
@@ -260,177 +494,15 @@ def design_ncp(source: Any, *, mode: str = "phlw", curves: int | tuple[int, int]
     report : JSON-ready figures (metrics, timings, stage details) plus ``"state"``, an
         :class:`NCPState` with the arrays (not JSON)
     """
-    if mode not in KIND:
-        raise InputError(f"unknown mode {mode!r}; use 'phlw', 'cnc' or 'aa'")
-    if n is not None and not np.isfinite(n):
-        raise InputError(f"the net normal curvature n must be a finite number (1/m), got {n}")
-    say = progress or (lambda _m: None)
-    timings: dict[str, float] = {}
-    t_all = time.perf_counter()
-
-    t0 = time.perf_counter()
-    surf, n_src, info = load_surface(source, mode=mode, phlw_options=phlw_options,
-                                     progress=progress, units=units, clean=clean, obj=obj)
-    input_units = info.pop("units")
-    timings["surface"] = time.perf_counter() - t0
-    if strict and info.get("phlw_converged") is False:
-        raise ConvergenceError(
-            "the PHLW step did not converge within its iteration limits (phlw_options outer x "
-            "max_iter; --phlw-outer, --phlw-max-iter); raise them, or run without strict to "
-            "continue from the unconverged surface")
-    # a no-net answer on the PHLW step's surface is the step's failure, unless the user's n
-    # is the reason
-    from_phlw = "phlw_converged" in info and n is None
-
-    def guarded(stage: Callable[[], Any]) -> Any:
-        """A stage's no-net answer on a surface of the PHLW step is the step's failure."""
-        try:
-            return stage()
-        except NoNetError as exc:
-            if from_phlw:
-                raise _phlw_failure(info, mode, exc) from exc
-            raise
-
-    notes: list[str] = []
-    t0 = time.perf_counter()
-    u, v = uniform_params(surf, samples)
-    dirs = guarded(lambda: net_directions(surf, u, v, mode=mode,
-                                          n=n if mode == "cnc" else None,
-                                          n_hint=n_src if mode == "cnc" else None))
-    notes += dirs.notes
-    if mode == "cnc":
-        n = float(dirs.n_rows[0])
-    timings["directions"] = time.perf_counter() - t0
-    ok = dirs.valid
-    say(f"net directions on {samples[0]} x {samples[1]} samples: beta in "
-        f"[{np.degrees(dirs.beta[ok].min()):.1f}, {np.degrees(dirs.beta[ok].max()):.1f}] deg")
-    for note in dirs.notes:
-        say(f"note: {note}")
-
-    t0 = time.perf_counter()
-    traced = trace(surf, dirs, curves=curves, spacing=spacing, n_ctrl=levelset_ctrl,
-                   degree=levelset_degree, omega_f=omega_f, grid=trace_grid, progress=progress)
-    net = traced.net
-    timings["tracing"] = time.perf_counter() - t0
-    say(f"traced {len(net.lamellae)} lamellae, {len(net.joints)} joints, {len(net.loops)} loops")
-    for note in traced.dropped:
-        say(f"note: {note}")
-    failed = [f for f, fit in traced.fits.items() if not fit.converged]
-    if strict and failed:
-        raise ConvergenceError(
-            f"the level-set fit of family {failed[0]} did not converge; use fewer level-set "
-            "control points (--levelset-ctrl) or a larger fairness weight (--omega-f), or run "
-            "without strict")
-
-    t0 = time.perf_counter()
-    col = guarded(lambda: collapse_curve(surf, mode=mode, n=n, samples=collapse_samples))
-    if col.fit.get("invalid_samples"):
-        notes.append(f"the collapse curve counts {col.fit['invalid_samples']} of "
-                     f"{collapse_samples[0] * collapse_samples[1]} samples without a net "
-                     "direction with the net angle clipped to [0, pi/2]")
-    timings["collapse"] = time.perf_counter() - t0
-    say(f"collapse curve ({collapse_samples[0]} x {collapse_samples[1]} samples): length "
-        f"{col.s[-1]:.4g} m, shape {col.shape}")
-
-    t0 = time.perf_counter()
-    post = post_optimize(surf, net, traced.joint_uv, col, weights=postopt_weights,
-                         rounds=postopt_rounds, progress=progress)
-    timings["postopt"] = time.perf_counter() - t0
-    if strict and not post.converged:
-        last = post.history[-1]["message"] if post.history else "no round run"
-        raise ConvergenceError(
-            f"the post-optimization did not converge in {postopt_rounds} round(s) ({last}); "
-            "give it more rounds (--rounds), or run without strict")
-
-    t0 = time.perf_counter()
-    E = net.edges()
-    d = collapse_direction(surf)
-    seq = simulate_alignment(post.V, post.r, E, d, aligned=(post.Vt, post.rt), frames=frames,
-                             weights=sim_weights, progress=progress)
-    timings["simulation"] = time.perf_counter() - t0
-
-    t0 = time.perf_counter()
-    mesh = surf.sample(*surface_samples)
-    B = plane_frame(d)
-    A2 = _register_2d((seq.aligned - seq.centroid) @ B.T, post.Vt)
-    da0 = alignability_error(post.V0, net.loops)
-    da1 = alignability_error(post.V, net.loops)
-    dl = delta_l(post.V, seq.aligned, E)
-    dn = delta_n(post.V, post.r, seq.aligned, seq.aligned_r, E)
-    dev = deviation(post.V, mesh.V, mesh.F)
-    cross = crossing_normal_curvature(surf, traced)
-    inner = interior_vertices(len(net.joints), E)
-    metrics: dict[str, Any] = {
-        "n_joints": int(len(net.joints)), "n_loops": int(len(net.loops)),
-        "n_lamellae": {"C1": len(net.family(1)), "C3": len(net.family(3))},
-        "delta_a_before": _pct(summary(da0)), "delta_a_after": _pct(summary(da1)),
-        "delta_a_reduction": float(np.nanmean(da0) / max(np.nanmean(da1), 1e-300)),
-        "delta_l": _pct(summary(dl)), "delta_n": _pct(summary(dn)),
-        "delta_n_interior": _pct(summary(dn[inner])),
-        "deviation": {"mean": dev["mean"], "max": dev["max"]},
-        "crossing_kn": {"mean": 100 * cross["mean"], "max": 100 * cross["max"],
-                        "joints": int(len(cross["joints"]))},
-        "collapse_length": float(col.s[-1]),
-        "plane_distance_before_projection": seq.plane_distance,
-        # the largest edge-length change of any state of the alignment sequence, %
-        "sequence_length_error": 100.0 * max(float(np.nanmax(np.abs(delta_l(post.V, V, E))))
-                                             for V in seq.V),
-    }
-    if mode == "cnc":
-        _, R = fit_circle(A2)
-        metrics["n"] = n
-        metrics["collapse_radius"] = col.radius
-        metrics["collapse_radius_error"] = 100 * col.fit.get("radius_error", float("nan"))
-        metrics["aligned_radius"] = R
-        metrics["aligned_radius_error"] = 100 * abs(R - col.radius) / col.radius
-    elif mode == "aa":
-        metrics["collapse_line_error"] = 100 * col.fit["line_error"]
-        metrics["aligned_line_error"] = 100 * line_deviation(A2)
-    gates = design_gates(KIND[mode], metrics)
-    metrics["quality"] = {"ok": passed(gates), "summary": gate_summary(gates),
-                          "gates": [{**g.as_dict(), "line": g.line()} for g in gates]}
-    timings["metrics"] = time.perf_counter() - t0
-    timings["total"] = time.perf_counter() - t_all
-    metrics["timings"] = timings
-    if not passed(gates) and not allow_unconverged:
-        stopped = _stopped(info, traced, post)
-        raise ConvergenceError(
-            f"the {KIND[mode]} design misses the paper's figures: {gate_summary(gates)}"
-            + (f" ({', '.join(stopped)} stopped short of its tolerances)" if stopped else "")
-            + (f"; notes: {'; '.join(notes)}" if notes else "")
-            + "; try more post-optimization rounds (--rounds), more or fewer curves (--curves), "
-            "or pass --allow-unconverged (allow_unconverged=True) to write it anyway, marked as "
-            "failing")
-
-    ds = max(1, len(col.points) // 600)
-    keep = np.unique(np.concatenate([np.arange(0, len(col.points), ds), [len(col.points) - 1]]))
-    curve = CollapseCurve(points=col.points[keep], normals=col.normals[keep], shape=col.shape,
-                          radius=col.radius)
-    params = {"mode": mode, "curves": curves, "spacing": spacing, "samples": list(samples),
-              "levelset": {"ctrl": list(levelset_ctrl), "degree": list(levelset_degree),
-                           "omega_f": omega_f},
-              "collapse_samples": list(collapse_samples), "frames": frames,
-              "collapse_direction": d.tolist(), "postopt_weights": post.weights,
-              "allow_unconverged": bool(allow_unconverged), "notes": notes, **info}
-    # the lamellae carried onto the post-optimized joints: axes.obj and joint_s (the cut
-    # files' joint positions) describe the gridshell that aligns, not the traced net
-    out_net = move_joints(net, post.V)
-    bundle = DesignBundle(kind=KIND[mode], net=out_net, aligned=seq.aligned, surface_V=mesh.V,
-                          surface_F=mesh.F, metrics=metrics, params=params, collapse=curve,
-                          collapse_s=_collapse_s(traced, col, A2), units=input_units)
-    report = {"metrics": metrics,
-              "levelset": {f: {"align_rms_sin": fit.align_rms, "density": fit.density,
-                               "converged": fit.converged} for f, fit in traced.fits.items()},
-              "postopt": {"history": post.history, "converged": post.converged,
-                          "terms": post.report},
-              "simulation": {"history": seq.history},
-              "dropped": traced.dropped, "notes": notes,
-              "quality": metrics["quality"],
-              "state": NCPState(surf, traced, col, post, seq, A2)}
-    say(f"Delta_a {metrics['delta_a_before']['mean']:.3g} % -> "
-        f"{metrics['delta_a_after']['mean']:.3g} %, Delta_l max {metrics['delta_l']['max']:.3g} %, "
-        f"Delta_n max {metrics['delta_n']['max']:.3g} %")
-    return Design(bundle, report)
+    opts = NCPOptions(mode=mode, curves=curves, spacing=spacing, n=n, samples=samples,
+                      levelset_ctrl=levelset_ctrl, levelset_degree=levelset_degree,
+                      omega_f=omega_f, trace_grid=trace_grid, collapse_samples=collapse_samples,
+                      postopt_weights=postopt_weights, postopt_rounds=postopt_rounds,
+                      frames=frames, sim_weights=sim_weights, surface_samples=surface_samples,
+                      phlw_options=phlw_options, allow_unconverged=allow_unconverged,
+                      strict=strict, units=units, clean=clean, obj=obj, progress=progress)
+    state = ncp_state(source, opts)
+    return run_stages(NCP_STAGES, state, state["timings"])["design"]
 
 
 def write_ncp(path: str | Path, bundle: DesignBundle, report: dict, *, render: bool = True,

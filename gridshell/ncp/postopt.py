@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
-from typing import Callable, NamedTuple
+from typing import Any, Callable, NamedTuple
 
 import numpy as np
 
@@ -290,12 +290,7 @@ def post_optimize(surf: BSplineSurface, net: Net, joint_uv: np.ndarray, collapse
         precision (``Delta_n`` divides by the normal offsets of the neighbours, which are
         tiny on asymptotic nets); 0 keeps the paper's weights throughout
     """
-    w = dict(DEFAULT_WEIGHTS)
-    for key, val in (weights or {}).items():
-        if key not in w:
-            raise InputError(f"unknown post-optimization weight {key!r}; weights are "
-                             f"{', '.join(w)}")
-        w[key] = float(val)
+    w = _postopt_weights(weights)
     if int(rounds) < 0:
         raise InputError(f"post-optimization rounds must be >= 0, got {rounds}")
     V0, r0, Vt0, rt0 = initial_configuration(surf, joint_uv, collapse)
@@ -303,43 +298,18 @@ def post_optimize(surf: BSplineSurface, net: Net, joint_uv: np.ndarray, collapse
     E = net.edges()
     if len(E) == 0:
         raise InputError("the net has no edges; trace more curves")
-    j, k = vertex_pairs(E)
-    # scaled units: unit bounding-box diagonal of the surface
-    S_dense = surf.evaluate_grid(*[np.linspace(a, b, 30) for a, b in surf.domain]).reshape(-1, 3)
-    centre = S_dense.mean(axis=0)
-    scale = float(np.linalg.norm(S_dense.max(0) - S_dense.min(0)))
+    centre, scale = _scaled_frame(surf)
     C2, N2 = collapse.points / scale, collapse.normals
     lay = Layout([("V", (n, 3)), ("r", (n, 3)), ("Vt", (n, 2)), ("rt", (n, 2))])
     x = lay.pack({"V": (V0 - centre) / scale, "r": r0, "Vt": Vt0 / scale, "rt": rt0})
-    inner = interior_vertices(n, E)
-    from gridshell.solver.terms import laplacian_matrix
-    Lap = laplacian_matrix(n, E, fixed_rows=np.setdiff1d(np.arange(n), inner))
-    density = net_density(lay.view(x, "V"), E)
-    ell = EDGE_REF / density          # mean edge length, scaled units
-    prob = Problem(lay)
-    prob.add("length (chi_l)", w["length"] * density ** 4, edge_length_eq, EdgeLength(E))
-    prob.add("axis (chi_r)", w["axis"] * density ** 2, rotation_axis_eq, AxisPairs(j, k))
-    prob.add("unit (chi_u)", w["unit"], unit_norm_eq, UnitNorm("r"))
-    prob.add("unit aligned (chi_u~)", w["unit"], unit_norm_eq, UnitNorm("rt"))
-    prob.add("closeness (E_c)", w["closeness"], T.closeness,
-             T.Closeness("V", (V0 - centre) / scale))
-    prob.add("fairness", w["fairness"], T.linear, T.Linear("V", Lap))
+    prob, ell = _fixed_terms(lay, x, E, w, (V0 - centre) / scale)
     uv = np.asarray(joint_uv, float).copy()
     history = []
     sol = None
     t0 = time.perf_counter()
     for rnd in range(int(rounds)):
-        V = lay.view(x, "V") * scale + centre
-        uv, foot, nrm = surface_closest(surf, V, uv)
-        Ct, Nt, _ = closest_on_polyline(lay.view(x, "Vt"), C2, N2)
-        for name, wk, fn, data in (
-                ("gliding (E_g)", "gliding", T.gliding,
-                 T.Gliding("V", (foot - centre) / scale, nrm)),
-                ("closeness aligned (E_c~)", "closeness_aligned", T.closeness,
-                 T.Closeness("Vt", Ct)),
-                ("gliding aligned (E_g~)", "gliding_aligned", T.gliding, T.Gliding("Vt", Ct, Nt)),
-                ("normal (E_s)", "normal", T.gliding, T.Gliding("r", nrm, nrm)),
-                ("normal aligned (E_s~)", "normal_aligned", T.gliding, T.Gliding("rt", Nt, Nt))):
+        uv, terms = _round_terms(surf, lay, x, uv, centre, scale, C2, N2)
+        for name, wk, fn, data in terms:
             if rnd == 0:
                 prob.add(name, w[wk], fn, data)
             else:
@@ -347,24 +317,14 @@ def post_optimize(surf: BSplineSurface, net: Net, joint_uv: np.ndarray, collapse
         sol = solve(prob, x, method="lm", max_iter=int(max_iter), tol_rel=1e-9,
                     stop=still_joints(lay, x, ("V", "Vt"), ROUND_STILL * ell))
         x = sol.x
-        history.append({"round": rnd + 1, "iterations": sol.iterations, "energy0": sol.energy0,
-                        "energy": sol.energy, "message": sol.message,
-                        "time": time.perf_counter() - t0})
+        history.append(_round_record(rnd + 1, sol, t0))
         if progress is not None:
             progress(f"post-optimization round {rnd + 1}/{rounds}: energy {sol.energy0:.3e} -> "
                      f"{sol.energy:.3e} in {sol.iterations} iterations")
     if polish > 0:
-        # finishing round: the soft terms scaled by ``polish`` so that the constraints hold to
-        # the solver's precision (the geometry moves by ~polish times the soft residuals)
-        soft = [e.name for e in prob.entries if e.fn is not edge_length_eq
-                and e.fn is not rotation_axis_eq and e.fn is not unit_norm_eq]
-        for name in soft:
-            prob.set_weight(name, w[_WEIGHT_OF[name]] * polish)
-        sol = solve(prob, x, method="lm", max_iter=int(max_iter), tol_rel=1e-9)
+        sol = _polish(prob, x, w, polish, int(max_iter))
         x = sol.x
-        history.append({"round": "polish", "iterations": sol.iterations,
-                        "energy0": sol.energy0, "energy": sol.energy, "message": sol.message,
-                        "time": time.perf_counter() - t0})
+        history.append(_round_record("polish", sol, t0))
     converged = bool(sol is not None and sol.converged)
     if sol is not None:
         # the constraints are what the post-optimization is for: when they hold to
@@ -383,3 +343,79 @@ def post_optimize(surf: BSplineSurface, net: Net, joint_uv: np.ndarray, collapse
                          uv=uv, V0=V0, r0=r0, Vt0=Vt0, rt0=rt0, history=history,
                          report=sol.report if sol is not None else {},
                          converged=converged, weights=w)
+
+
+def _postopt_weights(weights: dict[str, float] | None) -> dict[str, float]:
+    """:data:`DEFAULT_WEIGHTS` with the caller's overrides (unknown names refused)."""
+    w = dict(DEFAULT_WEIGHTS)
+    for key, val in (weights or {}).items():
+        if key not in w:
+            raise InputError(f"unknown post-optimization weight {key!r}; weights are "
+                             f"{', '.join(w)}")
+        w[key] = float(val)
+    return w
+
+
+def _scaled_frame(surf: BSplineSurface) -> tuple[np.ndarray, float]:
+    """``(centre (3,), scale)`` of the scaled units: the centre and the bounding-box diagonal
+    (m) of the surface sampled 30 x 30."""
+    S_dense = surf.evaluate_grid(*[np.linspace(a, b, 30) for a, b in surf.domain]).reshape(-1, 3)
+    centre = S_dense.mean(axis=0)
+    return centre, float(np.linalg.norm(S_dense.max(0) - S_dense.min(0)))
+
+
+def _fixed_terms(lay: Layout, x: np.ndarray, E: np.ndarray, w: dict[str, float],
+                 V0s: np.ndarray) -> tuple[Problem, float]:
+    """The problem with the terms whose data do not change between rounds (``chi_l``,
+    ``chi_r`` weighted by the net's density, ``chi_u``, ``chi_u~``, closeness to the initial
+    joints ``V0s`` and fairness of the interior joints, scaled units), and the mean edge
+    length ``ell`` (scaled units)."""
+    from gridshell.solver.terms import laplacian_matrix
+
+    n = len(V0s)
+    j, k = vertex_pairs(E)
+    inner = interior_vertices(n, E)
+    Lap = laplacian_matrix(n, E, fixed_rows=np.setdiff1d(np.arange(n), inner))
+    density = net_density(lay.view(x, "V"), E)
+    prob = Problem(lay)
+    prob.add("length (chi_l)", w["length"] * density ** 4, edge_length_eq, EdgeLength(E))
+    prob.add("axis (chi_r)", w["axis"] * density ** 2, rotation_axis_eq, AxisPairs(j, k))
+    prob.add("unit (chi_u)", w["unit"], unit_norm_eq, UnitNorm("r"))
+    prob.add("unit aligned (chi_u~)", w["unit"], unit_norm_eq, UnitNorm("rt"))
+    prob.add("closeness (E_c)", w["closeness"], T.closeness, T.Closeness("V", V0s))
+    prob.add("fairness", w["fairness"], T.linear, T.Linear("V", Lap))
+    return prob, EDGE_REF / density          # mean edge length, scaled units
+
+
+def _round_terms(surf: BSplineSurface, lay: Layout, x: np.ndarray, uv: np.ndarray,
+                 centre: np.ndarray, scale: float, C2: np.ndarray, N2: np.ndarray
+                 ) -> tuple[np.ndarray, list[tuple]]:
+    """The closest points of the state ``x`` refreshed: the joints' parameters ``uv`` (from
+    the last ones) and ``(name, weight key, term, data)`` of the gliding, aligned and normal
+    terms on the surface and on the collapse polyline ``C2, N2`` (scaled units)."""
+    V = lay.view(x, "V") * scale + centre
+    uv, foot, nrm = surface_closest(surf, V, uv)
+    Ct, Nt, _ = closest_on_polyline(lay.view(x, "Vt"), C2, N2)
+    return uv, [
+        ("gliding (E_g)", "gliding", T.gliding, T.Gliding("V", (foot - centre) / scale, nrm)),
+        ("closeness aligned (E_c~)", "closeness_aligned", T.closeness, T.Closeness("Vt", Ct)),
+        ("gliding aligned (E_g~)", "gliding_aligned", T.gliding, T.Gliding("Vt", Ct, Nt)),
+        ("normal (E_s)", "normal", T.gliding, T.Gliding("r", nrm, nrm)),
+        ("normal aligned (E_s~)", "normal_aligned", T.gliding, T.Gliding("rt", Nt, Nt))]
+
+
+def _polish(prob: Problem, x: np.ndarray, w: dict[str, float], polish: float,
+            max_iter: int) -> Any:
+    """The finishing round: the soft terms scaled by ``polish`` so that the constraints hold
+    to the solver's precision (the geometry moves by ~polish times the soft residuals)."""
+    soft = [e.name for e in prob.entries if e.fn is not edge_length_eq
+            and e.fn is not rotation_axis_eq and e.fn is not unit_norm_eq]
+    for name in soft:
+        prob.set_weight(name, w[_WEIGHT_OF[name]] * polish)
+    return solve(prob, x, method="lm", max_iter=max_iter, tol_rel=1e-9)
+
+
+def _round_record(rnd: int | str, sol: Any, t0: float) -> dict[str, Any]:
+    """One line of the history: round, iterations, energies, message and time (s since ``t0``)."""
+    return {"round": rnd, "iterations": sol.iterations, "energy0": sol.energy0,
+            "energy": sol.energy, "message": sol.message, "time": time.perf_counter() - t0}

@@ -176,16 +176,7 @@ def optimize_phlw(surf: BSplineSurface, reference: Any, *, mode: Mode = "phlw",
         energy became non-finite
     """
     _check_mode(mode)
-    w = dict(DEFAULT_WEIGHTS)
-    if mode == "aa":
-        # n = 0 is fixed: E_beta has no net variable left to regularize and only pulls H -> 0
-        # (towards a minimal surface); measured on a pseudosphere it moves K off row-constancy
-        # by 1 %. Off by default in aa; pass weights={"beta": 5e-4} for the paper's setting.
-        w["beta"] = 0.0
-    for key, val in (weights or {}).items():
-        if key not in w:
-            raise InputError(f"unknown weight {key!r}; weights are {', '.join(w)}")
-        w[key] = float(val)
+    w = _phlw_weights(mode, weights)
     if int(outer) < 1 or int(max_iter) < 1:
         raise InputError(f"outer and max_iter must be >= 1, got {outer} and {max_iter}")
     V, Fr = _reference_arrays(reference)
@@ -197,24 +188,61 @@ def optimize_phlw(surf: BSplineSurface, reference: Any, *, mode: Mode = "phlw",
     s0 = _scaled_surface(surf, center, diag)
     plan = sample_levels(samples)
     fine = Level(s0, plan[-1], w, (Vs, Fr), mode, diag)
-    u, v, R = fine.u, fine.v, len(fine.u)
     x, fit = fine.x0, fine.fit
+    diagnostics = _initial_diagnostics(fine, mode, diag)
+    before = {"terms": fine.prob.report(x), **surface_figures(surf, fit.n / diag, fit.t / diag,
+                                                              fine.u, fine.v, mode, w["target"],
+                                                              diag)}
+    energy_initial = fine.prob.energy(x)
+    judge = Judge(fine, surf, center, diag, before, float(energy_initial), (V, Fr), mode,
+                  w["target"], check_samples)
+    t0 = time.perf_counter()
+    level = fine if len(plan) == 1 else Level(s0, plan[0], w, (Vs, Fr), mode, diag)
+    state, history = _rounds(fine, level, judge, x, outer=int(outer), max_iter=int(max_iter),
+                             early_stop=early_stop, progress=progress, t0=t0)
+    return _phlw_result(state, history, fine, judge, before=before, diagnostics=diagnostics,
+                        energy_initial=float(energy_initial), mode=mode, weights=w, diag=diag)
+
+
+def _phlw_weights(mode: Mode, weights: dict[str, float] | None) -> dict[str, float]:
+    """:data:`DEFAULT_WEIGHTS` with the caller's overrides (unknown names refused)."""
+    w = dict(DEFAULT_WEIGHTS)
+    if mode == "aa":
+        # n = 0 is fixed: E_beta has no net variable left to regularize and only pulls H -> 0
+        # (towards a minimal surface); measured on a pseudosphere it moves K off row-constancy
+        # by 1 %. Off by default in aa; pass weights={"beta": 5e-4} for the paper's setting.
+        w["beta"] = 0.0
+    for key, val in (weights or {}).items():
+        if key not in w:
+            raise InputError(f"unknown weight {key!r}; weights are {', '.join(w)}")
+        w[key] = float(val)
+    return w
+
+
+def _initial_diagnostics(fine: Level, mode: Mode, diag: float) -> list[str]:
+    """Notes on the initial row fit of the fine level (rows clamped into the principal range)
+    and on where the reference admits no net as it is (:func:`principal_range_notes`)."""
+    x, fit, R = fine.x0, fine.fit, len(fine.u)
     diagnostics: list[str] = []
     if len(fit.clamped):
         diagnostics.append(f"initial fit: rows {fit.clamped.tolist()} had t_u^2 < 0 (b^2 - 4ac > 0) "
                            "or n_u outside [kappa_1, kappa_2]; started there from n_u inside "
                            "the principal range")
-    diagnostics += principal_range_notes(fine.lay.view(x, "K").reshape(R, -1),
-                                         fine.lay.view(x, "H").reshape(R, -1), u, mode, diag)
+    return diagnostics + principal_range_notes(fine.lay.view(x, "K").reshape(R, -1),
+                                               fine.lay.view(x, "H").reshape(R, -1), fine.u,
+                                               mode, diag)
 
-    before = {"terms": fine.prob.report(x), **surface_figures(surf, fit.n / diag, fit.t / diag, u,
-                                                          v, mode, w["target"], diag)}
-    energy_initial = fine.prob.energy(x)
-    judge = Judge(fine, surf, center, diag, before, float(energy_initial), (V, Fr), mode,
-                   w["target"], check_samples)
+
+def _rounds(fine: Level, level: Level, judge: Judge, x: np.ndarray, *, outer: int,
+            max_iter: int, early_stop: bool, progress: Callable[[str], None] | None,
+            t0: float) -> tuple[Any, list[dict]]:
+    """The rounds from ``x`` (the fine level's start), on the coarse ``level`` first when it
+    is not ``fine`` (continued on the fine one from its control points): ``(the judged state
+    of the last accepted round, one record per round)``. A level ends when a round is
+    rejected, gains less than :data:`ROUND_TOL_REL` or its round count is reached; with
+    ``early_stop`` the rounds end as soon as the figures hold. ``t0``: the clock of the
+    records' ``time`` (s)."""
     history: list[dict] = []
-    t0 = time.perf_counter()
-    level = fine if len(plan) == 1 else Level(s0, plan[0], w, (Vs, Fr), mode, diag)
     xl = x if level is fine else level.x0     # the state at the current level
     state = judge(x, unchanged=True)          # the figures of the fine level's state
     at_level, total = 0, 0
@@ -223,8 +251,8 @@ def optimize_phlw(surf: BSplineSurface, reference: Any, *, mode: Mode = "phlw",
             level.refresh(xl)                 # closest points at the accepted state
         to_fine = (lambda xr: xr) if level is fine else \
             (lambda xr, lv=level: fine.start(lv.lay.view(xr, "C")))
-        step = run_round(level.prob, level.lay, level.data, xl, int(max_iter),
-                      stop=(lambda xr: judge.holds(to_fine(xr))) if early_stop else None)
+        step = run_round(level.prob, level.lay, level.data, xl, max_iter,
+                         stop=(lambda xr: judge.holds(to_fine(xr))) if early_stop else None)
         at_level += 1
         total += 1
         rec = {"round": total, "samples": list(level.samples),
@@ -238,20 +266,34 @@ def optimize_phlw(surf: BSplineSurface, reference: Any, *, mode: Mode = "phlw",
         history.append(rec)
         held = step["accepted"] and not rec["figures_failing"]
         if progress is not None:
-            where = (f"round {at_level}/{outer}" if level is fine else
-                     f"coarse round {at_level}/{COARSE_ROUNDS} ({level.samples[0]} x "
-                     f"{level.samples[1]} samples)")
-            progress(f"{where}: energy {step['energy0']:.3e} -> {step['energy']:.3e} in "
-                     f"{step['iterations']} iterations ({step['message']})"
-                     + ("; the figures hold" if held else ""))
+            progress(_round_line(step, at_level, outer, None if level is fine else level, held))
         if held and early_stop:
             break
         if not step["accepted"] or gain_small or at_level >= (
-                int(outer) if level is fine else COARSE_ROUNDS):
+                outer if level is fine else COARSE_ROUNDS):
             if level is fine:
                 break
             # continuation: the next sampling level starts from this level's control points
             level, xl, at_level = fine, fine.start(level.lay.view(xl, "C")), 0
+    return state, history
+
+
+def _round_line(step: dict, at_level: int, outer: int, coarse: Level | None, held: bool) -> str:
+    """The progress line of one round (``coarse``: its level when not the fine one)."""
+    where = (f"round {at_level}/{outer}" if coarse is None else
+             f"coarse round {at_level}/{COARSE_ROUNDS} ({coarse.samples[0]} x "
+             f"{coarse.samples[1]} samples)")
+    return (f"{where}: energy {step['energy0']:.3e} -> {step['energy']:.3e} in "
+            f"{step['iterations']} iterations ({step['message']})"
+            + ("; the figures hold" if held else ""))
+
+
+def _phlw_result(state: Any, history: list[dict], fine: Level, judge: Judge, *, before: dict,
+                 diagnostics: list[str], energy_initial: float, mode: Mode,
+                 weights: dict[str, float], diag: float) -> PHLWResult:
+    """The :class:`PHLWResult` of the rounds' last ``state``; raises
+    :class:`ConvergenceError` for a non-finite energy, or when every round was rejected and
+    the initial surface misses the figures."""
     x = state.x
     energy_final = state.energy
     if not np.isfinite(energy_final):
@@ -261,7 +303,7 @@ def optimize_phlw(surf: BSplineSurface, reference: Any, *, mode: Mode = "phlw",
     if unchanged:
         state = judge(x, unchanged=True)
     figures, check = state.figures, state.check
-    diagnostics += check.messages
+    diagnostics = [*diagnostics, *check.messages]
     if unchanged and not all(f["ok"] for f in figures.values()):
         raise ConvergenceError(
             f"the {mode.upper()} optimization could not lower its energy from "
@@ -269,11 +311,12 @@ def optimize_phlw(surf: BSplineSurface, reference: Any, *, mode: Mode = "phlw",
             f"{history[0]['energy_true']:.4g} after round 1) and was rejected; try more control "
             "points, a denser reference or another mode")
     n_rows, t_rows = state.n_rows, state.t_rows
-    abc = np.column_stack([np.ones(R), -2 * n_rows, n_rows ** 2 + t_rows ** 2])
+    abc = np.column_stack([np.ones(len(fine.u)), -2 * n_rows, n_rows ** 2 + t_rows ** 2])
     after = {"terms": fine.prob.report(x), **state.after}
-    return PHLWResult(surface=state.surface, mode=mode, u_rows=u, v_samples=v, n_rows=n_rows,
-                      t_rows=t_rows, abc=abc, history=history, report_before=before,
-                      report_after=after, converged=all(f["ok"] for f in figures.values()),
+    return PHLWResult(surface=state.surface, mode=mode, u_rows=fine.u, v_samples=fine.v,
+                      n_rows=n_rows, t_rows=t_rows, abc=abc, history=history,
+                      report_before=before, report_after=after,
+                      converged=all(f["ok"] for f in figures.values()),
                       deviation=state.deviation, diagnostics=diagnostics, net_check=check,
-                      weights=w, reference_diagonal=diag, figures=figures,
+                      weights=weights, reference_diagonal=diag, figures=figures,
                       energy_initial=float(energy_initial), energy_final=float(energy_final))
