@@ -6,6 +6,8 @@ import sys
 import time
 from typing import Any, Callable, Iterable, Mapping
 
+from gridshell.measure.quality import Gate
+
 
 class Progress:
     """Progress messages on stderr, with the elapsed time; silent with ``-q``."""
@@ -112,8 +114,26 @@ def print_gates(args: Any, summary: dict, title: str, quality: dict) -> None:
         print_summary(args, title, {**summary, "quality": quality})
         return
     print_summary(args, title, {**summary, "quality": "pass" if quality["ok"] else "FAIL"})
-    for g in quality["gates"]:
-        print(f"    {g['line']}")
+    for line in quality_lines(quality["gates"]):
+        print(f"    {line}")
+
+
+def quality_lines(gates: list[dict]) -> list[str]:
+    """The pass / FAIL lines of a design's gates (``Gate.as_dict()`` records): the lamella
+    fairness first (the checks that hold on one line, each failing one on its own), then one
+    line per figure of the paper."""
+    fair = [g for g in gates if str(g.get("name", "")).startswith("fair_")]
+    line = (lambda g: g.get("line") or Gate.from_dict(g).line())
+    out = []
+    held = [g for g in fair if g.get("ok", False)]
+    if held:
+        radius = next((g["detail"].split(" (")[0] for g in held if g["name"] == "fair_radius"
+                       and g.get("detail")), None)
+        out.append(f"pass  lamella fairness: {len(held)} of {len(fair)} checks hold (radius, "
+                   "corners, hairpins, loops, distance from the surface, folds"
+                   + (f"; smallest in-plane radius {radius}" if radius else "") + ")")
+    out += [line(g) for g in fair if not g.get("ok", False)]
+    return out + [line(g) for g in gates if g not in fair]
 
 
 def _fmt(v: Any) -> str:

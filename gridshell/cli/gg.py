@@ -81,8 +81,9 @@ def _offsets(args: Any) -> tuple[list[float], list[float]] | None:
 def run(args: Any) -> int:
     from gridshell.core.atomic import check_output
     from gridshell.api import design_gg, write
-    from gridshell.measure.quality import Gate, gate_lines
-    from gridshell.cli.common import Progress, input_line, input_options, print_summary
+
+    from gridshell.cli.common import (Progress, input_line, input_options, print_summary,
+                                      quality_lines)
 
     offsets = _offsets(args)
     if not 0 <= args.frames <= 1000:
@@ -106,7 +107,7 @@ def run(args: Any) -> int:
     m = bundle.metrics
     seq = report["sequence"]
     quality = bundle.params["quality"]
-    gates = [Gate(g["name"], g["label"], g["value"], g["limit"]) for g in quality["gates"]]
+
     surf = bundle.params["surface"]
     summary = {
         "bundle": str(out),
@@ -136,7 +137,7 @@ def run(args: Any) -> int:
     else:
         print_summary(args, "GG design", summary)
         print("  quality (the paper's figures on the traced net):")
-        for line in gate_lines(gates):
+        for line in quality_lines(quality["gates"]):
             print(f"    {line}")
         print(f"  verdict: {verdict}")
     return 0

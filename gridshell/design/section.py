@@ -31,7 +31,7 @@ from typing import Any, Mapping
 from gridshell.core.errors import InputError
 from gridshell.geometry.strips3d import real_section_m
 
-__all__ = ["DEFAULTS", "DEFAULT_CUT", "FABRICATION_REPORT", "StripSection", "fabrication_report_path", "parse_scale", "read_fabrication_report",
+__all__ = ["DEFAULTS", "DEFAULT_CUT", "FABRICATION_REPORT", "StripSection", "built_width_m", "design_width_m", "fabrication_report_path", "parse_scale", "read_fabrication_report",
            "resolve_section", "scale_text", "stored_params"]
 
 #: the one definition of the strip's defaults: cut width and thickness (mm of the model), scale
@@ -46,6 +46,26 @@ FABRICATION_REPORT = Path("fabrication") / "fabrication.json"
 
 #: the source of a value the caller gave, and of a default
 GIVEN, DEFAULT = "given", "defaults"
+
+
+def built_width_m(width_mm: float | None = None, scale: float | None = None) -> float:
+    """The strip's width at the built scale, metres: the cut width (mm of the model; default
+    :data:`DEFAULTS`) over the scale (20 mm at 1:10 -> 0.2 m)."""
+    w = DEFAULTS["width"] if width_mm is None else float(width_mm)
+    sc = DEFAULTS["scale"] if scale is None else float(scale)
+    return w * 1e-3 / sc
+
+
+#: a design's strip is at most this share of its bounding-box diagonal wide (the default
+#: strip at 1:10 is 0.2 m: too wide for a 0.5 m object, which a user cuts at another scale)
+WIDTH_PER_DIAGONAL = 0.01
+
+
+def design_width_m(diagonal: float) -> float:
+    """The strip width a design is judged with before it is cut (its lamella fairness),
+    metres: the default strip at the built scale (:func:`built_width_m`), at most
+    :data:`WIDTH_PER_DIAGONAL` of the design's ``diagonal`` (metres)."""
+    return min(built_width_m(), WIDTH_PER_DIAGONAL * float(diagonal))
 
 
 def parse_scale(text: str | float) -> float:

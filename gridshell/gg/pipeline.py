@@ -25,12 +25,14 @@ from scipy.sparse.csgraph import connected_components
 from scipy.sparse.linalg import lsqr
 
 from gridshell.design.bundle import Design, DesignBundle, report_json, write_bundle
+from gridshell.design.section import design_width_m
 from gridshell.design.stages import run_stages, stage
 from gridshell.core.errors import ConvergenceError, GridshellError, InputError, NoNetError
 from gridshell.geometry.grid import grid_quads
 from gridshell.measure.metrics import (alignability_error, alignability_error_arc, coverage, delta_l, deviations,
                        geodesic_turning, summary, target_deviation)
 from gridshell.geometry.net import Net
+from gridshell.measure.fairness import net_fairness
 from gridshell.measure.quality import Gate, design_gates, gate_lines, gate_summary, passed
 from gridshell.gg.clairaut import geodesic_net
 from gridshell.gg.mapback import map_back, map_to_revolution
@@ -549,6 +551,24 @@ def _sequence_stage(s: dict[str, Any]) -> dict[str, Any]:
     return {"sequence": seq, "metrics": metrics}
 
 
+def _design_width(V: np.ndarray) -> float:
+    """The strip width the design's fairness is judged with (metres, :func:`design_width_m`)."""
+    return design_width_m(float(np.linalg.norm(np.ptp(np.asarray(V, float), axis=0))))
+
+
+@stage("fairness", needs=("net", "surface_V", "surface_F", "sequence", "metrics"),
+       gives=("metrics",))
+def _fairness_stage(s: dict[str, Any]) -> dict[str, Any]:
+    """Lamella fairness and net sanity (:func:`gridshell.measure.fairness.net_fairness`:
+    in-plane radius against 10 strip widths (:func:`design_width_m`),
+    corners, hairpins, loops, distance from the surface, folds of the alignment states)."""
+    seq = s["sequence"]
+    fair = net_fairness(s["net"], s["surface_V"], s["surface_F"], tangent=True,
+                        width=_design_width(s["surface_V"]),
+                        states=None if seq is None else seq.V)
+    return {"metrics": {**s["metrics"], "fairness": fair}}
+
+
 @stage("bundle", needs=("net", "aligned", "surface_V", "surface_F", "metrics", "rev", "inet",
                         "geo", "surface", "collapse_info", "sequence"),
        gives=("bundle", "report"))
@@ -593,7 +613,7 @@ def _gg_params(s: dict[str, Any]) -> dict[str, Any]:
 
 #: the GG pipeline (paper 4.1), in order: :func:`design_gg` runs them over its parameters
 GG_STAGES = (_read_stage, _grid_stage, _surface_stage, _net_stage, _collapse_stage,
-             _metrics_stage, _gate_stage, _sequence_stage, _bundle_stage)
+             _metrics_stage, _sequence_stage, _fairness_stage, _gate_stage, _bundle_stage)
 
 
 def _edge_families(net: Net, edges: np.ndarray) -> np.ndarray:

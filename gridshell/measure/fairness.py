@@ -23,8 +23,8 @@ surface):
   ``pi`` strip widths apart along it (self-intersection of the strip);
 - the largest **distance from the surface** of the axis samples, % of the diagonal;
 
-and per alignment state, the net-loops that **fold** (the loop's vector area turns by more
-than 90 degrees from one state to the next while the loop still has area).
+and per alignment state, the net-loops that **fold** (a loop's vector area points more than
+150 degrees away from a neighbour's in the same state, both keeping a quarter of their area).
 
 :func:`gridshell.measure.quality.fairness_gates` turns the record into gates that name the
 lamella and the position (arc length along it, metres).
@@ -40,7 +40,7 @@ import numpy as np
 from gridshell.geometry.diffgeo import normal_geodesic_curvature, polyline_curvature
 
 __all__ = ["BEND_WIDTHS", "CORNER_DEG", "FAIR_RADIUS_WIDTHS", "HAIRPIN_DEG", "HAIRPIN_WIDTHS", "OFF_SURFACE",
-           "LamellaFairness", "fairness_metrics", "folded_loops",
+           "LamellaFairness", "fairness_metrics", "net_fairness", "folded_loops",
            "lamella_fairness"]
 
 #: smallest in-plane radius of a strip, in strip widths at the built scale
@@ -55,11 +55,11 @@ HAIRPIN_WIDTHS = 3.0
 #: width about any axis has a kink
 BEND_WIDTHS = 1.0
 #: axis samples farther than this from the design's surface (% of the diagonal) are off it
-OFF_SURFACE = 1.0
+OFF_SURFACE = 2.0
 #: a loop folds when its vector area turns by more than this between states (degrees) ...
-FOLD_DEG = 90.0
+FOLD_DEG = 150.0
 #: ... while its area is at least this share of its deployed area
-FOLD_MIN_AREA = 0.05
+FOLD_MIN_AREA = 0.25
 
 
 @dataclass(frozen=True)
@@ -213,32 +213,47 @@ def lamella_fairness(lamella_id: int, axis: np.ndarray, normals: np.ndarray, *,
         float(turns[i_c]), float(s[i_c + 1]), hp, s_hp, _loop(P, s, width), off, s_off)
 
 
+def _loop_pairs(Q: np.ndarray) -> np.ndarray:
+    """``(p, 2)`` pairs of net-loops that share an edge."""
+    E = np.sort(np.stack([Q, np.roll(Q, -1, axis=1)], -1).reshape(-1, 2), axis=1)
+    owner = np.repeat(np.arange(len(Q)), Q.shape[1])
+    order = np.lexsort((E[:, 1], E[:, 0]))
+    E, owner = E[order], owner[order]
+    same = np.all(E[1:] == E[:-1], axis=1)
+    return np.stack([owner[:-1][same], owner[1:][same]], -1)
+
+
 def folded_loops(states: Sequence[np.ndarray], loops: np.ndarray) -> list[tuple[int, int]]:
-    """``(state, loop)`` pairs where a net-loop folds: its vector area turns by more than
-    :data:`FOLD_DEG` from state ``k - 1`` to state ``k`` while it still has at least
-    :data:`FOLD_MIN_AREA` of its area in the first state. ``states``: joint positions
-    ``(n, 3)`` per state, the deployed one first; ``loops (m, 4)`` joint indices."""
+    """``(state, loop)`` pairs where the net folds: a net-loop whose vector area points more
+    than :data:`FOLD_DEG` away from that of a neighbour (a loop sharing an edge) in the same
+    state, both keeping at least :data:`FOLD_MIN_AREA` of their area in the first state (a
+    crease, judged within each state, whatever the step between states). ``states``: joint
+    positions ``(n, 3)`` per state, the deployed one first and the aligned (collapsed) one
+    last, where every loop is degenerate by design and is not judged; ``loops (m, 4)``."""
     Q = np.asarray(loops, dtype=np.int64)
-    if len(states) < 2 or len(Q) == 0:
+    if len(states) < 3 or len(Q) == 0:
+        return []
+    pairs = _loop_pairs(Q)
+    if len(pairs) == 0:
         return []
 
     def vector_area(V: np.ndarray) -> np.ndarray:
         V = np.asarray(V, float)
         return 0.5 * np.cross(V[Q[:, 2]] - V[Q[:, 0]], V[Q[:, 3]] - V[Q[:, 1]])
 
-    A0 = vector_area(states[0])
-    a0 = np.linalg.norm(A0, axis=1)
-    out: list[tuple[int, int]] = []
-    prev = A0
+    a0 = np.linalg.norm(vector_area(states[0]), axis=1)
     cos_fold = math.cos(math.radians(FOLD_DEG))
-    for k in range(1, len(states)):
+    out: list[tuple[int, int]] = []
+    for k in range(1, len(states) - 1):       # the last state is the collapse: no area
         A = vector_area(states[k])
-        a, ap = np.linalg.norm(A, axis=1), np.linalg.norm(prev, axis=1)
-        live = (a >= FOLD_MIN_AREA * a0) & (ap >= FOLD_MIN_AREA * a0) & (a0 > 0)
+        a = np.linalg.norm(A, axis=1)
+        live = (a >= FOLD_MIN_AREA * a0) & (a0 > 0)
+        i, j = pairs[:, 0], pairs[:, 1]
         with np.errstate(invalid="ignore", divide="ignore"):
-            c = (A * prev).sum(1) / (a * ap)
-        out += [(k, int(j)) for j in np.flatnonzero(live & (c < cos_fold))]
-        prev = A
+            c = (A[i] * A[j]).sum(1) / (a[i] * a[j])
+        bad = live[i] & live[j] & (c < cos_fold)
+        smaller = np.where(a[i] <= a[j], i, j)[bad]
+        out += [(k, int(m)) for m in np.unique(smaller)]
     return out
 
 
@@ -273,3 +288,12 @@ def fairness_metrics(lamellae: Iterable[tuple[int, np.ndarray]], V: np.ndarray, 
             "lamellae": [f.as_dict() for f in per],
             "folds": [{"state": k, "loop": j} for k, j in folds],
             "n_states": 0 if states is None else len(states)}
+
+
+def net_fairness(net, V: np.ndarray, F: np.ndarray, *, tangent: bool, width: float,
+                 states: Sequence[np.ndarray] | None = None) -> dict:
+    """:func:`fairness_metrics` of a :class:`~gridshell.geometry.net.Net` (its lamella axes
+    and net-loops) on its surface ``V, F`` with the alignment ``states`` (joint positions,
+    metres, the deployed state first)."""
+    return fairness_metrics([(lam.id, lam.axis) for lam in net.lamellae], V, F,
+                            tangent=tangent, width=width, states=states, loops=net.loops)

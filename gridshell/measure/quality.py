@@ -213,12 +213,12 @@ def fairness_gates(fair: Mapping | None) -> list[Gate]:
         "none" if not loops else "; ".join(
             f"lamella {d['id']} at s = {d['loop_s_m'][0]:.3g} and {d['loop_s_m'][1]:.3g} m"
             for d in loops[:3]) + (f" (+{len(loops) - 3} more)" if len(loops) > 3 else ""))))
-    if fair.get("n_states", 0) > 1:
+    if fair.get("n_states", 0) > 2:
         folds = list(fair.get("folds") or [])
         states = sorted({f["state"] for f in folds})
         gates.append(Gate("fair_fold", "no net-loop folds in the alignment", held=not folds,
                           detail="none" if not folds else (
                               f"{len(folds)} folds in {len(states)} of "
-                              f"{fair['n_states'] - 1} states (first: state {folds[0]['state']}"
+                              f"{fair['n_states'] - 2} intermediate states (first: state {folds[0]['state']}"
                               f", loop {folds[0]['loop']})")))
     return gates

@@ -21,11 +21,13 @@ import numpy as np
 
 from gridshell.geometry.bspline import BSplineSurface
 from gridshell.design.bundle import CollapseCurve, Design, DesignBundle, report_json, write_bundle
+from gridshell.design.section import design_width_m
 from gridshell.design.stages import Stage, run_stages, stage
 from gridshell.core.errors import ConvergenceError, InputError, NoNetError
 from gridshell.measure.metrics import alignability_error, delta_l, delta_n, deviation, summary
 from gridshell.measure.quality import design_gates, gate_summary, passed
 from gridshell.geometry.net import move_joints
+from gridshell.measure.fairness import net_fairness
 from gridshell.ncp.collapse import (CollapseResult, closest_on_polyline, collapse_curve, fit_circle,
                        line_deviation)
 from gridshell.geometry.bspline import uniform_params
@@ -340,6 +342,10 @@ def _metrics_stage(state: dict[str, Any]) -> dict[str, Any]:
     A2 = _register_2d((seq.aligned - seq.centroid) @ B.T, post.Vt)
     metrics = _design_figures(surf, state["traced"], col, post, seq, mesh)
     metrics.update(_mode_figures(o.mode, state["n"], col, A2))
+    # fairness of the lamellae the bundle holds (carried onto the post-optimized joints)
+    metrics["fairness"] = net_fairness(move_joints(state["traced"].net, post.V), mesh.V, mesh.F,
+                                       tangent=False, width=design_width_m(float(np.linalg.norm(
+                                           np.ptp(mesh.V, axis=0)))), states=seq.V)
     gates = design_gates(KIND[o.mode], metrics)
     metrics["quality"] = {"ok": passed(gates), "summary": gate_summary(gates),
                           "gates": [{**g.as_dict(), "line": g.line()} for g in gates]}

@@ -31,9 +31,14 @@ def test_gg_then_verify(tmp_path, capsys):
     summary = json.loads(capsys.readouterr().out)
     assert summary["ok"] and summary["verdict"].startswith("PASS")
     # the paper's figures as gates, one per figure (quality.design_gates)
-    assert [g["name"] for g in summary["gates"]] == ["delta_a_mean", "delta_a_max",
-                                                     "delta_a_arc_mean", "delta_a_arc_max"]
-    assert all(g["ok"] and g["value"] < g["limit"] for g in summary["gates"])
+    paper = [g for g in summary["gates"] if not g["name"].startswith("fair_")]
+    assert [g["name"] for g in paper] == ["delta_a_mean", "delta_a_max",
+                                          "delta_a_arc_mean", "delta_a_arc_max"]
+    assert all(g["ok"] and g["value"] < g["limit"] for g in paper)
+    # and the lamella fairness (measure.fairness), every check held
+    fair = [g for g in summary["gates"] if g["name"].startswith("fair_")]
+    assert {"fair_radius", "fair_corner", "fair_loop"} <= {g["name"] for g in fair}
+    assert all(g["ok"] for g in fair)
     b = read_bundle(out)
     assert b.kind == "GG" and len(b.net.loops) > 0 and (out / "preview.png").is_file()
     assert b.revolution_V is not None
@@ -139,7 +144,8 @@ def test_gg_prints_progress_on_stderr_and_a_one_screen_summary(tmp_path, capsys)
     # the summary ends with one pass/fail line per figure and the verdict
     assert lines[-1].strip().startswith("verdict: PASS")
     gate_lines = [ln.strip() for ln in lines if ln.strip().startswith(("pass  ", "FAIL  "))]
-    assert len(gate_lines) == 4 and all(ln.startswith("pass  Delta_a") for ln in gate_lines)
+    assert len(gate_lines) == 5 and gate_lines[0].startswith("pass  lamella fairness")
+    assert all(ln.startswith("pass  Delta_a") for ln in gate_lines[1:])
     cov = float(next(ln for k, ln in body.items() if k.startswith("coverage")).split()[-1])
     assert cov == pytest.approx(100.0, abs=1.0)       # the helicoid grid is its own design
     assert (out / "alignment.gif").is_file() and len(list(out.glob("sequence/frame_*.obj"))) == 4

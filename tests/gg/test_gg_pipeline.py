@@ -162,7 +162,8 @@ def test_design_gg_on_a_dome_triangle_mesh():
 
 def _score(bundle):
     """Largest figure / threshold over the design's gates (below 1: all pass)."""
-    return max(g["value"] / g["limit"] for g in bundle.params["quality"]["gates"])
+    return max(g["value"] / g["limit"] for g in bundle.params["quality"]["gates"]
+               if g.get("limit") is not None)
 
 
 def test_a_freeform_hill_is_accepted_on_its_figures_at_every_scale():
@@ -175,8 +176,9 @@ def test_a_freeform_hill_is_accepted_on_its_figures_at_every_scale():
     for size, shift in ((0.5, (0.0, 0.0, 0.0)), (60.0, (500.0, -300.0, 20.0))):
         bundle, report = design_gg(_mesh(hill_grid(24, 16, size=size, shift=shift)), frames=0)
         q = bundle.params["quality"]
-        assert q["ok"] and len(q["gates"]) == 4 and all(g["ok"] for g in q["gates"])
-        assert bundle.params["converged"] and "all 4 figures" in q["summary"]
+        paper = [g for g in q["gates"] if not g["name"].startswith("fair_")]
+        assert q["ok"] and len(paper) == 4 and all(g["ok"] for g in q["gates"])
+        assert bundle.params["converged"] and q["summary"].startswith("all ")
         # (with the orthogonality constraint the constraint energy keeps falling by more than
         # POLISH_STALL per iteration here, so the polish may run its 20 iterations)
         assert report["design"]["stop"] in ("figures", "stagnation", "tolerance",

@@ -12,7 +12,8 @@ from gridshell.geometry.grid import grid_quads
 from gridshell.gg import pipeline
 from gridshell.gg.pipeline import GG_STAGES, design_gg
 
-NAMES = ["read", "grid", "surface", "net", "collapse", "metrics", "gate", "sequence", "bundle"]
+NAMES = ["read", "grid", "surface", "net", "collapse", "metrics", "sequence", "fairness", "gate",
+         "bundle"]
 
 
 def _catenoid_target(n: int = 12):

@@ -109,21 +109,23 @@ def test_off_the_surface():
 
 
 def test_folds_of_an_alignment_sequence():
-    # two quads side by side; in state 2 the second one flips over its shared edge
+    # two quads side by side; in state 2 the second one is folded back over the first
     V0 = np.array([[0, 0, 0], [1, 0, 0], [2, 0, 0], [0, 1, 0], [1, 1, 0], [2, 1, 0]], float)
     Q = np.array([[0, 1, 4, 3], [1, 2, 5, 4]])
     V1 = V0.copy()
-    V1[[2, 5], 2] = 0.5                                   # folds up 27 degrees: no fold
+    V1[[2, 5], 2] = 0.5                                   # bent up 27 degrees: no fold
     V2 = V0.copy()
     V2[[2, 5], 0] = 0.2                                   # folded back over the first quad
     V2[[2, 5], 2] = 0.1
-    assert folded_loops([V0, V1], Q) == []
-    assert folded_loops([V0, V1, V2], Q) == [(2, 1)]
-    # a loop that shrinks to nothing (the collapsed state) is not a fold
-    V3 = V0.copy()
-    V3[:, 1] = 0.0
-    assert folded_loops([V0, V3], Q) == []
-    m = fairness_metrics([], *_plane(), tangent=True, width=W, states=[V0, V1, V2], loops=Q)
+    R = V0 @ np.array([[0, 0, 1], [0, 1, 0], [-1, 0, 0]], float).T   # both turned 90 degrees
+    assert folded_loops([V0, V1, R, V0], Q) == []         # a rigid turn of the net is no fold
+    assert folded_loops([V0, V1, V2, V0], Q) == [(2, 1)]
+    assert folded_loops([V0, V1, V2], Q) == []            # the last state (collapsed) not judged
+    # a loop that shrinks to nothing is not a fold
+    V3 = V2.copy()
+    V3[:, 1] *= 0.01
+    assert folded_loops([V0, V3, V0], Q) == []
+    m = fairness_metrics([], *_plane(), tangent=True, width=W, states=[V0, V1, V2, V0], loops=Q)
     g = {g.name: g for g in fairness_gates(m)}["fair_fold"]
     assert not g.ok and "state 2, loop 1" in g.detail
 
