@@ -60,6 +60,9 @@ OFF_SURFACE = 2.0
 FOLD_DEG = 150.0
 #: ... while its area is at least this share of its deployed area
 FOLD_MIN_AREA = 0.25
+#: the net folds when more than this share of its loops fold in one state (a single loop
+#: that inverts and comes back, as on the paper's AA pseudosphere, is reported, not refused)
+FOLD_SHARE = 0.05
 
 
 @dataclass(frozen=True)
@@ -260,11 +263,13 @@ def folded_loops(states: Sequence[np.ndarray], loops: np.ndarray) -> list[tuple[
 def fairness_metrics(lamellae: Iterable[tuple[int, np.ndarray]], V: np.ndarray, F: np.ndarray,
                      *, tangent: bool, width: float,
                      states: Sequence[np.ndarray] | None = None,
-                     loops: np.ndarray | None = None) -> dict:
+                     loops: np.ndarray | None = None, gate_folds: bool = True) -> dict:
     """``metrics["fairness"]`` of a design: every lamella's figures
     (:func:`lamella_fairness`) against its surface ``V, F`` (metres), the folds of the
     alignment ``states`` (:func:`folded_loops`), and the thresholds used. ``lamellae``:
-    ``(id, axis)`` pairs; ``width``: the strip width at the built scale, metres."""
+    ``(id, axis)`` pairs; ``width``: the strip width at the built scale, metres;
+    ``gate_folds``: the states are the physical path (GG: the isometric family), so a fold
+    fails the design; False where they are an approximate simulation (NCP: folds reported)."""
     from gridshell.geometry.igl_adapter import closest_points_with_normals
 
     lams = [(int(i), np.asarray(a, float)) for i, a in lamellae]
@@ -287,13 +292,16 @@ def fairness_metrics(lamellae: Iterable[tuple[int, np.ndarray]], V: np.ndarray, 
                        "off_surface_percent": OFF_SURFACE},
             "lamellae": [f.as_dict() for f in per],
             "folds": [{"state": k, "loop": j} for k, j in folds],
+            "n_loops": 0 if loops is None else int(len(loops)), "fold_share": FOLD_SHARE,
+            "gate_folds": bool(gate_folds),
             "n_states": 0 if states is None else len(states)}
 
 
 def net_fairness(net, V: np.ndarray, F: np.ndarray, *, tangent: bool, width: float,
-                 states: Sequence[np.ndarray] | None = None) -> dict:
+                 states: Sequence[np.ndarray] | None = None, gate_folds: bool = True) -> dict:
     """:func:`fairness_metrics` of a :class:`~gridshell.geometry.net.Net` (its lamella axes
     and net-loops) on its surface ``V, F`` with the alignment ``states`` (joint positions,
     metres, the deployed state first)."""
     return fairness_metrics([(lam.id, lam.axis) for lam in net.lamellae], V, F,
-                            tangent=tangent, width=width, states=states, loops=net.loops)
+                            tangent=tangent, width=width, states=states, loops=net.loops,
+                            gate_folds=gate_folds)

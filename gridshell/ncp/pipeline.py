@@ -345,7 +345,8 @@ def _metrics_stage(state: dict[str, Any]) -> dict[str, Any]:
     # fairness of the lamellae the bundle holds (carried onto the post-optimized joints)
     metrics["fairness"] = net_fairness(move_joints(state["traced"].net, post.V), mesh.V, mesh.F,
                                        tangent=False, width=design_width_m(float(np.linalg.norm(
-                                           np.ptp(mesh.V, axis=0)))), states=seq.V)
+                                           np.ptp(mesh.V, axis=0)))), states=seq.V,
+                                       gate_folds=False)
     gates = design_gates(KIND[o.mode], metrics)
     metrics["quality"] = {"ok": passed(gates), "summary": gate_summary(gates),
                           "gates": [{**g.as_dict(), "line": g.line()} for g in gates]}

@@ -144,3 +144,25 @@ def test_design_gates_include_fairness_when_measured():
     bad = [g for g in gates if not g.ok]
     assert [g.name for g in bad] == ["fair_radius"] and "lamella 3" in bad[0].line()
     assert len(design_gates("GG", {k: v for k, v in m.items() if k != "fairness"})) == 4
+
+
+def test_an_isolated_fold_is_reported_not_refused():
+    fair = {"width_m": W, "limits": {"radius_in_plane_m": 2.0, "corner_deg": 30,
+                                     "hairpin_deg": 150, "hairpin_window_m": 0.6,
+                                     "off_surface_percent": 2.0},
+            "lamellae": [], "folds": [{"state": 3, "loop": 19}], "n_states": 8,
+            "n_loops": 60, "fold_share": 0.05}
+    g = {g.name: g for g in fairness_gates(fair)}["fair_fold"]
+    assert g.ok and "isolated" in g.detail and "loop 19" in g.detail
+    fair["folds"] = [{"state": 3, "loop": k} for k in range(4)]       # 4 of 60 > 5 %
+    assert not {g.name: g for g in fairness_gates(fair)}["fair_fold"].ok
+
+
+def test_folds_of_an_approximate_path_are_reported_not_gated():
+    fair = {"width_m": W, "limits": {"radius_in_plane_m": 2.0, "corner_deg": 30,
+                                     "hairpin_deg": 150, "hairpin_window_m": 0.6,
+                                     "off_surface_percent": 2.0},
+            "lamellae": [], "folds": [{"state": 3, "loop": k} for k in range(10)],
+            "n_states": 8, "n_loops": 60, "fold_share": 0.05, "gate_folds": False}
+    g = {g.name: g for g in fairness_gates(fair)}["fair_fold"]
+    assert g.ok and "not gated" in g.detail and "more than 5 %" in g.detail
