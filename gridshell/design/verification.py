@@ -160,35 +160,16 @@ def exit_code(res: dict[str, Any]) -> int:
     return 2 if res["problems"] else 4
 
 
-def verify_bundle(path: str | Path) -> dict[str, Any]:
-    """Metrics of the bundle at ``path`` recomputed from design.json, net.obj, axes.obj,
-    surface.obj (and aligned.obj, axes_r.npy, aligned_r.npy when present).
-
-    For NCP / CNC / AA bundles also: ``deviation`` of the joints from surface.obj (% of its
-    bounding-box diagonal), the figures of :func:`_aligned_figures` from aligned.obj, and
-    ``mismatch``, the figures that differ from those stored in design.json (a bundle whose
-    files were changed after the design). GG bundles: ``deviation`` of the surface (and
-    ``deviation_joints``) from the target mesh of ``params.target`` when it is readable, and
-    ``mismatch`` against :data:`GG_STORED`. Both: the stored counts (``n_joints``,
-    ``n_loops``, ``n_lamellae``) against the files.
-
-    The verdict: ``required`` (the figures and files this kind needs), ``gates`` (:func:`gridshell.measure.quality.design_gates` of the recomputed figures,
-    as dicts), ``checks`` (their pass / FAIL lines), ``problems`` (a file of
-    :data:`FIGURE_FILES` missing, a figure not computed, a mismatch) and ``ok``: every gate
-    holds and there is no problem. A bundle whose net.obj, axes.obj, surface.obj or
-    design.json cannot be read raises :class:`~gridshell.core.errors.InputError`.
-    """
-    from gridshell.design.bundle import (cached_bundle, check_collapse, lamellae_from_design, read_design_json,
-                         read_net_mesh)
+def _read_files(path: Path) -> tuple[dict, Any, Any, np.ndarray, np.ndarray]:
+    """design.json ``d`` of the bundle at ``path``, the cached bundle (or None), the
+    :class:`~gridshell.geometry.net.Net` of net.obj and axes.obj, and surface.obj's
+    ``V (n, 3)`` (metres) and ``F``; :class:`InputError` when one of them is missing."""
     from gridshell.core.errors import InputError
-    from gridshell.measure.metrics import (alignability_error, alignability_error_arc,
-                           crossing_normal_curvature_on_mesh, delta_l, delta_n,
-                           deviation, deviations, geodesic_turning, summary)
+    from gridshell.design.bundle import (cached_bundle, check_collapse, lamellae_from_design,
+                                         read_design_json, read_net_mesh)
+    from gridshell.geometry.meshfile import read_mesh, read_polylines
     from gridshell.geometry.net import Net
-    from gridshell.measure.quality import design_gates, failing
-    from gridshell.geometry.meshfile import read_configuration, read_mesh, read_polylines
 
-    path = Path(path)
     d = read_design_json(path)
     check_collapse(d, path)
     for name in ("net.obj", "axes.obj", "surface.obj"):
@@ -208,7 +189,16 @@ def verify_bundle(path: str | Path) -> dict[str, Any]:
         surf = read_mesh(path / "surface.obj", kind="any")
         surf_V, surf_F = surf.V, surf.F
     lams = lamellae_from_design(d, axes, path)
-    net = Net(joints=net_V, loops=net_F, lamellae=lams)
+    return d, done, Net(joints=net_V, loops=net_F, lamellae=lams), surf_V, surf_F
+
+
+def _net_figures(d: dict, net: Any, surf_V: np.ndarray, surf_F: np.ndarray) -> dict[str, Any]:
+    """Counts, alignability (eq. 5.1, per loop and arc-length, %) of ``net``, and the GG
+    ``geodesic_turning`` or the NCP ``crossing_kn`` (%) on surface.obj ``surf_V, surf_F``."""
+    from gridshell.measure.metrics import (alignability_error, alignability_error_arc,
+                                           crossing_normal_curvature_on_mesh,
+                                           geodesic_turning, summary)
+
     da = alignability_error(net.joints, net.loops)
     da_arc = alignability_error_arc(net)
     out: dict[str, Any] = {
@@ -217,15 +207,26 @@ def verify_bundle(path: str | Path) -> dict[str, Any]:
         "alignability_arc": {k: 100 * v for k, v in summary(da_arc).items()},
         "per_loop": {"alignability": (100 * da).tolist(), "alignability_arc": (100 * da_arc).tolist()},
     }
-    ncp = d["kind"] != "GG"
-    if not ncp:
+    if d["kind"] == "GG":
         out["geodesic_turning"] = 100 * geodesic_turning(net, surf_V, surf_F)["ratio"]
     else:  # orthogonal lamellae: equal normal curvature of the two axes at every joint
         ck = crossing_normal_curvature_on_mesh(net, surf_V, surf_F, reuse=True)
         out["crossing_kn"] = {"mean": 100 * ck["mean"], "max": 100 * ck["max"],
                               "joints": int(len(ck["joints"]))}
+    return out
+
+
+def _deviation_figures(d: dict, net: Any, surf_V: np.ndarray,
+                       surf_F: np.ndarray) -> dict[str, Any]:
+    """``deviation`` (% of the diagonal): NCP kinds, of the joints from surface.obj; GG, of
+    surface.obj (and ``deviation_joints``) from the target of ``params.target``, read as the
+    design read it (``{"skipped": reason}`` when unreadable; nothing without a target)."""
+    from gridshell.core.errors import InputError
+    from gridshell.measure.metrics import deviation, deviations
+
+    out: dict[str, Any] = {}
     target = (d.get("params") or {}).get("target")
-    if ncp:  # the joints from the designed (PHLW) surface, as the pipeline measures them
+    if d["kind"] != "GG":  # the joints from the designed (PHLW) surface, as the pipeline measures them
         dv = deviation(net.joints, surf_V, surf_F, reuse=True)
         out["deviation"] = {"mean": dv["mean"], "max": dv["max"]}
     elif target:
@@ -243,35 +244,54 @@ def verify_bundle(path: str | Path) -> dict[str, Any]:
             dv, dj = deviations([surf_V, net.joints], t.V, t.F)
             out["deviation"] = {"mean": dv["mean"], "max": dv["max"]}
             out["deviation_joints"] = {"mean": dj["mean"], "max": dj["max"]}
-    problems = [f"{name} is missing: the figures that need it were not computed"
-                for name in FIGURE_FILES[d["kind"]] if not (path / name).is_file()]
+    return out
+
+
+def _read_aligned(path: Path, done: Any, net: Any) -> np.ndarray | None:
+    """The collapsed joints ``(n, 3)`` of aligned.obj (None when absent), checked against
+    net.obj's count and for finiteness (:class:`InputError` naming the file)."""
+    from gridshell.core.errors import InputError
+    from gridshell.geometry.meshfile import read_configuration
+
+    if not (path / "aligned.obj").is_file():
+        return None
+    Va = done.aligned if done is not None else read_configuration(path / "aligned.obj")[0]
+    if Va.shape != net.joints.shape:
+        raise InputError(f"{path}: aligned.obj has {len(Va)} vertices but net.obj "
+                         f"{len(net.joints)}; re-run the design command")
+    if not np.all(np.isfinite(Va)):
+        raise InputError(f"{path / 'aligned.obj'}: "
+                         f"{int((~np.isfinite(Va)).any(axis=1).sum())} vertices are not "
+                         "finite (NaN or Inf); re-run the design command")
+    return Va
+
+
+def _delta_figures(path: Path, net: Any, Va: np.ndarray | None) -> dict[str, Any]:
+    """``delta_l`` and ``delta_n`` (%, mean / max) between the net and its collapsed state
+    ``Va`` with the stored rotation axes; both None without axes_r.npy, aligned_r.npy or Va."""
+    from gridshell.measure.metrics import delta_l, delta_n, summary
+
     r_star, r_a = path / "axes_r.npy", path / "aligned_r.npy"
-    Va = None
-    has_r = r_star.is_file() and r_a.is_file()
-    if (path / "aligned.obj").is_file():
-        Va = done.aligned if done is not None else read_configuration(path / "aligned.obj")[0]
-        if Va.shape != net.joints.shape:
-            raise InputError(f"{path}: aligned.obj has {len(Va)} vertices but net.obj "
-                             f"{len(net.joints)}; re-run the design command")
-        if not np.all(np.isfinite(Va)):
-            raise InputError(f"{path / 'aligned.obj'}: "
-                             f"{int((~np.isfinite(Va)).any(axis=1).sum())} vertices are not "
-                             "finite (NaN or Inf); re-run the design command")
-        if ncp:
-            out.update(_aligned_figures(Va, d))
-    if has_r and Va is not None:
-        rs, ra = _load_axes(r_star, len(net.joints)), _load_axes(r_a, len(net.joints))
-        E = net.edges()
-        out["delta_l"] = {k: 100 * v for k, v in summary(delta_l(net.joints, Va, E)).items()}
-        out["delta_n"] = {k: 100 * v for k, v in
-                          summary(delta_n(net.joints, rs, Va, ra, E)).items()}
-    else:
-        out["delta_l"] = out["delta_n"] = None  # no rotation axes stored (GG, or older NCP)
+    if not (r_star.is_file() and r_a.is_file() and Va is not None):
+        return {"delta_l": None, "delta_n": None}  # no rotation axes stored (GG, or older NCP)
+    rs, ra = _load_axes(r_star, len(net.joints)), _load_axes(r_a, len(net.joints))
+    E = net.edges()
+    return {"delta_l": {k: 100 * v for k, v in summary(delta_l(net.joints, Va, E)).items()},
+            "delta_n": {k: 100 * v for k, v in
+                        summary(delta_n(net.joints, rs, Va, ra, E)).items()}}
+
+
+def _verdict(out: dict[str, Any], d: dict, net: Any, problems: list[str]) -> None:
+    """Add to ``out`` the stored metrics, ``mismatch`` (counts and figures against
+    design.json), ``required``, ``gates``, ``checks``, ``problems`` and ``ok``."""
+    from gridshell.measure.quality import design_gates, failing
+
     stored = d.get("metrics", {})
     out["stored"] = stored if isinstance(stored, dict) else {}
     families = {"C1": len(net.family(1)), "C3": len(net.family(3))}
     out["mismatch"] = (_count_mismatch(d, len(net.joints), len(net.loops), families)
-                       + _mismatch(out, out["stored"], NCP_STORED if ncp else GG_STORED))
+                       + _mismatch(out, out["stored"],
+                                   NCP_STORED if d["kind"] != "GG" else GG_STORED))
     if out["mismatch"]:
         problems.append("design.json disagrees with the files on " + ", ".join(out["mismatch"])
                         + " (the bundle was changed after the design)")
@@ -282,6 +302,37 @@ def verify_bundle(path: str | Path) -> dict[str, Any]:
     out["checks"] = [g.line() for g in gates]
     out["problems"] = problems
     out["ok"] = not bad and not problems
+
+
+def verify_bundle(path: str | Path) -> dict[str, Any]:
+    """Metrics of the bundle at ``path`` recomputed from design.json, net.obj, axes.obj,
+    surface.obj (and aligned.obj, axes_r.npy, aligned_r.npy when present).
+
+    For NCP / CNC / AA bundles also: ``deviation`` of the joints from surface.obj (% of its
+    bounding-box diagonal), the figures of :func:`_aligned_figures` from aligned.obj, and
+    ``mismatch``, the figures that differ from those stored in design.json (a bundle whose
+    files were changed after the design). GG bundles: ``deviation`` of the surface (and
+    ``deviation_joints``) from the target mesh of ``params.target`` when it is readable, and
+    ``mismatch`` against :data:`GG_STORED`. Both: the stored counts (``n_joints``,
+    ``n_loops``, ``n_lamellae``) against the files.
+
+    The verdict: ``required`` (the figures and files this kind needs), ``gates`` (:func:`gridshell.measure.quality.design_gates` of the recomputed figures,
+    as dicts), ``checks`` (their pass / FAIL lines), ``problems`` (a file of
+    :data:`FIGURE_FILES` missing, a figure not computed, a mismatch) and ``ok``: every gate
+    holds and there is no problem. A bundle whose net.obj, axes.obj, surface.obj or
+    design.json cannot be read raises :class:`~gridshell.core.errors.InputError`.
+    """
+    path = Path(path)
+    d, done, net, surf_V, surf_F = _read_files(path)
+    out = _net_figures(d, net, surf_V, surf_F)
+    out.update(_deviation_figures(d, net, surf_V, surf_F))
+    problems = [f"{name} is missing: the figures that need it were not computed"
+                for name in FIGURE_FILES[d["kind"]] if not (path / name).is_file()]
+    Va = _read_aligned(path, done, net)
+    if Va is not None and d["kind"] != "GG":
+        out.update(_aligned_figures(Va, d))
+    out.update(_delta_figures(path, net, Va))
+    _verdict(out, d, net, problems)
     return out
 
 

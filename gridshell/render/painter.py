@@ -213,7 +213,6 @@ class Painter:
         eight when the joint dots have eight).
         """
         from matplotlib.collections import PathCollection
-        from matplotlib.path import Path as MplPath
 
         if not self.polys:
             return None
@@ -228,14 +227,34 @@ class Painter:
         local = order - starts[chunk]                             # its index in that list
         out_of = np.empty(len(order), bool)
         out_of[order] = outlined                                  # outlined, in list order
+        M = Minv_T = None
+        half_px = 0.0
         if linewidth > 0:
             M = transform.get_matrix()[:2, :2]   # data -> display pixels (linear axes)
             Minv_T = np.linalg.inv(M).T
             half_px = 0.5 * float(linewidth) * float(dpi) / 72.0
+        sources = self._sources(kmax, starts, out_of, M, Minv_T, half_px)
+        special: list[Any] = []
+        if np.any(outlined):
+            special, chunk, local, face = self._outlines(outlined, chunk, local, face, edge,
+                                                         kmax, M, Minv_T, half_px)
+        light = agg_only and len(chunk) > 1 and transform.is_affine
+        paths = (_LightPolygonPaths if light else _PolygonPaths)(sources, chunk, local, special)
+        coll = PathCollection(paths, facecolors=face, edgecolors="none", linewidths=0.0)
+        coll.set_transform(transform)
+        return coll
+
+    def _sources(self, kmax: int, starts: np.ndarray, out_of: np.ndarray, M, Minv_T,
+                 half_px: float) -> list[tuple[np.ndarray, type]]:
+        """Per list of :meth:`add`: its polygons' closed vertices (data coordinates; grown by
+        ``half_px`` display pixels where not ``out_of`` when ``M`` is given, else only padded)
+        and the :func:`_polygon_type` a ``Path`` of them would have (the rcParams now)."""
+        from matplotlib.path import Path as MplPath
+
         sources = []
-        for c, (P, s0) in enumerate(zip(self.polys, starts)):
+        for P, s0 in zip(self.polys, starts):
             pad = kmax - P.shape[1]
-            if linewidth > 0:       # closed: the first corner again at the end
+            if M is not None:       # closed: the first corner again at the end
                 V = _grow_as_padded(P, M, Minv_T, half_px, pad,
                                     ~out_of[s0:s0 + len(P)])
             else:
@@ -245,38 +264,42 @@ class Painter:
             template = MplPath(V[0], closed=True)
             sources.append((V, _polygon_type(len(template.codes), template.should_simplify,
                                              template.simplify_threshold)))
-        special: list[Any] = []
-        if np.any(outlined):
-            copies = np.where(outlined, 2, 1)
-            idx = np.repeat(np.arange(len(order)), copies)
-            ring = np.zeros(len(idx), bool)    # the outline after an outlined polygon
-            ring[np.cumsum(copies)[outlined] - 1] = True
-            # the outlined polygons padded, as the growth defines them
-            Po = np.empty((int(outlined.sum()), kmax, 2))
-            ch, lo = chunk[outlined], local[outlined]
-            for c, P in enumerate(self.polys):
-                sel = ch == c
-                if sel.any():
-                    Po[sel] = _pad_to(P[lo[sel]], kmax)
-            X = Po @ M.T
-            out = (grow_polygons(X, 1.0) - X) @ Minv_T * half_px   # outward
-            loop = [MplPath.MOVETO] + [MplPath.LINETO] * (kmax - 1) + [MplPath.CLOSEPOLY]
-            ring_codes = np.array(loop + loop, dtype=MplPath.code_type)
-            # each outline: the grown polygon and, reversed, the shrunk one (a hole), all
-            # rings in one array (the numbers of each ring's own concatenation)
-            grown, shrunk = Po + out, Po - out
-            R = np.empty((len(Po), 2 * kmax + 2, 2))
-            R[:, :kmax], R[:, kmax] = grown, grown[:, 0]
-            R[:, kmax + 1:-1], R[:, -1] = shrunk[:, ::-1], shrunk[:, -1]
-            special = [MplPath(r, ring_codes) for r in R]
-            chunk, local = chunk[idx], local[idx]
-            chunk[ring], local[ring] = -1, np.arange(len(special))
-            face = np.where(ring[:, None], edge[idx], face[idx])
-        light = agg_only and len(chunk) > 1 and transform.is_affine
-        paths = (_LightPolygonPaths if light else _PolygonPaths)(sources, chunk, local, special)
-        coll = PathCollection(paths, facecolors=face, edgecolors="none", linewidths=0.0)
-        coll.set_transform(transform)
-        return coll
+        return sources
+
+    def _outlines(self, outlined: np.ndarray, chunk: np.ndarray, local: np.ndarray,
+                  face: np.ndarray, edge: np.ndarray, kmax: int, M: np.ndarray,
+                  Minv_T: np.ndarray, half_px: float):
+        """The outline rings (matplotlib ``Path``: the polygon grown by ``half_px`` display
+        pixels and, reversed as a hole, shrunk by as much) of the ``outlined`` polygons, each
+        drawn right after its polygon: the rings, and the drawn order's ``chunk`` / ``local``
+        (a ring: chunk -1, its index in the rings) and face colours (a ring: the edge's)."""
+        from matplotlib.path import Path as MplPath
+
+        copies = np.where(outlined, 2, 1)
+        idx = np.repeat(np.arange(len(chunk)), copies)
+        ring = np.zeros(len(idx), bool)    # the outline after an outlined polygon
+        ring[np.cumsum(copies)[outlined] - 1] = True
+        # the outlined polygons padded, as the growth defines them
+        Po = np.empty((int(outlined.sum()), kmax, 2))
+        ch, lo = chunk[outlined], local[outlined]
+        for c, P in enumerate(self.polys):
+            sel = ch == c
+            if sel.any():
+                Po[sel] = _pad_to(P[lo[sel]], kmax)
+        X = Po @ M.T
+        out = (grow_polygons(X, 1.0) - X) @ Minv_T * half_px   # outward
+        loop = [MplPath.MOVETO] + [MplPath.LINETO] * (kmax - 1) + [MplPath.CLOSEPOLY]
+        ring_codes = np.array(loop + loop, dtype=MplPath.code_type)
+        # each outline: the grown polygon and, reversed, the shrunk one (a hole), all
+        # rings in one array (the numbers of each ring's own concatenation)
+        grown, shrunk = Po + out, Po - out
+        R = np.empty((len(Po), 2 * kmax + 2, 2))
+        R[:, :kmax], R[:, kmax] = grown, grown[:, 0]
+        R[:, kmax + 1:-1], R[:, -1] = shrunk[:, ::-1], shrunk[:, -1]
+        special = [MplPath(r, ring_codes) for r in R]
+        chunk, local = chunk[idx], local[idx]
+        chunk[ring], local[ring] = -1, np.arange(len(special))
+        return special, chunk, local, np.where(ring[:, None], edge[idx], face[idx])
 
 
 def _pad_to(P: np.ndarray, k: int) -> np.ndarray:

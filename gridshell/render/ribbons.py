@@ -165,10 +165,41 @@ def render_ribbons(path: str | os.PathLike, axes: Sequence[np.ndarray],
     Path
         ``path``.
     """
-    from matplotlib.figure import Figure
-    from matplotlib.patches import Patch
+    from gridshell.render.painter import Camera, Painter
 
-    from gridshell.render.painter import Camera, Painter, strips_faces
+    axes, fams, V, F, J, w, t = _checked_inputs(axes, families, kind, V, F, joints, width,
+                                                thickness)
+    tangent = kind in TANGENT_KINDS
+    pts = np.concatenate(axes + ([J] if J is not None and len(J) else []))
+    elev, azim = view if view is not None else view_angles(pts)
+    cam = Camera(elev, azim)
+    r, u, c = cam.basis()
+    light = _unit(0.5 * c + 0.6 * u - 0.4 * r)
+    painter = Painter(cam)
+    bias = 0.5 * _paint_surface(painter, V, F, pts, max_faces, light) + 0.5 * t
+    if colours is not None and [len(c) for c in colours] != [len(a) for a in axes]:
+        raise InputError("render_ribbons: give one RGB per axis point in colours")
+    axes_d, fams_d, cols_d = _drawn_axes(axes, fams, colours, max_points)
+    # the normals at the axes' points and, after them, at the joints: one nearest-vertex search
+    Jn = J if J is not None and len(J) else np.zeros((0, 3))
+    N_all = nearest_vertex_normals(np.concatenate(axes_d + [Jn]), V, F) \
+        if axes_d or len(Jn) else np.zeros((0, 3))
+    n_axis = sum(len(a) for a in axes_d)
+    if axes_d:
+        _paint_strips(painter, axes_d, fams_d, cols_d, N_all[:n_axis], w, t, tangent, light,
+                      bias)
+    if J is not None and len(J):
+        _paint_joints(painter, J, N_all[n_axis:], pts, w, t, tangent, cam, bias)
+    fig = _figure(painter, size, dpi, title, colorbar,
+                  sorted(set(fams_d)) if colours is None else [], fams_d)
+    _write_png(fig, path, dpi)
+    return Path(path)
+
+
+def _checked_inputs(axes, families, kind, V, F, joints, width, thickness):
+    """The arguments of :func:`render_ribbons` as arrays (axes ``(k_i, 3)``, families as
+    ints, ``V``, ``F``, joints or None) and the strip's section ``w, t`` in metres (the
+    default cut at its scale when not given); :class:`InputError` naming a bad one."""
     from gridshell.design.section import resolve_section
 
     axes = [np.asarray(a, float).reshape(-1, 3) for a in axes]
@@ -188,63 +219,81 @@ def render_ribbons(path: str | os.PathLike, axes: Sequence[np.ndarray],
     t = default.thickness_m if thickness is None else float(thickness)
     if not (w > 0 and t > 0):
         raise InputError(f"render_ribbons: width and thickness must be positive, got {w}, {t}")
-    tangent = kind in TANGENT_KINDS
+    return axes, fams, V, F, J, w, t
 
-    pts = np.concatenate(axes + ([J] if J is not None and len(J) else []))
-    elev, azim = view if view is not None else view_angles(pts)
-    cam = Camera(elev, azim)
-    r, u, c = cam.basis()
-    light = _unit(0.5 * c + 0.6 * u - 0.4 * r)
-    painter = Painter(cam)
 
+def _paint_surface(painter, V: np.ndarray, F: np.ndarray, pts: np.ndarray, max_faces: int,
+                   light: np.ndarray) -> float:
+    """Add the opaque surface under the points ``pts`` (:func:`_surface_near`) to
+    ``painter``, grey shaded by the unit ``light``; returns the median face size in metres
+    (0 when no face is drawn)."""
     S = _surface_near(V, F, pts, max_faces)
-    if len(S):
-        n = _unit(np.cross(S[:, 2] - S[:, 0], S[:, -1] - S[:, 1]))
-        k = 0.62 + 0.3 * np.abs(n @ light)
-        face = np.column_stack([np.outer(k, _SURFACE_RGB), np.ones(len(S))])
-        painter.add(S, face, face)  # edges as the faces: no seams, no mesh lines
-        size_faces = float(np.median(row_norms(S[:, 2] - S[:, 0])))
-    else:
-        size_faces = 0.0
-    bias = 0.5 * size_faces + 0.5 * t
+    if not len(S):
+        return 0.0
+    n = _unit(np.cross(S[:, 2] - S[:, 0], S[:, -1] - S[:, 1]))
+    k = 0.62 + 0.3 * np.abs(n @ light)
+    face = np.column_stack([np.outer(k, _SURFACE_RGB), np.ones(len(S))])
+    painter.add(S, face, face)  # edges as the faces: no seams, no mesh lines
+    return float(np.median(row_norms(S[:, 2] - S[:, 0])))
 
-    if colours is not None and [len(c) for c in colours] != [len(a) for a in axes]:
-        raise InputError("render_ribbons: give one RGB per axis point in colours")
+
+def _drawn_axes(axes: list[np.ndarray], fams: list[int], colours, max_points: int):
+    """The axes that are drawn (two points or more), each resampled to at most
+    ``max_points`` points (:func:`_resample_index`), their families, and their per-point
+    RGB ``(k_i, 3)`` when ``colours`` is given (else None)."""
     keep = [i for i, a in enumerate(axes) if len(a) >= 2]
     picks = [_resample_index(len(axes[i]), max_points) for i in keep]
     axes_d = [axes[i][p] for i, p in zip(keep, picks)]
     fams_d = [fams[i] for i in keep]
     cols_d = (None if colours is None else
               [np.asarray(colours[i], float).reshape(-1, 3)[p] for i, p in zip(keep, picks)])
-    # the normals at the axes' points and, after them, at the joints: one nearest-vertex search
-    Jn = J if J is not None and len(J) else np.zeros((0, 3))
-    N_all = nearest_vertex_normals(np.concatenate(axes_d + [Jn]), V, F) \
-        if axes_d or len(Jn) else np.zeros((0, 3))
+    return axes_d, fams_d, cols_d
+
+
+def _paint_strips(painter, axes_d, fams_d, cols_d, N: np.ndarray, w: float, t: float,
+                  tangent: bool, light: np.ndarray, bias: float) -> None:
+    """Add every strip (section ``w x t`` metres) at once to ``painter``, axis by axis: 8
+    groups of one quad per segment (:func:`gridshell.render.painter.strips_faces`), coloured
+    by family or by ``cols_d``; ``N`` the unit normals at all the axes' points, stacked."""
+    from gridshell.render.painter import strips_faces
+
     sizes = [len(a) for a in axes_d]
-    N = np.split(N_all[:sum(sizes)], np.cumsum(sizes)[:-1])
-    # every strip at once, axis by axis: 8 groups of one quad per segment (strips_faces)
-    if axes_d:
-        Q, side, qn = strips_faces(axes_d, N, w, t, tangent)
-        if cols_d is None:
-            rgb = np.concatenate([np.broadcast_to(np.asarray(
-                FAMILY_COLOURS.get(f, (0.3, 0.3, 0.3)), float), (8 * (k - 1), 3))
-                for f, k in zip(fams_d, sizes)])
-        else:
-            rgb = np.concatenate([np.tile(c[:-1], (8, 1)) for c in cols_d])
-        # GG: family C1 lies on the side of the normal where the two layers cross
-        layer = np.repeat([(0.5 * w if f == 1 else -0.5 * w) if tangent else 0.0
-                           for f in fams_d], [8 * (k - 1) for k in sizes])
-        painter.add_strip(Q, side, qn, rgb, light, bias, layer)
-    if J is not None and len(J):
-        ring = np.linspace(0, 2 * np.pi, 9)[:-1]
-        diag = float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0)))
-        rad = min(0.3 * w, 0.007 * diag) if diag > 0 else 0.3 * w
-        dots = J[:, None, :] + rad * (np.cos(ring)[None, :, None] * r +
-                                      np.sin(ring)[None, :, None] * u)
-        Nj = N_all[sum(sizes):]
-        lift = np.where(tangent, 0.5 * t, 0.25 * w) * np.sign(Nj @ c)
-        painter.add(dots + (lift[:, None] * Nj)[:, None, :], np.array([0.12, 0.12, 0.14, 1.0]),
-                    np.array([0.0, 0.0, 0.0, 1.0]), bias + 1.5 * w)
+    N = np.split(N, np.cumsum(sizes)[:-1])
+    Q, side, qn = strips_faces(axes_d, N, w, t, tangent)
+    if cols_d is None:
+        rgb = np.concatenate([np.broadcast_to(np.asarray(
+            FAMILY_COLOURS.get(f, (0.3, 0.3, 0.3)), float), (8 * (k - 1), 3))
+            for f, k in zip(fams_d, sizes)])
+    else:
+        rgb = np.concatenate([np.tile(c[:-1], (8, 1)) for c in cols_d])
+    # GG: family C1 lies on the side of the normal where the two layers cross
+    layer = np.repeat([(0.5 * w if f == 1 else -0.5 * w) if tangent else 0.0
+                       for f in fams_d], [8 * (k - 1) for k in sizes])
+    painter.add_strip(Q, side, qn, rgb, light, bias, layer)
+
+
+def _paint_joints(painter, J: np.ndarray, Nj: np.ndarray, pts: np.ndarray, w: float,
+                  t: float, tangent: bool, cam, bias: float) -> None:
+    """Add the joints ``J (p, 3)`` to ``painter`` as small octagons facing the camera, lifted
+    along their unit normals ``Nj (p, 3)`` towards it off the strips (metres)."""
+    r, u, c = cam.basis()
+    ring = np.linspace(0, 2 * np.pi, 9)[:-1]
+    diag = float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0)))
+    rad = min(0.3 * w, 0.007 * diag) if diag > 0 else 0.3 * w
+    dots = J[:, None, :] + rad * (np.cos(ring)[None, :, None] * r +
+                                  np.sin(ring)[None, :, None] * u)
+    lift = np.where(tangent, 0.5 * t, 0.25 * w) * np.sign(Nj @ c)
+    painter.add(dots + (lift[:, None] * Nj)[:, None, :], np.array([0.12, 0.12, 0.14, 1.0]),
+                np.array([0.0, 0.0, 0.0, 1.0]), bias + 1.5 * w)
+
+
+def _figure(painter, size: tuple[int, int], dpi: int, title: str | None,
+            colorbar: tuple[str, str] | None, present: list[int], fams_d: list[int]):
+    """The matplotlib ``Figure`` of ``size`` pixels: the painted polygons fitted to the
+    picture's box at equal scale, the colour bar, the legend of the families ``present``
+    (with their counts in ``fams_d``) and the title."""
+    from matplotlib.figure import Figure
+    from matplotlib.patches import Patch
 
     fig = Figure(figsize=(size[0] / dpi, size[1] / dpi), dpi=dpi)
     rect = (0.01, 0.01, 0.98, 0.91 if title else 0.98)   # the picture's box, figure fraction
@@ -268,14 +317,12 @@ def render_ribbons(path: str | os.PathLike, axes: Sequence[np.ndarray],
         cb = fig.colorbar(ScalarMappable(norm=Normalize(0.0, 1.0),
                                          cmap=colormaps[colorbar[0]]), cax=cax)
         cb.set_label(colorbar[1], fontsize=8)
-    present = sorted(set(fams_d)) if colours is None else []
     fig.legend(handles=[Patch(color=FAMILY_COLOURS.get(f, (0.3, 0.3, 0.3)),
                               label=f"family C{f} ({fams_d.count(f)})") for f in present],
                loc="lower left", fontsize=8, frameon=False)
     if title:
         fig.suptitle(title, fontsize=max(6.0, min(10.0, size[0] / 60.0)))
-    _write_png(fig, path, dpi)
-    return Path(path)
+    return fig
 
 
 def _extent(polys: Sequence[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:

@@ -133,13 +133,7 @@ def solve(problem: Problem, x0: np.ndarray, *, fixed: np.ndarray | None = None,
     stop : called with ``x`` after each accepted step; stop (converged) when it returns True
         (a caller's own convergence test, e.g. the design's figures hold)
     """
-    if method not in ("lm", "gn", "guided"):
-        raise InputError(f"unknown method {method!r}; use 'lm', 'gn' or 'guided'")
-    x = np.array(x0, dtype=float)
-    if x.shape != (problem.layout.size,):
-        raise InputError(f"x0 has shape {x.shape}, the layout needs ({problem.layout.size},)")
-    if not np.all(np.isfinite(x)):
-        raise InputError("x0 has NaN or infinite entries; check the initial geometry")
+    x = _checked_start(problem, x0, method)
     free = _free_columns(len(x), fixed)
     lin = linear if isinstance(linear, LinearSolver) else shared_solver(linear)
     ne = NormalEquations()
@@ -163,29 +157,8 @@ def solve(problem: Problem, x0: np.ndarray, *, fixed: np.ndarray | None = None,
             message, converged, it = "gradient below tolerance", True, it - 1
             break
         JTJ = ne.update(J)
-        diag = ne.diagonal()
-        scale = float(np.mean(diag)) if diag.size and np.mean(diag) > 0 else 1.0
-        accepted = False
-        while True:
-            try:
-                dx = -lin.factor(ne.damped(lam * scale), ne.key)(g)
-            except NotPositiveDefinite:  # singular: raise damping
-                lam *= 10.0
-                if lam > 1e16:
-                    message = ("linear system singular at every damping (non-finite Jacobian "
-                               "entries: a term is not differentiable at the current point)")
-                    break
-                continue
-            x_new = x.copy()
-            x_new[free] += dx
-            a_new = problem.assemble(x_new)
-            E_new = a_new.energy()
-            if method != "lm":
-                accepted = np.isfinite(E_new)
-                break
-            accepted, lam, nu = lm_update(E, E_new, g, dx, JTJ, lam, nu)
-            if accepted or lam > 1e16:
-                break
+        accepted, singular, dx, x_new, a_new, E_new, lam, nu = _damped_step(
+            problem, x, free, g, JTJ, ne, lin, lam, nu, method, E)
         step = float(np.linalg.norm(dx)) if accepted else 0.0
         rec = {"it": it, "energy": E_new if accepted else E, "step": step, "lambda": lam,
                "accepted": accepted, "time": time.perf_counter() - t0}
@@ -197,24 +170,11 @@ def solve(problem: Problem, x0: np.ndarray, *, fixed: np.ndarray | None = None,
         if callback is not None:
             callback(rec)
         if not accepted:
-            if method == "lm":
-                message = message if "singular" in message else \
-                    "no step lowers the energy (local minimum or inconsistent terms)"
-                converged = bool(np.max(np.abs(g)) <= max(tol_grad, 1e-8 * max(E, 1e-300) ** 0.5))
-            elif "singular" not in message:
-                message = "energy became non-finite"
+            message, converged = _rejected(method, singular, g, tol_grad, E)
             break
-        if stop is not None and stop(x):
-            message, converged = "the caller's stop condition holds", True
-            break
-        if method == "lm" and 0 <= rel < tol_rel:
-            message, converged = "relative energy decrease below tolerance", True
-            break
-        if step <= tol_step * (np.linalg.norm(x) + tol_step):
-            message, converged = "step below tolerance", True
-            break
-        if time_limit is not None and time.perf_counter() - t0 > time_limit:
-            message = f"time limit of {time_limit:g} s reached"
+        why = _stopped(x, stop, method, rel, tol_rel, step, tol_step, time_limit, t0)
+        if why is not None:
+            message, converged = why
             break
     else:
         it = max_iter
@@ -222,3 +182,80 @@ def solve(problem: Problem, x0: np.ndarray, *, fixed: np.ndarray | None = None,
         message, converged = "energy below tolerance", True
     return SolveResult(x=x, converged=converged, message=message, iterations=it, energy=E,
                        energy0=E0, history=history, report=a.report())  # a is at x
+
+
+_SINGULAR = ("linear system singular at every damping (non-finite Jacobian entries: a term "
+             "is not differentiable at the current point)")
+
+
+def _checked_start(problem: Problem, x0: np.ndarray, method: str) -> np.ndarray:
+    """``x0`` as a float copy, checked: a known ``method``, the layout's size, finite."""
+    if method not in ("lm", "gn", "guided"):
+        raise InputError(f"unknown method {method!r}; use 'lm', 'gn' or 'guided'")
+    x = np.array(x0, dtype=float)
+    if x.shape != (problem.layout.size,):
+        raise InputError(f"x0 has shape {x.shape}, the layout needs ({problem.layout.size},)")
+    if not np.all(np.isfinite(x)):
+        raise InputError("x0 has NaN or infinite entries; check the initial geometry")
+    return x
+
+
+def _damped_step(problem: Problem, x: np.ndarray, free: np.ndarray, g: np.ndarray, JTJ,
+                 ne: NormalEquations, lin: LinearSolver, lam: float, nu: float, method: str,
+                 E: float):
+    """One step ``dx`` of ``(J^T J + lam s D) dx = -g`` (``s`` the mean of diag ``J^T J``)
+    from ``x`` over the ``free`` columns: the damping raised tenfold while the system is
+    singular; "lm" retries with :func:`lm_update`'s damping until the energy ``E`` falls,
+    the other methods take the first finite step. Returns ``(accepted, singular, dx,
+    x_new, a_new, E_new, lam, nu)``; ``singular`` when no damping up to 1e16 factors."""
+    diag = ne.diagonal()
+    scale = float(np.mean(diag)) if diag.size and np.mean(diag) > 0 else 1.0
+    accepted = singular = False
+    dx = x_new = a_new = E_new = None
+    while True:
+        try:
+            dx = -lin.factor(ne.damped(lam * scale), ne.key)(g)
+        except NotPositiveDefinite:  # singular: raise damping
+            lam *= 10.0
+            if lam > 1e16:
+                singular = True
+                break
+            continue
+        x_new = x.copy()
+        x_new[free] += dx
+        a_new = problem.assemble(x_new)
+        E_new = a_new.energy()
+        if method != "lm":
+            accepted = np.isfinite(E_new)
+            break
+        accepted, lam, nu = lm_update(E, E_new, g, dx, JTJ, lam, nu)
+        if accepted or lam > 1e16:
+            break
+    return accepted, singular, dx, x_new, a_new, E_new, lam, nu
+
+
+def _rejected(method: str, singular: bool, g: np.ndarray, tol_grad: float,
+              E: float) -> tuple[str, bool]:
+    """``(message, converged)`` when no step was taken: "lm" has converged when the gradient
+    ``g`` is small against the energy ``E``; a non-finite energy is never convergence."""
+    if method == "lm":
+        message = _SINGULAR if singular else \
+            "no step lowers the energy (local minimum or inconsistent terms)"
+        return message, bool(np.max(np.abs(g)) <= max(tol_grad, 1e-8 * max(E, 1e-300) ** 0.5))
+    return (_SINGULAR if singular else "energy became non-finite"), False
+
+
+def _stopped(x: np.ndarray, stop, method: str, rel: float, tol_rel: float, step: float,
+             tol_step: float, time_limit: float | None, t0: float) -> tuple[str, bool] | None:
+    """``(message, converged)`` after an accepted step when a stopping test holds (the
+    caller's ``stop``, the relative decrease ``rel`` for "lm", the step length, the time
+    limit in seconds since ``t0``), else None."""
+    if stop is not None and stop(x):
+        return "the caller's stop condition holds", True
+    if method == "lm" and 0 <= rel < tol_rel:
+        return "relative energy decrease below tolerance", True
+    if step <= tol_step * (np.linalg.norm(x) + tol_step):
+        return "step below tolerance", True
+    if time_limit is not None and time.perf_counter() - t0 > time_limit:
+        return f"time limit of {time_limit:g} s reached", False
+    return None

@@ -280,6 +280,59 @@ def _extremes(X: np.ndarray) -> np.ndarray:
     return out
 
 
+def _sample_fractions(lams: list, diag: float) -> tuple[list, list, list]:
+    """Axis samples by arc-length fraction, fixed over the states: per lamella its arc
+    lengths (metres), its sample fractions (one per ``_STEP * diag`` of length, 8 to
+    ``MAX_SAMPLES``) and its joints' fractions."""
+    arcs = [polyline_arclength(lam.axis) for lam in lams]
+    fracs, joint_fracs = [], []
+    for lam, s in zip(lams, arcs):
+        L = float(s[-1])
+        m = int(np.clip(np.ceil(L / (_STEP * diag)) + 1, 8, MAX_SAMPLES))
+        fracs.append(np.linspace(0.0, 1.0, m))
+        joint_fracs.append(np.clip(lam.joint_s / L, 0.0, 1.0) if L > 0 else lam.joint_s * 0)
+    return arcs, fracs, joint_fracs
+
+
+def _strip_meshes(P: np.ndarray, N: np.ndarray, lams: list, sizes: list[int], w: float,
+                  t: float, tangent: bool) -> tuple[np.ndarray, np.ndarray, list]:
+    """The strip solids (section ``w x t`` metres) on the axis samples ``P (K, T, 3)`` with
+    normals ``N``: vertices ``(K, 4 T, 3)`` per state, faces (the same in every state:
+    strip_solid's of each strip, one after the other) and per strip ``(v0, nv, f0, nf)``."""
+    if tangent:  # two layers, bolted at the joints: C1 on the outer side, C3 inside
+        side = np.repeat([0.5 * t if lam.family == 1 else -0.5 * t for lam in lams], sizes)
+        P = P + side[None, :, None] * N
+    K, T = P.shape[:2]
+    frames = packed_strip_frames(P.reshape(-1, 3), N.reshape(-1, 3), np.tile(sizes, K), tangent)
+    strip_V = _solids_vertices(frames[0], frames[3], frames[4], w, t).reshape(K, 4 * T, 3)
+    Fk, offsets, nv, nf, of_k = [], [], 0, 0, {}
+    for k in sizes:
+        SF = of_k[k] if k in of_k else of_k.setdefault(k, strip_solid_faces(k))
+        offsets.append((nv, 4 * k, nf, len(SF)))
+        Fk.append(SF + nv)
+        nv, nf = nv + 4 * k, nf + len(SF)
+    return strip_V, np.concatenate(Fk), offsets
+
+
+def _utilisation(structure: dict[int, np.ndarray], lams: list, arcs: list,
+                 fracs: list) -> tuple[np.ndarray, dict[int, float]]:
+    """structure.json's utilisation at every axis sample (NaN on a lamella it lacks), by
+    arc length (spread evenly when not one value per axis point), and each lamella's max."""
+    util, lam_util = [], {}
+    for lam, s, f in zip(lams, arcs, fracs):
+        u = structure.get(int(lam.id))
+        if u is None or not len(u):
+            util.append(np.full(len(f), np.nan))
+            continue
+        if len(u) == len(lam.axis):
+            uf = s / s[-1] if s[-1] > 0 else np.linspace(0, 1, len(u))
+        else:  # not one value per axis point: spread evenly
+            uf = np.linspace(0.0, 1.0, len(u))
+        util.append(np.interp(f, uf, u))
+        lam_util[int(lam.id)] = float(np.nanmax(u))
+    return np.concatenate(util), lam_util
+
+
 def build_scene(bundle_dir: str | os.PathLike) -> dict[str, Any]:
     """The viewer's scene of a design bundle directory (see the module docstring).
 
@@ -303,14 +356,7 @@ def build_scene(bundle_dir: str | os.PathLike) -> dict[str, Any]:
     allP = np.concatenate([lam.axis for lam in lams] + [V])
     diag = float(np.linalg.norm(allP.max(axis=0) - allP.min(axis=0))) or 1.0
 
-    # axis samples by arc-length fraction, fixed over the states
-    arcs = [polyline_arclength(lam.axis) for lam in lams]
-    fracs, joint_fracs = [], []
-    for lam, s in zip(lams, arcs):
-        L = float(s[-1])
-        m = int(np.clip(np.ceil(L / (_STEP * diag)) + 1, 8, MAX_SAMPLES))
-        fracs.append(np.linspace(0.0, 1.0, m))
-        joint_fracs.append(np.clip(lam.joint_s / L, 0.0, 1.0) if L > 0 else lam.joint_s * 0)
+    arcs, fracs, joint_fracs = _sample_fractions(lams, diag)
     n0 = nearest_vertex_normals(states[0], V, F)
     normals = joint_normals(states, net.loops, n0)
     sizes = [len(f) for f in fracs]
@@ -321,20 +367,7 @@ def build_scene(bundle_dir: str | os.PathLike) -> dict[str, Any]:
 
     P = _axis_samples(net, use, states, arcs, fracs)                      # (K, T, 3)
     N = _sample_normals(lams, sizes, P[0], normals, at_joints, joints, V, F)
-    if tangent:  # two layers, bolted at the joints: C1 on the outer side, C3 inside
-        side = np.repeat([0.5 * t if lam.family == 1 else -0.5 * t for lam in lams], sizes)
-        P = P + side[None, :, None] * N
-    K, T = P.shape[:2]
-    frames = packed_strip_frames(P.reshape(-1, 3), N.reshape(-1, 3), np.tile(sizes, K), tangent)
-    strip_V = _solids_vertices(frames[0], frames[3], frames[4], w, t).reshape(K, 4 * T, 3)
-    # the faces, the same in every state: strip_solid's of each strip, one after the other
-    Fk, offsets, nv, nf, of_k = [], [], 0, 0, {}
-    for k in sizes:
-        SF = of_k[k] if k in of_k else of_k.setdefault(k, strip_solid_faces(k))
-        offsets.append((nv, 4 * k, nf, len(SF)))
-        Fk.append(SF + nv)
-        nv, nf = nv + 4 * k, nf + len(SF)
-    strip_F = np.concatenate(Fk)
+    strip_V, strip_F, offsets = _strip_meshes(P, N, lams, sizes, w, t, tangent)
 
     loop_da, jda = joint_delta_a(states[0], net.loops)
     da = at_joints(jda[joints][:, None])[:, 0]
@@ -342,42 +375,22 @@ def build_scene(bundle_dir: str | os.PathLike) -> dict[str, Any]:
     structure = _structure(d)
     lam_util: dict[int, float] = {}
     if structure is not None:
-        util = []
-        for lam, s, f in zip(lams, arcs, fracs):
-            u = structure.get(int(lam.id))
-            if u is None or not len(u):
-                util.append(np.full(len(f), np.nan))
-                continue
-            if len(u) == len(lam.axis):
-                uf = s / s[-1] if s[-1] > 0 else np.linspace(0, 1, len(u))
-            else:  # not one value per axis point: spread evenly
-                uf = np.linspace(0.0, 1.0, len(u))
-            util.append(np.interp(f, uf, u))
-            lam_util[int(lam.id)] = float(np.nanmax(u))
-        scalars["utilisation"] = encode(np.concatenate(util), "f4")
+        util, lam_util = _utilisation(structure, lams, arcs, fracs)
+        scalars["utilisation"] = encode(util, "f4")
 
     Ftri = F if F.shape[1] == 3 else np.concatenate([F[:, [0, 1, 2]], F[:, [0, 2, 3]]])
     Ftri = Ftri[np.all(Ftri >= 0, axis=1)]
     lo, hi = allP.min(axis=0), allP.max(axis=0)
     lo_hi = _extremes(strip_V)
-    centres = (0.5 * (lo_hi[0] + lo_hi[1])).tolist()
     return {
         "format": "gridshell.viewer", "version": 1, "kind": b.kind, "units": "m",
-        "tangent": bool(tangent),
-        "section": {"width_m": w, "thickness_m": t, "width_mm": section.width_mm,
-                    "thickness_mm": section.thickness_mm, "scale": section.scale,
-                    "source": section.source, "text": section.text()},
+        "tangent": bool(tangent), "section": _section_json(section),
         "bbox": [lo.tolist(), hi.tolist()],
         "surface": {"V": encode(V, "f4"), "F": encode(Ftri, "u4"), "nv": len(V),
                     "nf": len(Ftri)},
         "strips": {"F": encode(strip_F, "u4"), "nv": int(len(strip_V[0])),
                    "nf": int(len(strip_F)), "V": [encode(X, "f4") for X in strip_V]},
-        "lamellae": [{"id": int(lam.id), "family": int(lam.family),
-                      "length": float(s[-1]), "samples": len(f),
-                      "v0": o[0], "nv": o[1], "f0": o[2], "nf": o[3],
-                      **({"max_utilisation": lam_util[int(lam.id)]}
-                         if int(lam.id) in lam_util else {})}
-                     for lam, s, f, o in zip(lams, arcs, fracs, offsets)],
+        "lamellae": _lamellae_json(lams, arcs, fracs, offsets, lam_util),
         "joints": {"n": int(len(net.joints)), "radius": min(0.6 * w, diag / 80.0),
                    "V": [encode(J, "f4") for J in states],
                    "delta_a": encode(jda, "f4")},
@@ -385,13 +398,32 @@ def build_scene(bundle_dir: str | os.PathLike) -> dict[str, Any]:
                   "F": encode(np.asarray(net.loops, np.int64).reshape(-1, 4), "u4"),
                   "delta_a": encode(loop_da, "f4")},
         "states": labels,
-        "centres": centres,
+        "centres": (0.5 * (lo_hi[0] + lo_hi[1])).tolist(),
         "scalars": scalars,
         "delta_a": {"mean": float(np.mean(loop_da)) if len(loop_da) else None,
                     "max": float(np.max(loop_da)) if len(loop_da) else None},
         "has_structure": structure is not None,
         "max_utilisation": max(lam_util.values()) if lam_util else None,
     }
+
+
+def _section_json(section) -> dict[str, Any]:
+    """The strip's section of the scene: metres, mm, scale, where it came from, its text."""
+    return {"width_m": section.width_m, "thickness_m": section.thickness_m,
+            "width_mm": section.width_mm, "thickness_mm": section.thickness_mm,
+            "scale": section.scale, "source": section.source, "text": section.text()}
+
+
+def _lamellae_json(lams: list, arcs: list, fracs: list, offsets: list,
+                   lam_util: dict[int, float]) -> list[dict[str, Any]]:
+    """One record per drawn lamella: id, family, length (metres), samples, its strip's
+    vertex and face ranges, and its max utilisation when structure.json gives one."""
+    return [{"id": int(lam.id), "family": int(lam.family),
+             "length": float(s[-1]), "samples": len(f),
+             "v0": o[0], "nv": o[1], "f0": o[2], "nf": o[3],
+             **({"max_utilisation": lam_util[int(lam.id)]}
+                if int(lam.id) in lam_util else {})}
+            for lam, s, f, o in zip(lams, arcs, fracs, offsets)]
 
 
 def scene_json(bundle_dir: str | os.PathLike) -> str:
