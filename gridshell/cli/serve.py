@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import argparse
+import sys
 from typing import Any
 
 HELP = ("start a Hops server with the Grasshopper components GG design, NCP design, verify and "
@@ -29,8 +30,9 @@ def run(args: Any) -> int:
         raise InputError(f"the Hops server needs {exc.name}; install it with "
                          "pip install 'gridshell[server]'") from None
     app = make_app(args.workdir)
-    if not args.quiet:
+    if not args.quiet:  # with --json stdout keeps its one JSON object, printed at the end
         print(f"gridshell Hops server on http://{args.host}:{args.port}/ (components: /gg, /ncp, "
-              f"/verify, /fabricate; bundles in {app.config['GRIDSHELL_WORKDIR']}); Ctrl+C stops")
+              f"/verify, /fabricate; bundles in {app.config['GRIDSHELL_WORKDIR']}); Ctrl+C stops",
+              file=sys.stderr if args.json else sys.stdout)
     app.run(host=args.host, port=args.port, debug=False)
     return 0
