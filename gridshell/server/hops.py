@@ -31,9 +31,11 @@ from gridshell.core.errors import GridshellError  # noqa: E402
 class GridshellHops(HopsFlask):
     """HopsFlask whose solve replies carry errors and warnings instead of failing."""
 
-    def __init__(self, flask_app, debug: bool = False):
+    def __init__(self, flask_app, debug: bool = False, guard=None):
         from ghhops_server import params
         from ghhops_server.logger import hlogger
+
+        self.guard = guard   # a gridshell.server.guard.Guard: solves one at a time
 
         hlogger.setLevel(logging.DEBUG if debug else logging.WARNING)
         params._init_rhino3dm()      # what ghhops_server.Hops() does before its middleware
@@ -84,7 +86,8 @@ class GridshellHops(HopsFlask):
         if not ok:
             return True, self._reply(comp, errors=[inputs])
         try:
-            result = comp.handler(*inputs)
+            with self.guard.serial() if self.guard is not None else contextlib.nullcontext():
+                result = comp.handler(*inputs)
         except GridshellError as exc:
             return True, self._reply(comp, errors=[str(exc)])
         except Exception as exc:   # noqa: BLE001 - never a dead component
