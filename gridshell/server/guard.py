@@ -49,7 +49,9 @@ def _split_host(value: str) -> tuple[str, int | None]:
     ``("::1", 5000)``); port None when absent; ValueError when malformed."""
     value = value.strip().lower()
     if value.startswith("["):
-        name, _, rest = value[1:].partition("]")
+        name, closed, rest = value[1:].partition("]")
+        if not closed:
+            raise ValueError(value)
         port = rest[1:] if rest.startswith(":") else ("" if not rest else None)
         if port is None:
             raise ValueError(value)
@@ -200,9 +202,9 @@ class Guard:
         return self._host_ok(name) and (self.port is None or port == self.port)
 
     def _too_big(self, size: int) -> str:
-        return (f"refused: the request body is {size / 2 ** 20:.1f} MB, over the server's "
-                f"limit of {self.max_body / 2 ** 20:.1f} MB; send a coarser mesh or start the "
-                "server with a larger --max-body")
+        return (f"refused: the request body is {_size(size)}, over the server's limit of "
+                f"{_size(self.max_body)}; send a coarser mesh or start the server with a "
+                "larger --max-body")
 
     @contextlib.contextmanager
     def serial(self) -> Iterator[None]:
@@ -215,6 +217,10 @@ class Guard:
             yield
         finally:
             self._lock.release()
+
+
+def _size(n: int) -> str:
+    return f"{n / 2 ** 20:.1f} MB" if n >= 2 ** 20 else f"{n} bytes"
 
 
 def _hops_reply(start_response: Callable, status: int, message: str) -> list[bytes]:
