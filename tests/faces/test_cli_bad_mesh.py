@@ -11,7 +11,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from tests.faces.test_hostile_inputs import GG, MESH_CASES, _UNCLEANED, _write_hostile, run_hostile
+
 from gridshell.cli.main import main
+from gridshell.geometry import meshfile
 
 N = 25  # a 25 x 25 grid: 625 vertices, as the report that found the bug had
 
@@ -41,8 +44,12 @@ def _bad_obj(tmp_path: Path, case: str) -> Path:
 CASES = ["no faces", "-99999", "99999", "626", "0"]
 
 
+@pytest.mark.parametrize("line_parser", [False, True], ids=["fast", "plain"])
 @pytest.mark.parametrize("case", CASES)
-def test_gg_of_a_bad_obj_is_exit_2_with_one_line(tmp_path, capsys, case):
+def test_gg_of_a_bad_obj_is_exit_2_with_one_line(tmp_path, capsys, monkeypatch, case,
+                                                 line_parser):
+    if line_parser:
+        monkeypatch.setattr(meshfile, "_parse_obj_fast", lambda data: None)
     path = _bad_obj(tmp_path, case)
     out = tmp_path / "out"
     got = main(["gg", str(path), "-o", str(out), "--grid", "6", "6", "--no-preview"])
@@ -66,3 +73,14 @@ def test_the_process_exits_2(tmp_path):
     lines = [ln for ln in run.stderr.splitlines() if ln.strip()]
     assert run.returncode == 2 and len(lines) == 1, run.stderr
     assert "BAD.obj" in lines[0] and "line 631" in lines[0], lines[0]
+
+
+@pytest.mark.parametrize("kind", MESH_CASES)
+def test_the_hostile_meshes_through_the_line_parser(tmp_path, capsys, monkeypatch, kind):
+    """The hostile-input suite's malformed OBJ files with the vectorized OBJ readers off:
+    the line parser gives the same categories and words."""
+    monkeypatch.setattr(meshfile, "_parse_obj_fast", lambda data: None)
+    src = tmp_path / "target.obj"
+    words = _write_hostile(src, kind)
+    run_hostile(capsys, tmp_path, ["gg", str(src), "-o", str(tmp_path / "out"), *GG,
+                                   *_UNCLEANED.get(kind, [])], 2, words + [src.name])

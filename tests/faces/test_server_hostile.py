@@ -320,3 +320,25 @@ def test_allow_adds_a_root_and_a_missing_one_is_named(server, tmp_path):
     assert not d.get("errors"), d
     with pytest.raises(InputError, match="--allow .*no such folder"):
         make_app(tmp_path / "w2", allow=(tmp_path / "missing",))
+
+
+@pytest.mark.parametrize("argv, code, word", [
+    (["--allow", "/no/such/folder"], 2, "--allow /no/such/folder: no such folder"),
+    (["--max-body", "0"], 2, "give a positive size"),
+    (["--max-body", "lots"], 2, "is not a size")])
+def test_serve_refuses_bad_confinement_options(capsys, tmp_path, argv, code, word):
+    from gridshell.cli.main import main
+
+    try:
+        got = main(["serve", "--workdir", str(tmp_path / "w"), *argv, "-q"])
+    except SystemExit as exc:     # argparse: a bad value
+        got = exc.code
+    err = capsys.readouterr().err
+    assert got == code and word in err and "Traceback" not in err, err
+
+
+def test_max_body_sizes():
+    from gridshell.cli.serve import _size
+
+    assert _size("64M") == 64 * 2 ** 20 and _size("1k") == 1024 and _size("5000") == 5000
+    assert _size("1.5GB") == int(1.5 * 2 ** 30)
