@@ -36,6 +36,7 @@ class _Watch(io.TextIOBase):
         self._line += s
         *done, self._line = self._line.split("\n")
         self.said = self.said or any(ln.startswith(self.prefix) for ln in done + [self._line])
+        self._line = self._line[:len(self.prefix)]   # a line's start is all the check needs
         return self.target.write(s) if self.target is not None else len(s)
 
     def text(self) -> str:

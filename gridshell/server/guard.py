@@ -201,8 +201,10 @@ class Guard:
         port = port or (443 if scheme.lower() == "https" else 80)
         return self._host_ok(name) and (self.port is None or port == self.port)
 
-    def _too_big(self, size: int) -> str:
-        return (f"refused: the request body is {_size(size)}, over the server's limit of "
+    def _too_big(self, size: int | None) -> str:
+        """The 413 message of a body of ``size`` bytes (None: unannounced, cut off)."""
+        said = f"is {_size(size)}" if size is not None else "runs on"
+        return (f"refused: the request body {said}, over the server's limit of "
                 f"{_size(self.max_body)}; send a coarser mesh or start the server with a "
                 "larger --max-body")
 
@@ -246,7 +248,7 @@ class GuardMiddleware:
                 "chunked" in environ.get("HTTP_TRANSFER_ENCODING", "").lower():
             body = environ["wsgi.input"].read(self.guard.max_body + 1)
             if len(body) > self.guard.max_body:
-                return _hops_reply(start_response, 413, self.guard._too_big(len(body)))
+                return _hops_reply(start_response, 413, self.guard._too_big(None))
             environ["wsgi.input"] = io.BytesIO(body)
             environ["CONTENT_LENGTH"] = str(len(body))
         return self.app(environ, start_response)
