@@ -3,7 +3,6 @@ from __future__ import annotations
 
 import argparse
 import importlib
-import json
 import os
 import sys
 
@@ -102,8 +101,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     2 bad input or no command, 3 no net, 4 not converged, 5 output refused or not writable,
     1 other tool error; argparse exits with 2 on an unknown option)."""
     argv = sys.argv[1:] if argv is None else list(argv)
+    from gridshell.cli.outcome import parse_or_explain, run_command
+
     parser = build_parser(_requested(argv))
-    args = parser.parse_args(argv)
+    args = parse_or_explain(lambda: parser.parse_args(argv), argv)
     if not getattr(args, "command", None):
         parser.print_help(sys.stderr)
         print(f"\ngridshell: error: give a command, one of {', '.join(SUBCOMMANDS)} "
@@ -112,19 +113,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     from gridshell.core.manifest import set_command
 
     set_command(args.command, ["gridshell", *argv])
-    try:
-        result = args._run(args)
-    except GridshellError as exc:
-        if getattr(args, "json", False):
-            print(json.dumps({"ok": False, "error": type(exc).__name__, "message": str(exc)}))
-        print(f"gridshell {args.command}: error: {exc}", file=sys.stderr)
-        return exc.exit_code
-    except KeyboardInterrupt:
-        print("interrupted", file=sys.stderr)
-        return 130
+    try:  # --json: one JSON object on stdout; -q: never without the error line
+        return run_command(args.command, lambda: args._run(args), bool(args.json))
     finally:
         set_command(None)
-    return int(result or 0)
 
 
 if __name__ == "__main__":  # pragma: no cover

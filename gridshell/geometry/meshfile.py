@@ -21,7 +21,7 @@ import os
 import re
 import warnings
 from pathlib import Path
-from typing import Sequence
+from typing import Callable, Sequence
 
 import numpy as np
 
@@ -68,6 +68,7 @@ def _parse_obj(path: Path, lines: list[str]) -> tuple[np.ndarray, list[list[int]
     verts: list[list[str]] = []
     faces: list[list[int]] = []
     polylines: list[list[int]] = []
+    where: list[str] = []  # each face's line, for messages
     known = {"vt", "vn", "vp", "o", "g", "s", "usemtl", "mtllib", "p", "#"}
     for lineno, raw in enumerate(lines, 1):
         t = raw.split()
@@ -82,8 +83,12 @@ def _parse_obj(path: Path, lines: list[str]) -> tuple[np.ndarray, list[list[int]
             elif tag in ("f", "l"):
                 idx = [int(s.split("/")[0]) for s in t[1:]]
                 nv = len(verts)
+                if tag == "f" and not idx:
+                    raise ValueError
                 idx = [i - 1 if i > 0 else nv + i for i in idx]  # negative = relative
                 (faces if tag == "f" else polylines).append(idx)
+                if tag == "f":
+                    where.append(f"line {lineno} ({raw.strip()[:40]!r})")
             elif tag not in known:
                 raise ValueError
         except ValueError:
@@ -92,7 +97,25 @@ def _parse_obj(path: Path, lines: list[str]) -> tuple[np.ndarray, list[list[int]
         V = np.array(verts, dtype=float).reshape(-1, 3)
     except ValueError:
         raise _corrupt(path, "a vertex record holds a non-number") from None
+    check_face_indices(path, faces, len(V), where.__getitem__)
     return V, faces, polylines
+
+
+def check_face_indices(path: Path, faces: list[list[int]] | np.ndarray, n_vertices: int,
+                       where: Callable[[int], str]) -> None:
+    """:class:`MeshError` naming the first of ``faces`` (0-based vertex indices, lists or an
+    ``(m,k)`` array) that refers to a vertex outside ``0 .. n_vertices - 1``: ``where(i)``
+    is the place of face ``i`` in the file (``"line 12 ('f 1 2 9')"``, ``"face record 3"``)."""
+    if isinstance(faces, np.ndarray):
+        bad = np.flatnonzero(((faces < 0) | (faces >= n_vertices)).any(axis=1)) \
+            if faces.size else np.zeros(0, np.int64)
+        first = int(bad[0]) if len(bad) else None
+    else:
+        first = next((i for i, f in enumerate(faces)
+                      if min(f) < 0 or max(f) >= n_vertices), None)
+    if first is not None:
+        raise _corrupt(path, f"{where(first)}: a face refers to a vertex outside 0 .. "
+                       f"{n_vertices - 1} (the file holds {n_vertices} vertices, counted from 0)")
 
 
 _OBJ_OTHER = re.compile(rb"^(?![ \t]*(?:v[ \t]|f[ \t]|vt[ \t]|vn[ \t]|#|o[ \t]|g[ \t]|s[ \t]|"
@@ -224,8 +247,9 @@ def _parse_polylines_regex(data: bytes) -> tuple[np.ndarray, list[np.ndarray]] |
 
 
 def _parse_off(path: Path, lines: list[str]) -> tuple[np.ndarray, list[list[int]]]:
-    body = [ln.split("#")[0].split() for ln in lines]
-    body = [t for t in body if t]
+    numbered = [(n, ln.split("#")[0].split()) for n, ln in enumerate(lines, 1)]
+    numbered = [(n, t) for n, t in numbered if t]
+    body = [t for _, t in numbered]
     if not body or not body[0][0].upper().endswith("OFF"):
         raise _corrupt(path, "no OFF header")
     head = body[0][1:] if len(body[0]) > 1 else (body[1] if len(body) > 1 else [])
@@ -234,6 +258,8 @@ def _parse_off(path: Path, lines: list[str]) -> tuple[np.ndarray, list[list[int]
         nv, nf = int(head[0]), int(head[1])
     except (IndexError, ValueError):
         raise _corrupt(path, "the OFF header has no vertex and face counts") from None
+    if nv < 0 or nf < 0:
+        raise _corrupt(path, f"the OFF header announces {nv} vertices and {nf} faces")
     if len(rest) < nv + nf:
         raise _corrupt(path, f"the header announces {nv} vertices and {nf} faces but the file "
                        f"holds {len(rest)} records")
@@ -242,11 +268,13 @@ def _parse_off(path: Path, lines: list[str]) -> tuple[np.ndarray, list[list[int]
         faces = []
         for r in rest[nv:nv + nf]:
             k = int(r[0])
-            if len(r) < k + 1:
+            if k < 1 or len(r) < k + 1:
                 raise ValueError
             faces.append([int(s) for s in r[1:k + 1]])
     except ValueError:
         raise _corrupt(path, "a vertex or face record is incomplete or not numeric") from None
+    first = len(numbered) - len(rest) + nv  # the first face record's place in ``numbered``
+    check_face_indices(path, faces, len(V), lambda i: f"line {numbered[first + i][0]}")
     return V, faces
 
 
@@ -257,14 +285,28 @@ _PLY_TYPES = {"char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1", "short":
 
 
 def _parse_ply(path: Path) -> tuple[np.ndarray, list[list[int]] | np.ndarray]:
-    data = path.read_bytes()
+    """Vertices and faces (0-based, checked against the vertices) of an ASCII or binary PLY."""
+    fmt, elements, body, line0 = _ply_header(path, path.read_bytes())
+    if fmt == "ascii":
+        V, faces, where = _ply_ascii(path, body, elements, line0)
+    else:
+        V, faces = _ply_binary(path, body, elements, "<" if fmt == "binary_little_endian" else ">")
+        where = lambda i: f"face record {i + 1}"  # noqa: E731
+    if V is not None:
+        check_face_indices(path, faces, len(V), where)
+    return V, faces
+
+
+def _ply_header(path: Path, data: bytes) -> tuple[str, list, bytes, int]:
+    """Format, elements ``[name, count, [(prop, type, list_type | None)]]``, the body's bytes
+    and the line number of its first line, of a PLY file's ``data``."""
     end = data.find(b"end_header")
     if not data.startswith(b"ply") or end < 0:
         raise _corrupt(path, "no complete PLY header")
     nl = data.find(b"\n", end)
     header = data[:end].decode("ascii", errors="replace").splitlines()
     body = data[nl + 1:] if nl >= 0 else b""
-    fmt, elements = None, []  # elements: [name, count, [(prop, type, list_types|None)]]
+    fmt, elements = None, []
     try:
         for ln in header[1:]:
             t = ln.split()
@@ -274,6 +316,8 @@ def _parse_ply(path: Path) -> tuple[np.ndarray, list[list[int]] | np.ndarray]:
                 fmt = t[1]
             elif t[0] == "element":
                 elements.append([t[1], int(t[2]), []])
+                if elements[-1][1] < 0:
+                    raise ValueError
             elif t[0] == "property":
                 if t[1] == "list":
                     elements[-1][2].append((t[4], _PLY_TYPES[t[3]], _PLY_TYPES[t[2]]))
@@ -286,32 +330,41 @@ def _parse_ply(path: Path) -> tuple[np.ndarray, list[list[int]] | np.ndarray]:
     names = [e[0] for e in elements]
     if "vertex" not in names or "face" not in names:
         raise _corrupt(path, "the PLY file has no vertex or no face element")
-    V = None
-    faces: list[list[int]] | np.ndarray = []
-    if fmt == "ascii":
-        rows = [ln.split() for ln in body.decode("ascii", errors="replace").splitlines()]
-        rows = [r for r in rows if r]
-        pos = 0
-        for name, count, props in elements:
-            chunk = rows[pos:pos + count]
-            if len(chunk) < count:
-                raise _corrupt(path, f"the {name} element announces {count} records, "
-                               f"found {len(chunk)}")
-            pos += count
-            try:
-                if name == "vertex":
-                    col = {p[0]: i for i, p in enumerate(props)}
-                    V = np.array([[r[col["x"]], r[col["y"]], r[col["z"]]] for r in chunk],
-                                 dtype=float).reshape(-1, 3)
-                elif name == "face":
-                    faces = [[int(s) for s in r[1:1 + int(r[0])]] for r in chunk]
-                    if any(len(f) != int(r[0]) for f, r in zip(faces, chunk)):
-                        raise ValueError
-            except (KeyError, ValueError, IndexError):
-                raise _corrupt(path, f"a {name} record is incomplete or not numeric") from None
-        return V, faces
-    bo = "<" if fmt == "binary_little_endian" else ">"
-    off = 0
+    return fmt, elements, body, len(header) + 2
+
+
+def _ply_ascii(path: Path, body: bytes, elements: list, line0: int
+               ) -> tuple[np.ndarray | None, list[list[int]], Callable[[int], str]]:
+    """Vertices, faces and the place of each face (``where(i)``, its line) of an ASCII PLY
+    body whose first line is line ``line0`` of the file."""
+    rows = [(n, ln.split()) for n, ln in
+            enumerate(body.decode("ascii", errors="replace").splitlines(), line0)]
+    rows = [(n, r) for n, r in rows if r]
+    V, faces, face_pos, pos = None, [], 0, 0
+    for name, count, props in elements:
+        chunk = [r for _, r in rows[pos:pos + count]]
+        if len(chunk) < count:
+            raise _corrupt(path, f"the {name} element announces {count} records, "
+                           f"found {len(chunk)}")
+        try:
+            if name == "vertex":
+                col = {p[0]: i for i, p in enumerate(props)}
+                V = np.array([[r[col["x"]], r[col["y"]], r[col["z"]]] for r in chunk],
+                             dtype=float).reshape(-1, 3)
+            elif name == "face":
+                faces, face_pos = [[int(s) for s in r[1:1 + int(r[0])]] for r in chunk], pos
+                if any(int(r[0]) < 1 or len(f) != int(r[0]) for f, r in zip(faces, chunk)):
+                    raise ValueError
+        except (KeyError, ValueError, IndexError):
+            raise _corrupt(path, f"a {name} record is incomplete or not numeric") from None
+        pos += count
+    return V, faces, lambda i: f"line {rows[face_pos + i][0]}"
+
+
+def _ply_binary(path: Path, body: bytes, elements: list, bo: str
+                ) -> tuple[np.ndarray | None, list[list[int]] | np.ndarray]:
+    """Vertices and faces of a binary PLY body of byte order ``bo`` (``"<"`` or ``">"``)."""
+    V, faces, off = None, [], 0
     for name, count, props in elements:
         if any(p[2] is not None for p in props):
             if name != "face" or len(props) != 1:
@@ -320,7 +373,10 @@ def _parse_ply(path: Path) -> tuple[np.ndarray, list[list[int]] | np.ndarray]:
             _, itype, ctype = props[0]
             faces, off = _ply_binary_lists(path, body, off, count, bo + ctype, bo + itype)
             continue
-        dt = np.dtype([(p[0], bo + p[1]) for p in props])
+        try:
+            dt = np.dtype([(p[0], bo + p[1]) for p in props])
+        except ValueError:  # two properties of one name
+            raise _corrupt(path, f"the PLY {name} element's properties are malformed") from None
         need = dt.itemsize * count
         if len(body) - off < need:
             raise _corrupt(path, f"the {name} element is cut short")
@@ -366,8 +422,8 @@ def _read_raw(path: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     ext = _check_readable(path)
     try:
         fast = _parse_obj_fast(path.read_bytes()) if ext == ".obj" else None
-        if fast is not None:
-            return fast
+        if fast is not None and fast[1].max() < len(fast[0]):
+            return fast  # else the line parser names the face's line
         if ext == ".obj":
             V, faces, _ = _parse_obj(path, _decode(path))
         elif ext == ".off":
@@ -391,17 +447,30 @@ def read_configuration(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray,
     file must still parse and hold at least one vertex (:class:`MeshError` otherwise);
     coordinates must be finite.
     """
-    V, P, sizes = read_polygons(path)
+    V, P, sizes = _polygons(Path(path))
     check_coordinates(V, Path(path).name)
     return V, P, sizes
+
+
+def _require_faces(path: Path, V: np.ndarray, P: np.ndarray) -> None:
+    """:class:`MeshError` for a mesh file of vertices only (a point cloud, or faces lost)."""
+    if len(P) == 0:
+        raise MeshError(f"{path.name}: the mesh is empty, {len(V)} vertices but no faces (no face "
+                        "record on any line); export the mesh with its faces, not as points")
 
 
 def read_polygons(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Vertices ``V (n,3)`` (finite, in the file's units), padded faces ``(m,k)`` (``-1``
     padded, indices checked) and face sizes ``(m,)`` of a mesh file: the file as it is, before
     unit conversion, cleaning and the geometry checks (:mod:`gridshell.io` reads user meshes
-    through it)."""
-    path = Path(path)
+    through it). A file of vertices only is a :class:`MeshError`."""
+    V, P, sizes = _polygons(Path(path))
+    _require_faces(Path(path), V, P)
+    return V, P, sizes
+
+
+def _polygons(path: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`read_polygons` without the faces required (a bundle's configurations)."""
     V, P, sizes = _read_raw(path)
     V = np.asarray(V, dtype=np.float64).reshape(-1, 3)
     if not np.all(np.isfinite(V)):
@@ -462,6 +531,7 @@ def read_mesh(path: str | os.PathLike, kind: str = "any",
         raise ValueError(f"kind must be 'any', 'quad' or 'tri', got {kind!r}")
     path = Path(path)
     V, P, sizes = _read_raw(path)
+    _require_faces(path, V, P)
     check_coordinates(V, path.name)
     validate_mesh(V, P, require_quads=kind == "quad", name=path.name,
                   manifold_vertices=manifold_vertices)

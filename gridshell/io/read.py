@@ -199,6 +199,13 @@ def _checked_mesh(V: np.ndarray, P: np.ndarray, sizes: np.ndarray, name: str,
     from gridshell.geometry.meshfile import _check_extent, check_coordinates
     from gridshell.geometry.quadmesh import check_face_areas, validate_mesh
 
+    bad = ~np.isfinite(V).all(axis=1)
+    if bad.any():   # a Rhino object's arrays come unchecked (a mesh file's were checked)
+        raise MeshError(f"{name}: {int(bad.sum())} vertices have NaN or infinite coordinates "
+                        f"(the first is vertex {int(np.flatnonzero(bad)[0])}); repair the mesh")
+    if len(P) == 0 or P.shape[1] == 0:
+        raise MeshError(f"{name}: the mesh is empty, {len(V)} vertices but no faces; give a "
+                        "mesh with its faces")
     check_coordinates(V, name)
     report = None
     if clean:

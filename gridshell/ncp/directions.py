@@ -487,8 +487,8 @@ def reference_net_check(surf: BSplineSurface, mode: str, samples: tuple[int, int
                         ) -> None:
     """Raise :class:`NoNetError` if no surface near ``surf`` can carry a net of ``mode``
     because ``surf`` itself has none anywhere: umbilic at every sample (a plane or sphere
-    patch: no principal directions), or, for ``aa``, ``K > 0`` at every sample (no asymptotic
-    directions). Uses only ``K`` and ``H``, so any parametrization of ``surf`` will do (e.g.
+    patch: no principal directions), or, for ``aa``, ``K < 0`` at fewer than
+    :data:`MAX_DROPPED` of the samples (asymptotic directions exist only there). Uses only ``K`` and ``H``, so any parametrization of ``surf`` will do (e.g.
     the initial fit of a reference mesh, before the PHLW step)."""
     u, v = uniform_params(surf, samples)
     g = grid_curvature(surf, u, v)
@@ -507,13 +507,31 @@ def reference_net_check(surf: BSplineSurface, mode: str, samples: tuple[int, int
             "curvatures (e.g. a saddle or a torus patch), or design a geodesic gridshell "
             "(gridshell gg)")
     flat = np.abs(K) <= UMBILIC_TOL * local * local
-    if mode == "aa" and np.all((K > 0) | flat):
+    if mode == "aa":
+        _aa_check(K, flat)
+
+
+def _aa_check(K: np.ndarray, flat: np.ndarray) -> None:
+    """:class:`NoNetError` unless ``K < 0`` (1/m^2; ``flat``: K = 0 within the tolerance) at
+    more than :data:`MAX_DROPPED` of the samples: asymptotic directions exist only there, and
+    a net may lack its directions on no more than that fraction (which the level-set fit
+    leaves out), so a reference with less has no AA net near it, before any PHLW work."""
+    neg, pos = (K < 0) & ~flat, (K > 0) & ~flat
+    if neg.mean() >= MAX_DROPPED:
+        return
+    if not neg.any():
         what = (f"K > 0 at all {K.size} samples (smallest K {float(K.min()):.4g} 1/m^2: it "
                 "bends like a dome)" if not flat.any() else
                 f"K > 0 at {int(np.sum(~flat))} and K = 0 at {int(flat.sum())} of {K.size} "
                 "samples (developable there: the two asymptotic directions coincide), K < 0 "
                 "nowhere")
-        raise NoNetError(
-            f"the reference has {what}, and asymptotic directions exist only where K < 0, so "
-            "no AA net (n = 0) exists on it or near it; use mode 'phlw' or 'cnc', or a reference "
-            "with K < 0 (e.g. a saddle)")
+    else:
+        what = (f"K < 0 at only {int(neg.sum())} of {K.size} samples ({100 * neg.mean():.2g} %,"
+                f" fewer than the {100 * MAX_DROPPED:g} % a net may lack its directions on; "
+                f"K > 0 at {int(pos.sum())}" + (f", up to {float(K.max()):.4g} 1/m^2" if
+                                                pos.any() else "")
+                + f", K = 0 at {int(flat.sum())})")
+    raise NoNetError(
+        f"the reference has {what}, and asymptotic directions exist only where K < 0, so "
+        "no AA net (n = 0) exists on it or near it; use mode 'phlw' or 'cnc', or a reference "
+        "with K < 0 (e.g. a saddle)")

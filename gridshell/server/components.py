@@ -22,7 +22,8 @@ the same object (:func:`gridshell.server.rhino.target_input`): double-precision 
 polygons kept, a NURBS surface the B-spline itself.
 
 Designs are written as bundles into the server's work directory; ``Bundle`` is the path that
-``/verify`` and ``/fabricate`` take. ``Options`` is a JSON object of further keywords of
+``/verify`` and ``/fabricate`` take, accepted inside that directory or a ``--allow`` folder
+only (:mod:`gridshell.server.guard`). ``Options`` is a JSON object of further keywords of
 :func:`gridshell.gg.pipeline.design_gg`, :func:`gridshell.ncp.pipeline.design_ncp` or
 :class:`fabrication.FabParams` (``{}`` for none). Metrics and reports are JSON text.
 
@@ -179,13 +180,14 @@ def analyze_component(new_dir: Callable[[str], Path], target: Any = None, sample
                  json.dumps(finite_json(a.as_dict()), default=_plain, allow_nan=False), str(out))
 
 
-def verify_component(bundle_dir: str) -> Reply:
+def verify_component(resolve: Callable[[Any], Path], bundle_dir: str) -> Reply:
     """The ``/verify`` component: OK, the pass / FAIL lines and the recomputed figures (JSON)
-    of the bundle at ``bundle_dir`` (:func:`gridshell.design.verification.design_verdict`)."""
+    of the bundle at ``bundle_dir`` (:func:`gridshell.design.verification.design_verdict`),
+    a folder ``resolve`` accepts (:meth:`gridshell.server.guard.Guard.bundle_dir`)."""
     from gridshell.design.bundle import finite_json
     from gridshell.design.verification import design_verdict
 
-    verdict = design_verdict(_bundle_path(bundle_dir))
+    verdict = design_verdict(resolve(bundle_dir))
     res = verdict.report
     warnings = [] if verdict.ok else ["the design fails its checks: " + "; ".join(
         [g.line() for g in verdict.gates if not g.ok] + list(verdict.problems))]
@@ -194,11 +196,13 @@ def verify_component(bundle_dir: str) -> Reply:
                  warnings=warnings)
 
 
-def fabricate_component(bundle_dir: str, scale: str | None = None, sheet: str = "600x400",
+def fabricate_component(resolve: Callable[[Any], Path], bundle_dir: str,
+                        scale: str | None = None, sheet: str = "600x400",
                         width: float | None = None, opts: str = "{}",
                         force: bool = False) -> Reply:
-    """The ``/fabricate`` component: the bundle's cut files (as ``gridshell fabricate``) and
-    its nested parts as curves, mm, the sheets laid out along x (:func:`_sheet_curves`)."""
+    """The ``/fabricate`` component: the cut files (as ``gridshell fabricate``) of the bundle
+    at ``bundle_dir``, a folder ``resolve`` accepts, and its nested parts as curves, mm, the
+    sheets laid out along x (:func:`_sheet_curves`)."""
     from dataclasses import fields
 
     from gridshell.design.section import resolve_section
@@ -207,7 +211,7 @@ def fabricate_component(bundle_dir: str, scale: str | None = None, sheet: str = 
 
     names = tuple(f.name for f in fields(FabParams) if f.name not in ("scale", "sheet", "width"))
     kw = options(opts, names, "Fabricate")
-    path = _bundle_path(bundle_dir)
+    path = resolve(bundle_dir)
     verdict = require_design(str(path), bool(force), "set Force to cut it anyway")
     strip = resolve_section(path, width=width, thickness=kw.pop("thickness", None),
                             scale=scale, stored=False)   # as 'gridshell fabricate'
@@ -350,10 +354,11 @@ def _fabricate_spec(hs) -> dict[str, Any]:
                  hs.HopsString("Folder", "D", "folder of the DXF / SVG files")])
 
 
-def register(hops, workdir: Path) -> None:
+def register(hops, workdir: Path, resolve: Callable[[Any], Path]) -> None:
     """Register the five components on ``hops`` (a ghhops_server Hops middleware); designs
-    go into new folders of ``workdir``. Each handler's parameters are its inputs in order
-    (Hops passes them so, a missing optional input as its default)."""
+    go into new folders of ``workdir``, bundles are taken where ``resolve`` accepts them.
+    Each handler's parameters are its inputs in order (Hops passes them so, a missing
+    optional input as its default)."""
     import ghhops_server as hs
 
     def new_dir(kind: str) -> Path:
@@ -373,34 +378,32 @@ def register(hops, workdir: Path) -> None:
 
     @hops.component(**_verify_spec(hs))
     def verify(bundle_dir):
-        return verify_component(bundle_dir)
+        return verify_component(resolve, bundle_dir)
 
     @hops.component(**_fabricate_spec(hs))
     def fab(bundle_dir, scale=None, sheet="600x400", width=None, opts="{}", force=False):
-        return fabricate_component(bundle_dir, scale, sheet, width, opts, force)
+        return fabricate_component(resolve, bundle_dir, scale, sheet, width, opts, force)
 
 
-def _bundle_path(text: str) -> Path:
-    path = Path(str(text or "").strip())
-    if not str(path) or not (path / "design.json").is_file():
-        raise InputError(f"{str(text)!r} is not a design bundle folder (no design.json); connect "
-                         "the Bundle output of a GG or NCP component")
-    return path
-
-
-def make_app(workdir: str | Path | None = None):
+def make_app(workdir: str | Path | None = None, *, allow: tuple = (), host: str = "127.0.0.1",
+             port: int | None = None, max_body: int | None = None):
     """The Flask app of the Hops server; designs go into ``workdir`` (default: a new
-    temporary folder)."""
+    temporary folder); bundles are read and written there and in the folders ``allow`` only,
+    requests answered when addressed to ``host`` (and ``port``, when given) and no larger than
+    ``max_body`` bytes (:mod:`gridshell.server.guard`)."""
     import tempfile
 
     from flask import Flask
 
+    from gridshell.server.guard import Guard, GuardMiddleware
     from gridshell.server.hops import GridshellHops
 
     wd = Path(workdir) if workdir else Path(tempfile.mkdtemp(prefix="gridshell-hops-"))
     wd.mkdir(parents=True, exist_ok=True)
+    guard = Guard.make(wd, allow, host=host, port=port, max_body=max_body)
     app = Flask("gridshell")
-    hops = GridshellHops(app)
-    register(hops, wd)
-    app.config["GRIDSHELL_WORKDIR"] = str(wd)
+    hops = GridshellHops(app, guard=guard)
+    register(hops, guard.roots[0], guard.bundle_dir)
+    app.wsgi_app = GuardMiddleware(app.wsgi_app, guard)
+    app.config.update(GRIDSHELL_WORKDIR=str(guard.roots[0]), GRIDSHELL_GUARD=guard)
     return app

@@ -31,9 +31,11 @@ from gridshell.core.errors import GridshellError  # noqa: E402
 class GridshellHops(HopsFlask):
     """HopsFlask whose solve replies carry errors and warnings instead of failing."""
 
-    def __init__(self, flask_app, debug: bool = False):
+    def __init__(self, flask_app, debug: bool = False, guard=None):
         from ghhops_server import params
         from ghhops_server.logger import hlogger
+
+        self.guard = guard   # a gridshell.server.guard.Guard: solves one at a time
 
         hlogger.setLevel(logging.DEBUG if debug else logging.WARNING)
         params._init_rhino3dm()      # what ghhops_server.Hops() does before its middleware
@@ -49,6 +51,20 @@ class GridshellHops(HopsFlask):
             body["warnings"] = list(warnings)
         return json.dumps(body, cls=_HopsEncoder)
 
+    def solve(self, uri, payload) -> tuple[bool, str]:
+        """ghhops-server's solve, with a body that is not a solve request (not JSON, nested
+        too deep, no ``pointer``) answered with a Hops error instead of a traceback."""
+        if uri == "/solve":
+            try:
+                data = json.loads(payload)
+                if not isinstance(data["pointer"], str):
+                    raise TypeError
+            except (ValueError, TypeError, KeyError, RecursionError):
+                return True, json.dumps({"values": [], "errors": [
+                    "the request is not a Hops solve request (a JSON object with 'pointer' and "
+                    "'values'); send it from a Hops component"]})
+        return super().solve(uri, payload)
+
     def _prepare_inputs(self, comp, payload) -> tuple[bool, Any]:
         """Inputs in the handler's order; a missing optional input takes its default."""
         import inspect
@@ -56,7 +72,7 @@ class GridshellHops(HopsFlask):
         try:
             data = json.loads(payload)
             given = {item["ParamName"]: item for item in data.get("values", [])}
-        except (ValueError, TypeError, KeyError, AttributeError):
+        except (ValueError, TypeError, KeyError, AttributeError, RecursionError):
             return False, "the request is not a Hops solve request (JSON with 'values')"
         inputs = []
         defaults = list(inspect.signature(comp.handler).parameters.values())
@@ -84,7 +100,8 @@ class GridshellHops(HopsFlask):
         if not ok:
             return True, self._reply(comp, errors=[inputs])
         try:
-            result = comp.handler(*inputs)
+            with self.guard.serial() if self.guard is not None else contextlib.nullcontext():
+                result = comp.handler(*inputs)
         except GridshellError as exc:
             return True, self._reply(comp, errors=[str(exc)])
         except Exception as exc:   # noqa: BLE001 - never a dead component

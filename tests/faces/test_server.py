@@ -3,6 +3,7 @@ request format; outputs checked against the Python API's results on the same inp
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -190,7 +191,7 @@ def test_fabricate_of_a_failing_design_is_refused_unless_forced(client, gg_solve
 
     _, _, out = gg_solved
     src = json.loads(out["Bundle"][0])
-    bad = tmp_path / "bad"
+    bad = Path(src).parent / f"bad-{tmp_path.name}"   # inside the server's work directory
     shutil.copytree(src, bad)
     d = json.loads((bad / "design.json").read_text())
     d["n_joints"] = d["n_joints"] + 1          # the files disagree with design.json
