@@ -149,42 +149,13 @@ def build_model(bundle, material: Material, section: Section, *,
     for li, lam in enumerate(net.lamellae):
         if len(lam.joints) == 0 or len(lam.axis) < 2:
             continue
-        A = lam.axis * scale
-        sA = polyline_arclength(A)
-        js = np.clip(lam.joint_s * scale, 0.0, sA[-1])
-        s_nodes, which = _node_arclengths(sA[-1], js, per_bay)
-        P = _interp_rows(s_nodes, sA, A)
-        jidx = lam.joints[which[which >= 0]]
-        P[which >= 0] = J[jidx]
-        nodes = np.empty(len(P), np.int64)
-        nodes[which >= 0] = jidx
+        s_nodes, which, P, nodes, seg = _lamella_nodes(lam, J, scale, n_nodes, per_bay)
         free = which < 0
-        nodes[free] = n_nodes + np.arange(int(free.sum()))
         n_nodes += int(free.sum())
         X.append(P[free])
-        seg = np.linalg.norm(np.diff(P, axis=0), axis=1)
-        if np.any(seg <= 1e-9 * max(sA[-1], 1e-300)):
-            raise InputError(f"lamella {lam.id}: two of its joints coincide; re-run the design")
-        # design frame: normals interpolated between the joints
-        jn = NJ[jidx]
-        Nn = rod.unit(_interp_rows(s_nodes, s_nodes[which >= 0], jn)) if len(jidx) > 1 \
-            else np.broadcast_to(jn[0], P.shape).copy()
-        T = rod.unit(np.diff(P, axis=0))
-        Ne = rod.unit(0.5 * (Nn[1:] + Nn[:-1]))
-        d1 = rod.unit(np.cross(Ne, T)) if tangent else Ne
-        a = rod.bishop_frame(P)
-        th = rod.frame_angle(a, T, d1)
-        # rest state: the strip as cut (gridshell.structure.cutshape, as fabrication cuts it)
+        d1, a, th = _design_frame(P, s_nodes, which, NJ[nodes[which >= 0]], tangent)
+        wbar, mbar = _rest_curvatures(bundle, lam, P, d1, s_nodes, seg, scale, shape, curve)
         k = len(P)
-        wbar, mbar = np.zeros((k - 2, 2)), np.zeros(k - 2)
-        if k >= 3 and shape != "line":
-            # a vertex's curvature belongs between its edges' midpoints
-            s_mid = 0.25 * (s_nodes[:-2] + 2 * s_nodes[1:-1] + s_nodes[2:])
-            kc = cut_curvature(bundle, lam, s_mid / scale, curve) / scale
-            wd, _ = rod.material_curvatures(P, d1)
-            lb = seg[:-1] + seg[1:]
-            w = 2.0 * np.tan(0.25 * kc * lb)
-            wbar[:, 0] = w if np.sum(w * wd[:, 0]) >= 0 else -w
         ne = k - 1
         rods.append(RodSpec(nodes, seg, np.full(ne, EA), np.full(ne, B1), np.full(ne, B2),
                             np.full(ne, GJ), wbar, mbar, np.full(ne, mass),
@@ -202,13 +173,89 @@ def build_model(bundle, material: Material, section: Section, *,
         raise InputError("the bundle has no lamella with joints; nothing to simulate")
     Xall = np.concatenate(X)
     theta_all, a1_all = np.concatenate(theta), np.concatenate(a1)
-    # joints: the director along the joint axis, signed like the net normal
-    all_T = rod.unit(Xall[np.concatenate([np.stack([r.nodes[:-1], r.nodes[1:]], 1)
-                                          for r in rods])][:, 1]
-                     - Xall[np.concatenate([np.stack([r.nodes[:-1], r.nodes[1:]], 1)
-                                            for r in rods])][:, 0])
     le = np.concatenate([r.lbar for r in rods])
     kJ = joint_factor * max(B1, B2, GJ, 1e-300) / float(np.median(le))
+    joints = _joint_specs(Xall, rods, theta_all, a1_all, joint_at, NJ, kJ)
+    network = RodNetwork(Xall, rods, theta_all, a1_all, joints=joints)
+    used = np.zeros(len(J), bool)
+    for r in rods:
+        used[r.nodes[r.nodes < len(J)]] = True
+    joint_node = np.where(used, np.arange(len(J)), -1)
+    sup = _supports(net, supports)
+    sup = sup[joint_node[sup] >= 0]
+    fixed = np.zeros(network.n, bool)
+    fixed[network.pos_dofs(sup).reshape(-1)] = True
+    network.fixed = fixed
+    if gravity:
+        network.forces[:, 2] -= GRAVITY * _lumped_mass(len(Xall), rods)
+    _check_supported(Xall, sup, len(J))
+    return DeployedModel(network, joint_node, sup, lam_nodes, lam_ids, scale, bundle.kind,
+                         rest, section, material, gravity,
+                         loops=net.loops.copy())
+
+
+def _lamella_nodes(lam, J: np.ndarray, scale: float, n_nodes: int, per_bay: int):
+    """A lamella's rod nodes on the model (metres): their arc lengths ``s_nodes``, the joint
+    position of each (``which``, -1 in between), positions ``P (k, 3)`` (the joints' own
+    where a joint lies), node indices (joints keep theirs, the others numbered on from
+    ``n_nodes``) and the edge lengths ``seg (k-1,)``; :class:`InputError` where two joints
+    coincide."""
+    A = lam.axis * scale
+    sA = polyline_arclength(A)
+    js = np.clip(lam.joint_s * scale, 0.0, sA[-1])
+    s_nodes, which = _node_arclengths(sA[-1], js, per_bay)
+    P = _interp_rows(s_nodes, sA, A)
+    jidx = lam.joints[which[which >= 0]]
+    P[which >= 0] = J[jidx]
+    nodes = np.empty(len(P), np.int64)
+    nodes[which >= 0] = jidx
+    free = which < 0
+    nodes[free] = n_nodes + np.arange(int(free.sum()))
+    seg = np.linalg.norm(np.diff(P, axis=0), axis=1)
+    if np.any(seg <= 1e-9 * max(sA[-1], 1e-300)):
+        raise InputError(f"lamella {lam.id}: two of its joints coincide; re-run the design")
+    return s_nodes, which, P, nodes, seg
+
+
+def _design_frame(P: np.ndarray, s_nodes: np.ndarray, which: np.ndarray, jn: np.ndarray,
+                  tangent: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The rod's material frame at the design: width direction ``d1`` per edge (``n x t``
+    when ``tangent``, else ``n``; ``n`` the joints' normals ``jn`` interpolated between the
+    joints by arc length), the Bishop frame's ``a`` and the angle ``theta`` from it to ``d1``."""
+    Nn = rod.unit(_interp_rows(s_nodes, s_nodes[which >= 0], jn)) if len(jn) > 1 \
+        else np.broadcast_to(jn[0], P.shape).copy()
+    T = rod.unit(np.diff(P, axis=0))
+    Ne = rod.unit(0.5 * (Nn[1:] + Nn[:-1]))
+    d1 = rod.unit(np.cross(Ne, T)) if tangent else Ne
+    a = rod.bishop_frame(P)
+    return d1, a, rod.frame_angle(a, T, d1)
+
+
+def _rest_curvatures(bundle, lam, P: np.ndarray, d1: np.ndarray, s_nodes: np.ndarray,
+                     seg: np.ndarray, scale: float, shape: str, curve) -> tuple[np.ndarray, np.ndarray]:
+    """Rest curvatures ``wbar (k-2, 2)`` and twists ``mbar (k-2,)`` of the rod: the strip as
+    cut (:mod:`gridshell.structure.cutshape`, as fabrication cuts it), strong-axis only,
+    signed like the design's (material curvatures about ``d1``)."""
+    k = len(P)
+    wbar, mbar = np.zeros((k - 2, 2)), np.zeros(k - 2)
+    if k >= 3 and shape != "line":
+        # a vertex's curvature belongs between its edges' midpoints
+        s_mid = 0.25 * (s_nodes[:-2] + 2 * s_nodes[1:-1] + s_nodes[2:])
+        kc = cut_curvature(bundle, lam, s_mid / scale, curve) / scale
+        wd, _ = rod.material_curvatures(P, d1)
+        lb = seg[:-1] + seg[1:]
+        w = 2.0 * np.tan(0.25 * kc * lb)
+        wbar[:, 0] = w if np.sum(w * wd[:, 0]) >= 0 else -w
+    return wbar, mbar
+
+
+def _joint_specs(Xall: np.ndarray, rods: list[RodSpec], theta_all: np.ndarray,
+                 a1_all: np.ndarray, joint_at: dict, NJ: np.ndarray, kJ: float) -> list[JointSpec]:
+    """The joints of crossing rods (``joint_at``: node -> its rods' edges before and after
+    it): each keeps the director along the joint axis, signed like the net normal ``NJ``,
+    common to its first rod and each other (stiffness ``kJ``)."""
+    ends = np.concatenate([np.stack([r.nodes[:-1], r.nodes[1:]], 1) for r in rods])
+    all_T = rod.unit(Xall[ends][:, 1] - Xall[ends][:, 0])
     joints = []
     for jn, refs in joint_at.items():
         if len(refs) < 2 or not np.any(NJ[jn]):
@@ -224,27 +271,17 @@ def build_model(bundle, material: Material, section: Section, *,
                     c[2 * side + q] = 0.5 * (1.0 if side == 0 else -1.0) * (frame @ NJ[jn])
                     edges.append(e)
             joints.append(JointSpec(np.asarray(edges), c, kJ))
-    network = RodNetwork(Xall, rods, theta_all, a1_all, joints=joints)
-    used = np.zeros(len(J), bool)
+    return joints
+
+
+def _lumped_mass(n: int, rods: list[RodSpec]) -> np.ndarray:
+    """Mass per node ``(n,)`` (kg): half of each element's mass at each of its ends."""
+    lump = np.zeros(n)
     for r in rods:
-        used[r.nodes[r.nodes < len(J)]] = True
-    joint_node = np.where(used, np.arange(len(J)), -1)
-    sup = _supports(net, supports)
-    sup = sup[joint_node[sup] >= 0]
-    fixed = np.zeros(network.n, bool)
-    fixed[network.pos_dofs(sup).reshape(-1)] = True
-    network.fixed = fixed
-    if gravity:
-        lump = np.zeros(len(Xall))
-        for r in rods:
-            half = 0.5 * r.mass * r.lbar
-            np.add.at(lump, r.nodes[:-1], half)
-            np.add.at(lump, r.nodes[1:], half)
-        network.forces[:, 2] -= GRAVITY * lump
-    _check_supported(Xall, sup, len(J))
-    return DeployedModel(network, joint_node, sup, lam_nodes, lam_ids, scale, bundle.kind,
-                         rest, section, material, gravity,
-                         loops=net.loops.copy())
+        half = 0.5 * r.mass * r.lbar
+        np.add.at(lump, r.nodes[:-1], half)
+        np.add.at(lump, r.nodes[1:], half)
+    return lump
 
 
 def _supports(net, supports) -> np.ndarray:
