@@ -121,15 +121,28 @@ def fabricate(bundle: str | Path | DesignBundle, out_dir: str | Path,
         placement (the rigid motion from strip coordinates, see :mod:`gridshell.fabrication.axis`, to
         the sheet; mm and degrees).
     """
-    # the writers (ezdxf, the previews, the cut list): only for writing, plan_parts does
-    # without them
-    from gridshell.fabrication.cutlist import cutlist_rows, write_cutlist
-    from gridshell.fabrication.dxf import write_sheet_dxf
-    from gridshell.fabrication.plan import write_plan
-    from gridshell.fabrication.preview import write_sheet_png
-    from gridshell.fabrication.svg import write_sheet_svg
-
     say = progress or (lambda msg: None)
+    bundle, bundle_dir, params = _fabrication_inputs(bundle, params, say)
+    out = Path(out_dir)
+    _check_out(out, bundle_dir)
+    parts, layout, info = plan_parts(bundle, params, say)
+    params = info["params"]  # joints engraved as marks where holes would merge
+    names = [f"sheet_{k + 1:02d}" for k in range(layout.n_sheets)]
+    report = _fabrication_report(bundle, parts, layout, info, params, names, plan)
+    say(f"writing {out}")
+    _write_fabrication(out, bundle, layout, params, names, report, plan, say)
+    report["out"] = str(out)
+    if keep_layout:
+        report["layout"] = layout
+    return report
+
+
+def _fabrication_inputs(bundle: str | Path | DesignBundle,
+                        params: FabParams | dict[str, Any] | None,
+                        say: Callable[[str], None]
+                        ) -> tuple[DesignBundle, Path | None, FabParams]:
+    """The bundle (read from its directory if a path), its directory (None for a bundle
+    object) and the parameters (defaults for None, a dict as FabParams fields)."""
     if params is None:
         params = FabParams()
     elif isinstance(params, dict):
@@ -139,21 +152,18 @@ def fabricate(bundle: str | Path | DesignBundle, out_dir: str | Path,
         bundle_dir = Path(bundle)
         say(f"reading {bundle_dir}")
         bundle = read_bundle(bundle_dir)
-    out = Path(out_dir)
-    _check_out(out, bundle_dir)
-    parts, layout, info = plan_parts(bundle, params, say)
-    params = info["params"]  # joints engraved as marks where holes would merge
+    return bundle, bundle_dir, params
+
+
+def _fabrication_report(bundle: DesignBundle, parts: list, layout: Any, info: dict[str, Any],
+                        params: FabParams, names: list[str], plan: bool) -> dict[str, Any]:
+    """fabrication.json's content: parameters, counts, utilisation, split lamellae, the files
+    and each piece's sheet and placement (mm, degrees)."""
     W, H = params.sheet
     area = sum(p.area for p in parts)
-    util = area / (layout.n_sheets * W * H)
-    per_sheet = [sum(p.area for p in layout.on_sheet(k)) / (W * H) for k in range(layout.n_sheets)]
-    names = [f"sheet_{k + 1:02d}" for k in range(layout.n_sheets)]
-    previews = [f"{n}.png" for n in names]
     files = [f"{n}{ext}" for n in names for ext in (".dxf", ".svg", ".png")]
     files += ["cutlist.csv"] + (["plan.png", "plan.svg"] if plan else []) + [REPORT, MANIFEST]
-    mm = params.mm_per_m
-    axis_lengths = {int(lam.id): lam.length * mm for lam in bundle.net.lamellae}
-    report = {
+    return {
         "kind": bundle.kind,
         "shape": info["strips"][0].axis.kind,
         "params": params.to_json(),
@@ -162,8 +172,9 @@ def fabricate(bundle: str | Path | DesignBundle, out_dir: str | Path,
         "n_sheets": layout.n_sheets,
         "n_joint_marks": int(sum(len(p.strip.joint_s) for p in parts)),
         "n_design_joints": int(sum(len(lam.joints) for lam in bundle.net.lamellae)),
-        "utilisation": util,
-        "utilisation_per_sheet": per_sheet,
+        "utilisation": area / (layout.n_sheets * W * H),
+        "utilisation_per_sheet": [sum(p.area for p in layout.on_sheet(k)) / (W * H)
+                                  for k in range(layout.n_sheets)],
         "material_used": layout.used(),
         "material_used_per_sheet": [layout.used(k) for k in range(layout.n_sheets)],
         "pieces_split": info["split"],
@@ -172,14 +183,30 @@ def fabricate(bundle: str | Path | DesignBundle, out_dir: str | Path,
         "radius_mm": info["strips"][0].axis.radius,
         "sheet_files": "one DXF and one SVG per sheet, and a PNG preview of each",
         "files": files,
-        "previews": previews,
+        "previews": [f"{n}.png" for n in names],
         "pieces": [{"lamella": p.strip.lamella, "piece": p.strip.piece,
                     "n_pieces": p.strip.n_pieces, "sheet": s + 1,
                     "flat_length_mm": p.strip.length, "s0": p.strip.s0,
                     "motion": p.motion.to_json()}
                    for p, s in zip(layout.parts, layout.sheet_of)],
     }
-    say(f"writing {out}")
+
+
+def _write_fabrication(out: Path, bundle: DesignBundle, layout: Any, params: FabParams,
+                       names: list[str], report: dict[str, Any], plan: bool,
+                       say: Callable[[str], None]) -> None:
+    """The sheets (DXF, SVG, PNG), the cut list, the plan and fabrication.json, written into
+    ``out`` atomically."""
+    # the writers (ezdxf, the previews, the cut list): only for writing, plan_parts does
+    # without them
+    from gridshell.fabrication.cutlist import cutlist_rows, write_cutlist
+    from gridshell.fabrication.dxf import write_sheet_dxf
+    from gridshell.fabrication.plan import write_plan
+    from gridshell.fabrication.preview import write_sheet_png
+    from gridshell.fabrication.svg import write_sheet_svg
+
+    W, H = params.sheet
+    axis_lengths = {int(lam.id): lam.length * params.mm_per_m for lam in bundle.net.lamellae}
     with atomic_dir(out, owner=OWNER, kind=f"fabrication of a {bundle.kind} design") as tmp:
         for k, name in enumerate(names):
             sp = layout.on_sheet(k)
@@ -198,10 +225,6 @@ def fabricate(bundle: str | Path | DesignBundle, out_dir: str | Path,
         (tmp / REPORT).write_text(json.dumps(finite_json(report), indent=1, allow_nan=False,
                                              default=_json_default),
                                   encoding="utf-8")
-    report["out"] = str(out)
-    if keep_layout:
-        report["layout"] = layout
-    return report
 
 
 def sheet_title(name: str, n_parts: int, params: FabParams) -> str:
