@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
-from typing import Callable
+from typing import Any, Callable
 
 import numpy as np
 import scipy.sparse as sp
@@ -48,6 +48,42 @@ def _factor_pd(A: sp.csc_matrix):
     return lu.solve
 
 
+def _shifted_factor(Hf: sp.csc_matrix, mu: float) -> tuple[Any, float]:
+    """A factorization of ``Hf + shift D`` (``D`` the Hessian's diagonal) that is positive
+    definite, the shift growing from ``mu`` tenfold (from 1e-8); ``(None, shift)`` if none."""
+    diag = np.abs(Hf.diagonal())
+    scale = float(np.mean(diag)) if diag.size and np.mean(diag) > 0 else 1.0
+    D = sp.diags(np.maximum(diag, 1e-12 * scale)).tocsc()
+    solve = None
+    shift = mu
+    for _ in range(60):
+        solve = _factor_pd((Hf + shift * D).tocsc() if shift > 0 else Hf)
+        if solve is not None:
+            break
+        shift = max(10.0 * shift, 1e-8)
+    return solve, shift
+
+
+def _line_search(fun: EnergyFn, q: np.ndarray, idx: np.ndarray, dq: np.ndarray, E: float,
+                 slope: float) -> tuple[np.ndarray, float, bool]:
+    """Backtracking (Armijo) along ``dq`` from ``q``: ``(q_new, alpha, taken)``."""
+    alpha = 1.0
+    qn = q
+    for _ in range(40):
+        qn = q.copy()
+        qn[idx] += alpha * dq
+        En = fun(qn, 0)[0]
+        if np.isfinite(En) and En <= E + 1e-4 * alpha * slope:
+            return qn, alpha, True
+        # near the minimum of a prestressed structure the decrease is below the energy's
+        # round-off: the full step of the (accurate) quadratic model is taken
+        if alpha == 1.0 and np.isfinite(En) and -slope <= 1e-11 * abs(E) \
+                and En <= E + 1e-11 * abs(E):
+            return qn, alpha, True
+        alpha *= 0.5
+    return qn, alpha, False
+
+
 def minimize(fun: EnergyFn, q0: np.ndarray, free: np.ndarray, *, gtol: float,
              etol: float = 1e-13, max_iter: int = 200,
              accept: Callable[[np.ndarray], None] | None = None,
@@ -75,17 +111,7 @@ def minimize(fun: EnergyFn, q0: np.ndarray, free: np.ndarray, *, gtol: float,
         if gmax <= gtol:
             message, converged, it = "gradient below tolerance", True, it - 1
             break
-        Hf = sp.csc_matrix(H[idx][:, idx])
-        diag = np.abs(Hf.diagonal())
-        scale = float(np.mean(diag)) if diag.size and np.mean(diag) > 0 else 1.0
-        D = sp.diags(np.maximum(diag, 1e-12 * scale)).tocsc()
-        solve = None
-        shift = mu
-        for _ in range(60):
-            solve = _factor_pd((Hf + shift * D).tocsc() if shift > 0 else Hf)
-            if solve is not None:
-                break
-            shift = max(10.0 * shift, 1e-8)
+        solve, shift = _shifted_factor(sp.csc_matrix(H[idx][:, idx]), mu)
         if solve is None:
             message = "no positive definite shift of the Hessian found"
             break
@@ -95,21 +121,7 @@ def minimize(fun: EnergyFn, q0: np.ndarray, free: np.ndarray, *, gtol: float,
             # Newton decrement: the energy is within etol of its minimum (relative)
             message, converged = "Newton decrement below tolerance", True
             break
-        alpha, taken = 1.0, False
-        for _ in range(40):
-            qn = q.copy()
-            qn[idx] += alpha * dq
-            En = fun(qn, 0)[0]
-            if np.isfinite(En) and En <= E + 1e-4 * alpha * slope:
-                taken = True
-                break
-            # near the minimum of a prestressed structure the decrease is below the energy's
-            # round-off: the full step of the (accurate) quadratic model is taken
-            if alpha == 1.0 and np.isfinite(En) and -slope <= 1e-11 * abs(E) \
-                    and En <= E + 1e-11 * abs(E):
-                taken = True
-                break
-            alpha *= 0.5
+        qn, alpha, taken = _line_search(fun, q, idx, dq, E, slope)
         if not taken:
             if shift > 0 and shift >= 1e6:
                 message = "line search failed (no descent along the Newton direction)"
