@@ -142,6 +142,19 @@ def safe_regions(materials: np.ndarray) -> np.ndarray:
     return shapely.buffer(materials, -SAFE_INSET, quad_segs=16)
 
 
+def _free_stretches(occupied: list[tuple[float, float]], strip: Strip
+                    ) -> list[tuple[float, float]]:
+    """The stretches ``(a, b)`` (mm along the strip) between the ``occupied`` ones and the
+    strip's ends (1 mm kept clear), longest first."""
+    occ = sorted(occupied + [(strip.s0 - 1, strip.s0 + 1.0), (strip.s1 - 1.0, strip.s1 + 1)])
+    free, end = [], occ[0][1]
+    for a, b in occ[1:]:
+        if a > end:
+            free.append((end, a))
+        end = max(end, b)
+    return sorted(free, key=lambda ab: ab[0] - ab[1])
+
+
 def strip_labels(strip: Strip, params: FabParams, material: Polygon,
                  safe: Polygon | None = None) -> tuple[list[np.ndarray], int]:
     """Engraving strokes of the strip: its name (``L12``, ``L12-1/2``) in the widest free
@@ -206,15 +219,8 @@ def strip_labels(strip: Strip, params: FabParams, material: Polygon,
             dropped += 1
     # the strip's name in the longest free stretch
     text = strip.name
-    occ = sorted(occupied + [(strip.s0 - 1, strip.s0 + 1.0), (strip.s1 - 1.0, strip.s1 + 1)])
-    free, end = [], occ[0][1]
-    for a, b in occ[1:]:
-        if a > end:
-            free.append((end, a))
-        end = max(end, b)
-    free.sort(key=lambda ab: ab[0] - ab[1])          # longest first
     placed = False
-    for a, b in free:
+    for a, b in _free_stretches(occupied, strip):
         if text_length(text, heights[-1]) > b - a:
             break                # too short at the smallest height, and so are the rest
         for h in heights:

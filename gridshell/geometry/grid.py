@@ -32,8 +32,33 @@ def grid_quads(rows: int, cols: int) -> np.ndarray:
     return np.stack([G[:-1, :-1], G[:-1, 1:], G[1:, 1:], G[1:, :-1]], axis=-1).reshape(-1, 4)
 
 
+def _halfedges(F: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The halfedges of quads ``F (m, 4)`` over ``n`` vertices: source and target vertex,
+    next halfedge in the face and the opposite halfedge (-1 on the boundary), each ``(4m,)``;
+    halfedge ``4f+c`` runs from corner ``c`` to ``c+1`` of face ``f``."""
+    m = len(F)
+    src = F.ravel()
+    dst = np.roll(F, -1, axis=1).ravel()
+    h = np.arange(4 * m)
+    nxt = h - h % 4 + (h + 1) % 4
+    # opposite halfedges by key matching
+    key = src * np.int64(n) + dst
+    order = np.argsort(key, kind="stable")
+    skey = key[order]
+    if np.any(skey[1:] == skey[:-1]):
+        raise _not_grid("an edge is used twice in the same direction (non-manifold or "
+                        "inconsistently oriented faces)")
+    rkey = dst * np.int64(n) + src
+    pos = np.minimum(np.searchsorted(skey, rkey), len(skey) - 1)
+    opp = np.where(skey[pos] == rkey, order[pos], -1)
+    return src, dst, nxt, opp
+
+
 def grid_from_quads(F: np.ndarray, n_vertices: int) -> np.ndarray:
     """Recover the vertex grid ``G (R, C)`` int64 of a quad mesh that is a regular grid.
+
+    Long because the walk and its checks (each a named refusal) read best in one place; the
+    halfedges are built by :func:`_halfedges`.
 
     Works on a halfedge structure of ``F`` (halfedge ``4f+c`` runs from corner ``c`` to
     ``c+1`` of face ``f``): from a corner vertex, base halfedges are propagated down the
@@ -62,20 +87,7 @@ def grid_from_quads(F: np.ndarray, n_vertices: int) -> np.ndarray:
     n, m = int(n_vertices), len(F)
     if F.min() < 0 or F.max() >= n:
         raise _not_grid("face indices are out of range")
-    src = F.ravel()
-    dst = np.roll(F, -1, axis=1).ravel()
-    h = np.arange(4 * m)
-    nxt = h - h % 4 + (h + 1) % 4
-    # opposite halfedges by key matching
-    key = src * np.int64(n) + dst
-    order = np.argsort(key, kind="stable")
-    skey = key[order]
-    if np.any(skey[1:] == skey[:-1]):
-        raise _not_grid("an edge is used twice in the same direction (non-manifold or "
-                        "inconsistently oriented faces)")
-    rkey = dst * np.int64(n) + src
-    pos = np.minimum(np.searchsorted(skey, rkey), len(skey) - 1)
-    opp = np.where(skey[pos] == rkey, order[pos], -1)
+    src, dst, nxt, opp = _halfedges(F, n)
 
     # valences: number of distinct neighbours over edges
     lo, hi = np.minimum(src, dst), np.maximum(src, dst)

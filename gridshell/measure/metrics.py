@@ -370,6 +370,21 @@ def smooth_grid_normals(P: np.ndarray, V: np.ndarray, F: np.ndarray) -> np.ndarr
     return N / np.maximum(np.linalg.norm(N, axis=1), 1e-300)[:, None]
 
 
+def _turning_integrals(a: np.ndarray, n: np.ndarray) -> tuple[float, float, float]:
+    """``(int |kg| ds, int |kappa| ds, max |kg|)`` of one axis ``a`` with its surface
+    normals ``n``: each interior vertex carries half of its two adjacent segments."""
+    from gridshell.geometry.diffgeo import normal_geodesic_curvature
+
+    kn, kg = normal_geodesic_curvature(a, n)
+    seg = np.linalg.norm(np.diff(a, axis=0), axis=1)
+    w = 0.5 * (seg[:-1] + seg[1:])
+    kg_i, kn_i = kg[1:-1], kn[1:-1]
+    ok = np.isfinite(kg_i) & np.isfinite(kn_i)
+    return (float(np.sum(np.abs(kg_i[ok]) * w[ok])),
+            float(np.sum(np.hypot(kg_i[ok], kn_i[ok]) * w[ok])),
+            float(np.abs(kg_i[ok]).max()) if ok.any() else 0.0)
+
+
 def geodesic_turning(net_or_axes: Net | Sequence[np.ndarray], V: np.ndarray,
                      F: np.ndarray, *, normals: str = "auto") -> dict[str, Any]:
     """How far lamella axes are from geodesics of a surface: ``int |kg| ds / int |kappa| ds``.
@@ -409,7 +424,6 @@ def geodesic_turning(net_or_axes: Net | Sequence[np.ndarray], V: np.ndarray,
         No axis with 3 points; an unknown ``normals``; ``normals="smooth"`` on a mesh that is
         not a structured quad grid.
     """
-    from gridshell.geometry.diffgeo import normal_geodesic_curvature
     from gridshell.geometry.igl_adapter import closest_points_with_normals
 
     if normals not in ("auto", "smooth", "mesh"):
@@ -434,23 +448,11 @@ def geodesic_turning(net_or_axes: Net | Sequence[np.ndarray], V: np.ndarray,
                              "GG bundle's surface.obj); pass normals='mesh' for other meshes")
         _, N = closest_points_with_normals(allP, V, F)
         used = "mesh"
-    kg_int = kappa_int = 0.0
-    kg_max = 0.0
-    start = 0
-    for a in clean:
-        n = N[start:start + len(a)]
-        start += len(a)
-        kn, kg = normal_geodesic_curvature(a, n)
-        seg = np.linalg.norm(np.diff(a, axis=0), axis=1)
-        w = np.zeros(len(a))
-        w[1:-1] = 0.5 * (seg[:-1] + seg[1:])
-        inner = slice(1, -1)
-        kg_i, kn_i, w_i = kg[inner], kn[inner], w[inner]
-        ok = np.isfinite(kg_i) & np.isfinite(kn_i)
-        kg_int += float(np.sum(np.abs(kg_i[ok]) * w_i[ok]))
-        kappa_int += float(np.sum(np.hypot(kg_i[ok], kn_i[ok]) * w_i[ok]))
-        if ok.any():
-            kg_max = max(kg_max, float(np.abs(kg_i[ok]).max()))
+    kg_int = kappa_int = kg_max = 0.0
+    cuts = np.cumsum([len(a) for a in clean])[:-1]
+    for a, n in zip(clean, np.split(N, cuts)):
+        gi, ki, mi = _turning_integrals(a, n)
+        kg_int, kappa_int, kg_max = kg_int + gi, kappa_int + ki, max(kg_max, mi)
     ratio = kg_int / kappa_int if kappa_int > 0 else 0.0
     return {"ratio": ratio, "kg_integral": kg_int, "kappa_integral": kappa_int, "kg_max": kg_max,
             "normals": used}
