@@ -48,6 +48,7 @@ def _failures(b: dict, tmp: Path) -> dict[str, tuple[list[str], int, str]]:
         "phlw": (["phlw", str(b["points"]), "-o", str(tmp / "o")], 2, "no faces"),
         "ncp": (["ncp", str(b["points"]), "-o", str(tmp / "o")], 2, "no faces"),
         "verify": (["verify", str(b["missing"])], 2, "aligned.obj"),
+        "analyze": (["analyze", str(b["points"]), "--no-files"], 2, "no faces"),
         "fabricate": (["fabricate", str(b["nowhere"]), "-o", str(tmp / "o")], 2, "nowhere"),
         "render": (["render", str(b["nowhere"])], 2, "nowhere"),
         "export": (["export", str(b["nowhere"])], 2, "nowhere"),
