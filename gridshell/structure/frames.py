@@ -178,3 +178,45 @@ def joint_curvatures(X: np.ndarray, s: np.ndarray, normals: np.ndarray) -> Darbo
     both[0], both[-1] = known[0] & known[1], known[-1] & known[-2]
     tg = np.where(both, -np.einsum("ij,ij->i", dN, U), 0.0)
     return DarbouxCurvatures(s, kn[where], kg[where], tg[where])
+
+
+#: lamella orientations (paper 3): tangent (GG, thickness along the surface normal) and
+#: orthogonal (AA, CNC, NCP, width along the surface normal)
+ORIENTATIONS = ("tangent", "orthogonal")
+
+
+@dataclass
+class AxisCurvatures:
+    """Curvatures of a strip about its section axes, one value per point (design units).
+
+    weak, strong : (k,) bending curvature about the weak / strong axis, 1/m, signed (an
+    orthogonal strip's ``strong`` is measured from its cut shape ``k_cut``);
+    twist : (k,) twist rate, rad/m.
+    """
+
+    weak: np.ndarray
+    strong: np.ndarray
+    twist: np.ndarray
+
+
+def axis_curvatures(dc: DarbouxCurvatures, orientation: str,
+                    k_cut: np.ndarray | float = 0.0) -> AxisCurvatures:
+    """The section-axis curvatures of a strip of ``orientation`` from the Darboux curvatures
+    ``dc`` of its axis (1/m): tangent: weak ``kn``, strong ``kg``, twist ``tau_g``; orthogonal:
+    weak ``kg``, strong ``kn - k_cut`` (``k_cut``: the in-plane curvature of the strip as cut,
+    1/m), twist ``tau_g`` (paper 3; table of :mod:`gridshell.structure.stresses`)."""
+    if orientation not in ORIENTATIONS:
+        raise InputError(f"orientation must be one of {', '.join(ORIENTATIONS)}, "
+                         f"got {orientation!r}")
+    if orientation == "tangent":
+        return AxisCurvatures(dc.kn, dc.kg, dc.tau_g)
+    return AxisCurvatures(dc.kg, dc.kn - np.asarray(k_cut, float), dc.tau_g)
+
+
+def strip_frame_curvatures(P: np.ndarray, normals: np.ndarray, orientation: str,
+                           k_cut: np.ndarray | float = 0.0) -> AxisCurvatures:
+    """Weak-axis, strong-axis curvature and twist (1/m, rad/m) of a strip whose axis is the
+    dense polyline ``P (k,3)`` (metres) with unit surface normals ``normals (k,3)``, from its
+    Darboux frame (:func:`darboux_curvatures`: ``kn``, ``kg``, ``tau_g = -<dN/ds, N x T>``,
+    do Carmo 3-2) assigned to the section axes by :func:`axis_curvatures`."""
+    return axis_curvatures(darboux_curvatures(P, normals), orientation, k_cut)

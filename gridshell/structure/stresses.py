@@ -30,12 +30,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gridshell.core.errors import InputError
-from gridshell.structure.frames import DarbouxCurvatures
+from gridshell.structure.frames import ORIENTATIONS, DarbouxCurvatures, axis_curvatures  # noqa: F401
 from gridshell.structure.materials import Material
 from gridshell.structure.section import Section, torsion_stress_factor
-
-ORIENTATIONS = ("tangent", "orthogonal")
 
 #: design kind -> lamella orientation (as gridshell.fabrication.strips.ORIENTATION)
 KIND_ORIENTATION = {"GG": "tangent", "AA": "orthogonal", "CNC": "orthogonal",
@@ -65,15 +62,9 @@ def strip_curvatures(dc: DarbouxCurvatures, orientation: str, section: Section,
     """The curvature changes of the real strip from the design's Darboux curvatures ``dc``
     (design units) for lamellae of ``orientation`` cut with in-plane curvature ``k_cut``
     (1/m of the design; orthogonal lamellae only), scaled to the model (module table)."""
-    if orientation not in ORIENTATIONS:
-        raise InputError(f"orientation must be one of {', '.join(ORIENTATIONS)}, "
-                         f"got {orientation!r}")
-    if orientation == "tangent":
-        weak, strong = dc.kn, dc.kg
-    else:
-        weak, strong = dc.kg, dc.kn - np.asarray(k_cut, float)
-    return StripCurvatures(section.strip_curvature(weak), section.strip_curvature(strong),
-                           section.strip_curvature(dc.tau_g))
+    a = axis_curvatures(dc, orientation, k_cut)
+    return StripCurvatures(section.strip_curvature(a.weak), section.strip_curvature(a.strong),
+                           section.strip_curvature(a.twist))
 
 
 @dataclass
