@@ -135,6 +135,19 @@ def joint_normals(V: np.ndarray, loops: np.ndarray) -> np.ndarray:
     return N
 
 
+def _spline_curvature(X: np.ndarray, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Unit tangents and curvature vectors ``(j,3)`` (1/m) at the joints ``X (j,3)`` of the
+    cubic spline (not-a-knot) ``X(s)`` through them at increasing arc lengths ``s (j,)``."""
+    from scipy.interpolate import CubicSpline
+
+    sp = CubicSpline(s, X, axis=0)   # not-a-knot: no artificial straight ends
+    d1, d2 = sp(s, 1), sp(s, 2)
+    sp1 = np.linalg.norm(d1, axis=1)
+    t = _unit_rows(d1)
+    kvec = (d2 - np.einsum("ij,ij->i", d2, t)[:, None] * t) / np.maximum(sp1 ** 2, 1e-300)[:, None]
+    return t, kvec
+
+
 def joint_curvatures(X: np.ndarray, s: np.ndarray, normals: np.ndarray) -> DarbouxCurvatures:
     """Curvatures of a lamella known by its joints only (a state of an alignment sequence).
 
@@ -146,23 +159,16 @@ def joint_curvatures(X: np.ndarray, s: np.ndarray, normals: np.ndarray) -> Darbo
     curvature is counted as ``kn`` and the twist as zero. Resolution: the joint spacing;
     NaN everywhere for fewer than 3 joints (not measurable).
     """
-    from scipy.interpolate import CubicSpline
-
     X = np.asarray(X, float).reshape(-1, 3)
     s = np.asarray(s, float).reshape(-1)
     j = len(X)
-    z = np.zeros(j)
     ok_s = np.concatenate([[True], np.diff(s) > 0]) if j else np.zeros(0, bool)
     if j < 3 or ok_s.sum() < 3:     # two joints tell nothing of the curvature
         z = np.full(j, np.nan)
         return DarbouxCurvatures(s, z, z.copy(), z.copy())
     where = np.cumsum(ok_s) - 1
     Xs, ss = X[ok_s], s[ok_s]
-    sp = CubicSpline(ss, Xs, axis=0)   # not-a-knot: no artificial straight ends
-    d1, d2 = sp(ss, 1), sp(ss, 2)
-    sp1 = np.linalg.norm(d1, axis=1)
-    t = _unit_rows(d1)
-    kvec = (d2 - np.einsum("ij,ij->i", d2, t)[:, None] * t) / np.maximum(sp1 ** 2, 1e-300)[:, None]
+    t, kvec = _spline_curvature(Xs, ss)
     N = np.asarray(normals, float).reshape(-1, 3)[ok_s]
     N = N - np.einsum("ij,ij->i", N, t)[:, None] * t
     known = np.linalg.norm(N, axis=1) > 1e-6

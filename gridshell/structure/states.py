@@ -23,7 +23,7 @@ import numpy as np
 
 from gridshell.design.bundle import DesignBundle
 from gridshell.structure.cutshape import collapse_curvature, cut_curvature, cut_shape
-from gridshell.structure.frames import joint_curvatures, joint_normals
+from gridshell.structure.frames import DarbouxCurvatures, joint_curvatures, joint_normals
 from gridshell.structure.materials import Material
 from gridshell.structure.section import Section
 from gridshell.structure.stresses import KIND_ORIENTATION, strip_curvatures, strip_stresses
@@ -31,6 +31,16 @@ from gridshell.structure.stresses import KIND_ORIENTATION, strip_curvatures, str
 METHOD = ("joints only: a cubic spline (not-a-knot) through each lamella's joints at the design's "
           "arc lengths; section normals from the joint mesh (NCP: the joint axes, deployed and "
           "collapsed as stored, interpolated between); resolution the joint spacing")
+
+#: the method for tangent (GG) strips
+METHOD_GG = ("joints only: a cubic spline (not-a-knot) through each lamella's joints at the "
+             "design's arc lengths; each lamella a geodesic of the state's surface (the GG "
+             "alignment keeps them so): strong-axis curvature 0 by construction, weak-axis "
+             "curvature the spline's whole curvature (its normal curvature on that surface), "
+             "twist from the joint mesh's normals; error bound: max_geodesic_residual_per_m, "
+             "the largest geodesic curvature the joint mesh implies (design units), the "
+             "strong-axis curvature if the stored state were the path; resolution the joint "
+             "spacing")
 
 _FRAME = re.compile(r"^frame_(\d+)\.obj$")
 
@@ -98,6 +108,26 @@ def _max_turn(X: np.ndarray) -> float:
     return float(np.degrees(np.arccos(c)).max())
 
 
+def _lamella_curvatures(lams, V: np.ndarray, normals: np.ndarray, orientation: str):
+    """The Darboux curvatures of every lamella of a state from its joints ``V (n,3)`` and the
+    joint normals ``normals (n,3)``, and the largest geodesic curvature (1/m) the joint mesh
+    implies. Tangent strips (GG): the alignment keeps each lamella a geodesic of the state's
+    surface, so ``kg = 0`` and the spline's whole curvature is normal curvature (the strip's
+    normal its principal normal, do Carmo 3-2), ``kn = sign(kn) hypot(kn, kg)``, the twist
+    ``tau_g`` from the joint normals; the residual ``max |kg|`` says how far the stored state
+    is from that. Orthogonal strips: as measured (residual 0)."""
+    dcs, resid = [], 0.0
+    for lam in lams:
+        dc = joint_curvatures(V[lam.joints], lam.joint_s, normals[lam.joints])
+        if orientation == "tangent" and np.all(np.isfinite(dc.kg)):
+            resid = max(resid, float(np.abs(dc.kg).max(initial=0.0)))
+            sign = np.where(dc.kn < 0, -1.0, 1.0)
+            dc = DarbouxCurvatures(dc.s, sign * np.hypot(dc.kn, dc.kg), np.zeros_like(dc.kg),
+                                   dc.tau_g)
+        dcs.append(dc)
+    return dcs, resid
+
+
 def state_record(bundle: DesignBundle, V: np.ndarray, normals: np.ndarray, section: Section,
                  material: Material, curve=None) -> dict[str, Any]:
     """Utilisation of every lamella in the state with joints ``V (n,3)`` and section normals
@@ -107,7 +137,7 @@ def state_record(bundle: DesignBundle, V: np.ndarray, normals: np.ndarray, secti
     lamella turns by more than :data:`FOLD_DEG` between joints (``max_turn_deg``)."""
     orientation = KIND_ORIENTATION[bundle.kind]
     lams = bundle.net.lamellae
-    dcs = [joint_curvatures(V[lam.joints], lam.joint_s, normals[lam.joints]) for lam in lams]
+    dcs, resid = _lamella_curvatures(lams, V, normals, orientation)
     k_cut = [np.zeros(len(lam.joints)) for lam in lams]
     sign = 1.0
     if orientation == "orthogonal":
@@ -135,7 +165,8 @@ def state_record(bundle: DesignBundle, V: np.ndarray, normals: np.ndarray, secti
     return {"max_utilisation": best[0], "worst_lamella": best[1], "worst_joint": best[2],
             "max_turn_deg": turn, "resolved": bool(turn <= FOLD_DEG),
             "max_weak_curvature_per_m": kw, "max_strong_curvature_per_m": ks,
-            "max_twist_rad_per_m": kt, "lamellae_max_utilisation": per}
+            "max_twist_rad_per_m": kt, "max_geodesic_residual_per_m": resid,
+            "lamellae_max_utilisation": per}
 
 
 def bundle_states(bundle: DesignBundle, path: Path | None, section: Section,
@@ -166,7 +197,8 @@ def bundle_states(bundle: DesignBundle, path: Path | None, section: Section,
         out.append({"name": name, "t": k / K, **rec})
     collapsed = out[-1]
     judged = [f["max_utilisation"] for f in out if f["resolved"]]
-    return {"method": METHOD, "fold_deg": FOLD_DEG, "frames": out,
+    method = METHOD_GG if KIND_ORIENTATION[bundle.kind] == "tangent" else METHOD
+    return {"method": method, "fold_deg": FOLD_DEG, "frames": out,
             "unresolved": [f["name"] for f in out if not f["resolved"]],
             "collapsed": {"name": collapsed["name"],
                           "max_utilisation": collapsed["max_utilisation"],
