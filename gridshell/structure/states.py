@@ -8,6 +8,10 @@ for NCP kinds, the joint axis, which is the strip's width direction: stored depl
 (``axes_r.npy``) and collapsed (``aligned_r.npy``), turned the fraction ``t`` of the way from
 one to the other in the intermediate states (:func:`slerp_axes`; the sequence's own axes are
 not stored).
+GG: each lamella is taken as a geodesic of the state's surface (the GG alignment keeps them
+so): the spline's whole curvature bends the strip about its weak axis, none about its strong
+axis, and the geodesic curvature the joint mesh would imply is reported as the error bound
+(``max_geodesic_residual_per_m``, :data:`METHOD_GG`).
 In a collapsed GG net every lamella lies on one line: no curvature, and the strips lie stacked
 untwisted. The resolution is the joint spacing, coarser than the dense axes of the deployed
 check; the deployed state is evaluated the same way (``frame_000``) so that the states compare
@@ -41,6 +45,9 @@ METHOD_GG = ("joints only: a cubic spline (not-a-knot) through each lamella's jo
              "the largest geodesic curvature the joint mesh implies (design units), the "
              "strong-axis curvature if the stored state were the path; resolution the joint "
              "spacing")
+
+#: the method of the states by strip orientation
+METHODS = {"tangent": METHOD_GG, "orthogonal": METHOD}
 
 _FRAME = re.compile(r"^frame_(\d+)\.obj$")
 
@@ -177,6 +184,7 @@ def bundle_states(bundle: DesignBundle, path: Path | None, section: Section,
     ``t`` (0 deployed, 1 collapsed); ``collapsed``; ``unresolved``: the names of the folded
     states (not judged); ``sequence_max_utilisation`` over the resolved ones."""
     n = len(bundle.net.joints)
+    METHOD = METHODS[KIND_ORIENTATION[bundle.kind]]     # noqa: N806 (this kind's method)
     loops = bundle.net.loops
     frames = _frames(path, n)
     named = [(f"frame_{k:03d}", V) for k, V in enumerate(frames)] if frames else \
@@ -197,8 +205,7 @@ def bundle_states(bundle: DesignBundle, path: Path | None, section: Section,
         out.append({"name": name, "t": k / K, **rec})
     collapsed = out[-1]
     judged = [f["max_utilisation"] for f in out if f["resolved"]]
-    method = METHOD_GG if KIND_ORIENTATION[bundle.kind] == "tangent" else METHOD
-    return {"method": method, "fold_deg": FOLD_DEG, "frames": out,
+    return {"method": METHOD, "fold_deg": FOLD_DEG, "frames": out,
             "unresolved": [f["name"] for f in out if not f["resolved"]],
             "collapsed": {"name": collapsed["name"],
                           "max_utilisation": collapsed["max_utilisation"],
