@@ -25,7 +25,7 @@ CHOLMOD_H := /usr/include/suitesparse/cholmod.h
 # a C++ compiler on PATH: $CXX if set, else the usual names
 HAVE_CXX  := { command -v "$${CXX:-c++}" || command -v g++ || command -v clang++; } >/dev/null 2>&1
 
-.PHONY: demo test bench clean venv browser
+.PHONY: demo test test-fast bench clean venv browser
 
 venv: $(STAMP)
 
@@ -76,7 +76,7 @@ $(STAMP): pyproject.toml
 demo: $(STAMP)
 	$(VENV)/bin/gridshell demo -o out/demo
 
-# The report viewer's browser test (tests/test_viewer.py) drives Debian's chromium headless. As
+# The report viewer's browser test (tests/render/test_viewer.py) drives Debian's chromium headless. As
 # root with apt-get, a missing chromium is installed quietly; otherwise that test is skipped and
 # says why.
 browser:
@@ -90,6 +90,10 @@ browser:
 
 test: $(STAMP) browser
 	$(PY) -m pytest -q
+
+# The edit loop: the suite without the tests marked slow or browser (pyproject.toml's markers).
+test-fast: $(STAMP)
+	$(PY) -m pytest -q -m "not slow and not browser"
 
 bench: $(STAMP)
 	$(PY) benchmarks/run_all.py

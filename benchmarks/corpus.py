@@ -50,6 +50,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from gridshell.corpus import MODES, Reference, select  # noqa: E402
+from gridshell.corpus.files import target_name  # noqa: E402
 from gridshell.measure.quality import design_gates, gate_summary, passed  # noqa: E402
 
 #: extra runs: the PHLW step alone (``--phlw``)
@@ -173,15 +174,18 @@ def run_one(ref: Reference, mode: str, work: Path, timeout: float,
     """One run of ``mode`` on ``ref`` in ``work``, with its checks; a JSON-able record."""
     d = work / ref.name
     d.mkdir(parents=True, exist_ok=True)
-    obj = d / "ref.obj"
-    if not obj.exists():
-        ref.write_obj(obj)
+    target = d / target_name(ref)
+    if not target.exists():
+        ref.write_target(d)
+    units = [] if ref.file_format == "3dm" else ["--units", ref.units]  # as a user passes it
     out = d / mode
     words = {**MODES, **PHLW_MODES}[mode]
     rec: dict[str, Any] = {"reference": ref.name, "family": ref.family, "mode": mode,
                            "mesh": f"{ref.mesh[0]}{ref.rows}x{ref.cols}", "size": ref.size,
-                           "curvature": ref.curvature, "expect_no_net": mode in ref.no_net}
-    res = _call([words[0], str(obj), "-o", str(out), "--json", *words[1:]], timeout)
+                           "curvature": ref.curvature, "expect_no_net": mode in ref.no_net,
+                           "tried": mode in ref.tried,
+                           "file": f"{ref.file_format} {ref.units}"}
+    res = _call([words[0], str(target), "-o", str(out), "--json", *units, *words[1:]], timeout)
     rec.update(code=res["code"], time=res["time"], message="", gates=[], verify_ok=None,
                verify_gates_ok=None, fabricate=None, energy_up=[], converged=None)
     if res["code"] is None:
@@ -277,7 +281,8 @@ def summary(records: list[dict[str, Any]]) -> str:
     out.append("\nSuccess (exit 0, every figure within the paper's thresholds, verify ok, "
                "fabricate exit 0):")
     for m in modes:
-        rs = [r for r in records if r["mode"] == m and not r["expect_no_net"]]
+        rs = [r for r in records if r["mode"] == m and not r["expect_no_net"]
+              and not r.get("tried")]
         if not rs:
             continue
         ok = sum(success(r) for r in rs)
@@ -293,6 +298,14 @@ def summary(records: list[dict[str, Any]]) -> str:
         out.append(f"  {m:10s} {ok:3d} / {len(rs):3d} = {ok / len(rs):6.1%}{goal_s}  "
                    f"({', '.join(f'{k}: {v}' for k, v in sorted(codes.items()))}; "
                    f"design and verify alone, without fabricate: {design})")
+    tried = [r for r in records if r.get("tried")]
+    if tried:
+        ok = sum(success(r) for r in tried)
+        refused = sum(r["code"] in (3, 4) and bool(r["message"]) for r in tried)
+        other = len(tried) - ok - refused
+        out.append(f"  runs a user would try where the surface does not admit the mode "
+                   f"(umbilic, K of both signs): {len(tried)}: {ok} succeed, {refused} refused "
+                   f"with a reason (exit 3/4), {other} otherwise (must be 0)")
     nn = [r for r in records if r["expect_no_net"]]
     if nn:
         good = sum(r["code"] == 3 for r in nn)
@@ -308,7 +321,8 @@ def summary(records: list[dict[str, Any]]) -> str:
         out.append(f"  {fam:18s} " + "  ".join(f"{c:>5s}" for c in cells))
     causes: dict[str, int] = {}
     for r in records:
-        if not success(r) and not (r["expect_no_net"] and r["code"] == 3):
+        if not success(r) and not (r["expect_no_net"] and r["code"] == 3) \
+                and not (r.get("tried") and r["code"] in (3, 4)):
             key = re.sub(r"[-+]?\d[\d.e+-]*", "#", r["message"] or f"exit {r['code']}")[:70]
             causes[f"{r['mode']}: {key}"] = causes.get(f"{r['mode']}: {key}", 0) + 1
     out.append("\nFailure causes (numbers replaced by #):")
@@ -373,7 +387,7 @@ def main(argv: list[str] | None = None) -> int:
         refs = refs[: args.limit]
     jobs: list[tuple[Reference, str]] = []
     for r in refs:
-        runs = list(r.modes) + (list(r.no_net) if args.no_net else [])
+        runs = list(r.modes) + list(r.tried) + (list(r.no_net) if args.no_net else [])
         if args.phlw or args.only == "phlw":
             runs += [f"phlw-{m.split('-')[1]}" for m in r.modes if m.startswith("ncp-")]
         if args.only:
@@ -385,8 +399,9 @@ def main(argv: list[str] | None = None) -> int:
         for r in refs:
             print(f"{r.name:22s} {r.mesh:4s} {r.rows:3d}x{r.cols:<3d} {r.size:6.2f} m "
                   f"{r.orientation:8s} {r.curvature:6s} revolution={r.revolution!s:5s} "
-                  f"runs: {' '.join(r.modes)}" + (f"  no-net: {' '.join(r.no_net)}"
-                                                  if r.no_net else ""))
+                  f"{r.file_format} {r.units:2s} runs: {' '.join(r.modes)}"
+                  + (f"  tried: {' '.join(r.tried)}" if r.tried else "")
+                  + (f"  no-net: {' '.join(r.no_net)}" if r.no_net else ""))
         print(f"{len(refs)} references, {len(jobs)} runs")
         return 0
     print(f"{len(refs)} references, {len(jobs)} runs, {args.jobs} at a time, "

@@ -8,6 +8,8 @@
     gs.write("out/gg", design)                  # the design bundle (same layout for every kind)
     gs.verify("out/gg")["ok"]                   # the figures recomputed from the files
     gs.fabricate("out/gg", "out/gg/fabrication", {"width": 20, "scale": "1:10"})
+    gs.check_structure("out/gg").ok             # the strips stay elastic (structure.json)
+    gs.simulate("out/gg").figures               # the elastic equilibrium (out/gg/equilibrium)
     gs.export_3dm("out/gg", "out/gg/gg.3dm")    # strips, holes, surface, cut sheets for Rhino
     gs.write_outputs("out/gg", report=True, rhino="out/gg/gg.3dm")  # render.png, report.html,
                                                 # and the .3dm built meanwhile (two cores)
@@ -19,43 +21,79 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any, Callable, Sequence
 
 from gridshell.design.bundle import Design, DesignBundle, read_bundle, write_bundle
 from gridshell.core.errors import InputError
 from gridshell.design.verification import require_design, verify_bundle
 
-__all__ = ["Design", "DesignBundle", "design_gg", "design_ncp", "export_3dm", "fabricate",
-           "optimize_phlw", "read", "verify", "write", "write_outputs"]
+__all__ = ["Design", "DesignBundle", "check_structure", "design_gg", "design_ncp", "export_3dm",
+           "fabricate", "optimize_phlw", "read", "simulate", "verify", "write", "write_outputs"]
 
 Progress = Callable[[str], None] | None
 
 
 # The pipelines are imported by the functions that run them (``gridshell gg`` loads neither
 # NCP nor PHLW: ~0.2 s of a command) and looked up at each call (a test or a plug-in
-# replacing gridshell.gg.pipeline.design_gg reaches the CLI and the API alike).
-def design_gg(*args: Any, **kwargs: Any) -> Design:
+# replacing gridshell.gg.pipeline.design_gg reaches the CLI and the API alike). Each function
+# spells out its pipeline's parameters (tests/test_api.py keeps names and defaults the same).
+def design_gg(target: Any, *, meridians: str = "cols", grid: tuple[int, int] | None = None,
+              direction: float | None = None, n_lamellae: int | None = 10,
+              spacing: float | None = None, crossing_angle: float = 90.0,
+              at_parallel: float = 0.5,
+              offsets: tuple[Sequence[float], Sequence[float]] | None = None,
+              weights: dict[str, float] | None = None, angle: float | None = None,
+              rounds: int = 10, polish_iter: int = 20, allow_unconverged: bool = False,
+              frames: int = 12, units: Any = None, clean: bool = True, obj: str | None = None,
+              progress: Progress = None) -> Design:
     """Design a geodesic (GG) gridshell on a target surface: ``(bundle, report)``;
     parameters and results of :func:`gridshell.gg.pipeline.design_gg`."""
     from gridshell.gg import pipeline
 
-    return pipeline.design_gg(*args, **kwargs)
+    return pipeline.design_gg(
+        target, meridians=meridians, grid=grid, direction=direction, n_lamellae=n_lamellae,
+        spacing=spacing, crossing_angle=crossing_angle, at_parallel=at_parallel,
+        offsets=offsets, weights=weights, angle=angle, rounds=rounds, polish_iter=polish_iter,
+        allow_unconverged=allow_unconverged, frames=frames, units=units, clean=clean, obj=obj,
+        progress=progress)
 
 
-def design_ncp(*args: Any, **kwargs: Any) -> Design:
+def design_ncp(source: Any, *, mode: str = "phlw", curves: int | tuple[int, int] | None = None,
+               spacing: float | None = None, n: float | None = None,
+               samples: tuple[int, int] = (48, 48), levelset_ctrl: tuple[int, int] = (12, 12),
+               levelset_degree: tuple[int, int] = (3, 3), omega_f: float = 0.01,
+               trace_grid: tuple[int, int] = (240, 240),
+               collapse_samples: tuple[int, int] = (1200, 1200),
+               postopt_weights: dict[str, float] | None = None, postopt_rounds: int = 3,
+               frames: int = 12, sim_weights: dict[str, float] | None = None,
+               surface_samples: tuple[int, int] = (100, 100), phlw_options: dict | None = None,
+               allow_unconverged: bool = False, strict: bool = False, units: Any = None,
+               clean: bool = True, obj: str | None = None, progress: Progress = None) -> Design:
     """Design an NCP gridshell (PHLW, CNC or AA) on a reference surface: ``(bundle,
     report)``; parameters and results of :func:`gridshell.ncp.pipeline.design_ncp`."""
     from gridshell.ncp import pipeline
 
-    return pipeline.design_ncp(*args, **kwargs)
+    return pipeline.design_ncp(
+        source, mode=mode, curves=curves, spacing=spacing, n=n, samples=samples,
+        levelset_ctrl=levelset_ctrl, levelset_degree=levelset_degree, omega_f=omega_f,
+        trace_grid=trace_grid, collapse_samples=collapse_samples,
+        postopt_weights=postopt_weights, postopt_rounds=postopt_rounds, frames=frames,
+        sim_weights=sim_weights, surface_samples=surface_samples, phlw_options=phlw_options,
+        allow_unconverged=allow_unconverged, strict=strict, units=units, clean=clean, obj=obj,
+        progress=progress)
 
 
-def optimize_phlw(*args: Any, **kwargs: Any) -> Any:
-    """The PHLW optimization of a B-spline surface (paper 4.2.1); parameters and result of
-    :func:`gridshell.ncp.phlw.optimize_phlw`."""
+def optimize_phlw(surf: Any, reference: Any, *, mode: str = "phlw",
+                  samples: tuple[int, int] = (18, 18), weights: dict[str, float] | None = None,
+                  outer: int = 4, max_iter: int = 40, check_samples: tuple[int, int] = (60, 60),
+                  early_stop: bool = True, progress: Progress = None) -> Any:
+    """The PHLW optimization of a B-spline surface (paper 4.2.1); parameters and result
+    (a PHLWResult) of :func:`gridshell.ncp.phlw.optimize_phlw`."""
     from gridshell.ncp import phlw
 
-    return phlw.optimize_phlw(*args, **kwargs)
+    return phlw.optimize_phlw(surf, reference, mode=mode, samples=samples, weights=weights,
+                              outer=outer, max_iter=max_iter, check_samples=check_samples,
+                              early_stop=early_stop, progress=progress)
 
 
 def _parts(design: Any, report: dict | None = None) -> tuple[DesignBundle, dict | None]:
@@ -134,22 +172,28 @@ def fabricate(design: Any, out_dir: str | os.PathLike, params: Any = None, *,
     return _fabricate(bundle, out_dir, params, progress=progress, plan=plan)
 
 
-def export_3dm(design: Any, path: str | os.PathLike, **options: Any) -> dict[str, Any]:
-    """Write a design (bundle directory, Design or DesignBundle) to a Rhino ``.3dm`` file
-    (:func:`gridshell.export.rhino.write_3dm`: strips of their real width and thickness,
-    holes, surface, collapsed state and cut sheets, in the input's unit); returns what was
-    written (``path``, ``units``, ``layers`` ...). ``options``: ``width``, ``thickness``,
-    ``hole``, ``scale``, ``sheet``, ``params``, ``units``, ``sheets``, ``force``, ``progress``."""
-    from gridshell.export.rhino import write_3dm
-
-    bundle = design if isinstance(design, (str, os.PathLike)) else _parts(design)[0]
-    return write_3dm(bundle, path, **options)
+#: the names the API takes from their modules as they are (the very functions, real signatures),
+#: imported on first use: name -> module
+_FROM = {"check_structure": "gridshell.workflow.structure",
+         "simulate": "gridshell.workflow.structure",
+         "export_3dm": "gridshell.export.rhino",
+         "write_outputs": "gridshell.workflow.outputs"}
 
 
-def write_outputs(bundle: str | os.PathLike, **options: Any) -> dict[str, Any]:
-    """render.png, alignment.gif, report.html and a .3dm of a bundle directory in one call
-    (``gridshell render``), the .3dm built in a second process meanwhile; options and result of
-    :func:`gridshell.workflow.outputs.write_outputs`."""
-    from gridshell.workflow.outputs import write_outputs as run
+def __getattr__(name: str) -> Any:
+    """The functions of :data:`_FROM`: ``check_structure`` (will the strips bend into the
+    design without breaking: structure.json, ``gridshell check``), ``simulate`` (the elastic
+    equilibrium, ``gridshell simulate``), ``export_3dm`` (the Rhino model, ``gridshell
+    export``) and ``write_outputs`` (render.png, alignment.gif, report.html and a .3dm in one
+    call, ``gridshell render``)."""
+    if name in _FROM:
+        import importlib
 
-    return run(bundle, **options)
+        fn = getattr(importlib.import_module(_FROM[name]), name)
+        globals()[name] = fn
+        return fn
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_FROM))

@@ -3,7 +3,7 @@
 #
 #     .venv/bin/python samples/make_meshes.py    # rewrites samples/*.obj, gridshell/data/*.obj
 #
-# Deterministic: running it again gives byte-identical files (tests/test_samples.py checks that
+# Deterministic: running it again gives byte-identical files (tests/architecture/test_samples.py checks that
 # the committed files are what this script makes). What each mesh is: samples/README.md.
 from __future__ import annotations
 
@@ -63,7 +63,7 @@ def helicoid(n: int = 25, c: float = 0.5) -> tuple[np.ndarray, np.ndarray]:
 def saddle(n: int = 20) -> tuple[np.ndarray, np.ndarray]:
     """Saddle ``z = 0.3 (x^2 - y^2)`` over [-1, 1]^2 as an ``n x n`` quad grid, rows along x.
 
-    The reference of ``tests/data/phlw_saddle_surface.json`` (``gridshell phlw saddle.obj
+    The reference of ``tests/helpers/data/phlw_saddle_surface.json`` (``gridshell phlw saddle.obj
     --mode phlw``): not PHLW itself, the PHLW step moves it to the nearest PHLW surface.
     """
     x, y = np.meshgrid(np.linspace(-1, 1, n), np.linspace(-1, 1, n), indexing="ij")

@@ -12,7 +12,6 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from pathlib import Path
 from typing import Any
 
 HELP = ("stresses the design imposes on its strips (bending about both axes, twist) for a "
@@ -55,44 +54,28 @@ def add_args(p: argparse.ArgumentParser) -> None:
                    help="lamellae listed in the table, most utilised first (default 12; 0: all)")
 
 
-def _fabrication_params(bundle: Path) -> dict[str, Any]:
-    """width, thickness and scale of the bundle's cut files, if it has them."""
-    f = bundle / "fabrication" / "fabrication.json"
-    try:
-        rep = json.loads(f.read_text(encoding="utf-8"))
-        p = rep.get("params", rep)
-        return {k: p[k] for k in ("width", "thickness", "scale") if k in p}
-    except (OSError, ValueError, AttributeError, TypeError):
-        return {}
-
-
-def section_and_material(args: Any):
-    """The :class:`Section` and :class:`Material` the options describe (SI inside)."""
-    from gridshell.fabrication.params import parse_scale
-
+def material_of(args: Any):
+    """The material the options describe: a preset name (None: the default) or, with values of
+    its own (``--E``, ``--allowable`` ...), a :class:`~gridshell.structure.materials.Material`."""
     from gridshell.core.errors import InputError
-    from gridshell.structure import Section, get_material, user_material
+    from gridshell.design.section import DEFAULTS
+    from gridshell.structure import get_material, user_material
 
-    fab = _fabrication_params(Path(args.bundle))
-    width = args.width if args.width is not None else fab.get("width", 20.0)
-    thickness = args.thickness if args.thickness is not None else fab.get("thickness", 1.0)
-    scale = parse_scale(args.scale if args.scale is not None else fab.get("scale", "1:10"))
-    for name, v in (("width", width), ("thickness", thickness)):
-        if not (isinstance(v, (int, float)) and v > 0 and v < float("inf")):
-            raise InputError(f"--{name} must be a positive length in mm, got {v}")
-    section = Section(float(width), float(thickness), scale)
-    own = args.material is None and args.E is not None
-    base = None if own else get_material(args.material or "pp")
     for name, v in (("E", args.E), ("G", args.G), ("allowable", args.allowable),
                     ("allowable-strain", args.allowable_strain), ("density", args.density)):
         if v is not None and not v > 0:
             raise InputError(f"--{name} must be positive, got {v}")
-    mat = user_material(
+    own = args.material is None and args.E is not None
+    changes = (args.E, args.G, args.nu, args.density, args.allowable, args.allowable_strain)
+    if not own and all(v is None for v in changes):
+        get_material(args.material or DEFAULTS["material"])  # an unknown name, before any work
+        return args.material
+    base = None if own else get_material(args.material or DEFAULTS["material"])
+    return user_material(
         base, E=None if args.E is None else args.E * 1e9,
         G=None if args.G is None else args.G * 1e9, nu=args.nu, density=args.density,
         allowable_stress=None if args.allowable is None else args.allowable * 1e6,
         allowable_strain=None if args.allowable_strain is None else args.allowable_strain / 100)
-    return section, mat
 
 
 def table(result: dict[str, Any], top: int = 12) -> list[str]:
@@ -129,26 +112,20 @@ def verdict_line(result: dict[str, Any]) -> str:
 
 
 def run(args: Any) -> int:
-    from gridshell.design.bundle import finite_json, read_bundle, read_design_json
+    from gridshell.api import check_structure
     from gridshell.core.errors import InputError
-    from gridshell.structure.check import check_bundle, write_structure_json
+    from gridshell.design.bundle import finite_json, read_design_json
     from gridshell.cli.common import Progress
 
     progress = Progress(args)
     if args.top < 0:
         raise InputError(f"--top must be >= 0, got {args.top}")
     read_design_json(args.bundle)
-    section, material = section_and_material(args)
-    bundle = read_bundle(args.bundle)
-    res = check_bundle(bundle, material, section, states=not args.no_states,
-                       bundle_dir=Path(args.bundle), progress=progress.callback)
-    out = write_structure_json(args.bundle, res)
-    picture = None
-    if not args.no_picture:
-        from gridshell.render.utilisation import PICTURE, render_utilisation
-
-        progress(f"drawing {PICTURE}")
-        picture = render_utilisation(bundle, res, Path(args.bundle) / PICTURE)
+    chk = check_structure(args.bundle, material=material_of(args), width=args.width,
+                          thickness=args.thickness, scale=args.scale,
+                          states=not args.no_states, picture=not args.no_picture,
+                          progress=progress.callback)
+    res, material, out, picture = chk.result, chk.material, chk.file, chk.picture
     code = 0 if res["verdict"] == "ok" else OVERSTRESSED
     if getattr(args, "json", False):
         summary = {k: v for k, v in res.items() if k not in ("lamellae", "states")}
@@ -161,8 +138,9 @@ def run(args: Any) -> int:
           f"{res['cut_shape']})")
     print(f"  material  {material.label}: E {material.E / 1e9:.3g} GPa, G {material.G / 1e9:.3g} "
           f"GPa, allowable {material.allowable / 1e6:.3g} MPa")
-    print(f"  section   {section.width_mm:g} x {section.thickness_mm:g} mm at "
-          f"{res['section']['scale_text']} (edge ratio {section.edge_ratio:.3g}:1)")
+    sec = res["section"]
+    print(f"  section   {sec['width_mm']:g} x {sec['thickness_mm']:g} mm at "
+          f"{sec['scale_text']} (edge ratio {sec['edge_ratio']:.3g}:1)")
     print("\n".join(table(res, args.top)))
     st = res["states"]
     if st:

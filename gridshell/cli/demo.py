@@ -94,17 +94,12 @@ def _finish(d: Path, label: str, name: str, fab_params: dict, progress) -> dict[
 
 def _structure(d: Path, label: str, fab_params: dict, progress) -> dict[str, Any]:
     """``gridshell check`` of the cut strips in polypropylene: structure.json and .png."""
-    from gridshell.fabrication.params import parse_scale
-
-    from gridshell.render.utilisation import PICTURE, render_utilisation
-    from gridshell.structure import Section, get_material
-    from gridshell.structure.check import check_bundle, write_structure_json
+    from gridshell.api import check_structure
+    from gridshell.render.utilisation import PICTURE
 
     progress(f"{label}: stresses in the strips (structure.json, {PICTURE})")
-    sec = Section(fab_params["width"], fab_params["thickness"], parse_scale(fab_params["scale"]))
-    res = check_bundle(d, get_material("pp"), sec)
-    write_structure_json(d, res)
-    render_utilisation(d, res, d / PICTURE)
+    res = check_structure(d, material="pp", width=fab_params["width"],
+                          thickness=fab_params["thickness"], scale=fab_params["scale"]).result
     return {k: res[k] for k in ("verdict", "max_utilisation", "max_utilisation_deployed",
                                 "governing_state", "max_elastic_thickness_mm")}
 

@@ -38,7 +38,7 @@ def add_args(p: argparse.ArgumentParser) -> None:
 def run(args: Any) -> int:
     from gridshell.core.atomic import check_output
     from gridshell.design.bundle import read_design_json
-    from gridshell.export.rhino import write_3dm
+    from gridshell.api import export_3dm
     from gridshell.cli.common import Progress, print_summary
 
     progress = Progress(args)
@@ -46,9 +46,9 @@ def run(args: Any) -> int:
     out = Path(args.output) if args.output else Path(args.bundle) / f"{design['kind'].lower()}.3dm"
     check_output(out, directory=False)
     progress(f"reading {args.bundle}")
-    info = write_3dm(args.bundle, out, width=args.width, thickness=args.thickness,
-                     hole=args.hole, scale=args.scale, sheet=args.sheet, units=args.units,
-                     sheets=not args.no_sheets, force=args.force, progress=progress.callback)
+    info = export_3dm(args.bundle, out, width=args.width, thickness=args.thickness,
+                      hole=args.hole, scale=args.scale, sheet=args.sheet, units=args.units,
+                      sheets=not args.no_sheets, force=args.force, progress=progress.callback)
     p = info["params"]
     u = info["units"]
     mpu = info["metres_per_unit"]

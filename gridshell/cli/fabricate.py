@@ -24,33 +24,38 @@ DXF_HELP = {"R2010": "AutoCAD 2010", "R12": "through ezdxf's R12 export"}
 
 def add_args(p: argparse.ArgumentParser) -> None:
     from gridshell.fabrication.params import AXIS_PLACES, DXF_VERSIONS, JOINT_STYLES, ROTATIONS, FabParams
+    from gridshell.design.section import DEFAULTS, scale_text
 
     add_bundle_arg(p)
     p.add_argument("-o", "--out", metavar="OUT",
                    help="output directory, replaced atomically (default DIR/fabrication)")
     g = p.add_argument_group("strips (mm of the model)")
-    g.add_argument("--width", type=float, default=20.0, help="strip width (default 20)")
-    g.add_argument("--thickness", type=float, default=1.0, help="sheet thickness (default 1)")
-    g.add_argument("--margin", type=float, default=15.0,
-                   help="strip length beyond the end joints (default 15)")
+    g.add_argument("--width", type=float, default=None,
+                   help=f"strip width (default {DEFAULTS['width']:g})")
+    g.add_argument("--thickness", type=float, default=None,
+                   help=f"sheet thickness (default {DEFAULTS['thickness']:g})")
+    g.add_argument("--margin", type=float, default=FabParams.margin,
+                   help=f"strip length beyond the end joints (default {FabParams.margin:g})")
     g.add_argument("--axis", choices=AXIS_PLACES, default=FabParams.axis,
                    help="place of the lamella axis on the strip: "
                         + choice_help(AXIS_HELP, AXIS_PLACES, FabParams.axis))
-    g.add_argument("--scale", default="1:10",
-                   help="model scale, e.g. 1:10 (default), 1:1 or 0.1")
+    g.add_argument("--scale", default=None,
+                   help=f"model scale, e.g. {scale_text(DEFAULTS['scale'])} (default), 1:1 or 0.1")
     g = p.add_argument_group("joints")
     g.add_argument("--joints", choices=JOINT_STYLES, default=None,
                    help=choice_help(JOINT_HELP, JOINT_STYLES, FabParams.joints) +
                    "; by default joints too close for holes at this scale are engraved as "
                    "marks (with a warning), an explicit --joints refuses them instead")
-    g.add_argument("--hole", type=float, default=3.0, help="hole diameter, mm (default 3)")
-    g.add_argument("--clearance", type=float, default=0.2,
-                   help="slot width = thickness + clearance, mm (default 0.2)")
+    g.add_argument("--hole", type=float, default=FabParams.hole,
+                   help=f"hole diameter, mm (default {FabParams.hole:g})")
+    g.add_argument("--clearance", type=float, default=FabParams.clearance,
+                   help=f"slot width = thickness + clearance, mm (default {FabParams.clearance:g})")
     g = p.add_argument_group("sheets and cutting")
-    g.add_argument("--sheet", default="600x400",
-                   help="sheet size WIDTHxHEIGHT mm (default 600x400)")
-    g.add_argument("--gap", type=float, default=2.0,
-                   help="gap between parts and to the sheet edges, mm (default 2)")
+    sheet = "x".join(f"{v:g}" for v in FabParams.sheet)
+    g.add_argument("--sheet", default=sheet,
+                   help=f"sheet size WIDTHxHEIGHT mm (default {sheet})")
+    g.add_argument("--gap", type=float, default=FabParams.gap,
+                   help=f"gap between parts and to the sheet edges, mm (default {FabParams.gap:g})")
     g.add_argument("--rotation", choices=ROTATIONS, default=FabParams.rotation,
                    help="how parts may turn on the sheet: free (any angle, isotropic sheets such "
                         "as polypropylene; default) or grain (along the sheet's long side, "
@@ -58,20 +63,21 @@ def add_args(p: argparse.ArgumentParser) -> None:
     g.add_argument("--overlap", type=float, default=None,
                    help="splice overlap of lamellae split to fit a sheet, mm (default: at a joint, "
                         "one joint spacing plus two margins, so the pieces share two joints; "
-                        "between joints, two widths plus two margins); every splice holds "
-                        "by two shared joints or two fasteners (one would be a hinge): a "
-                        "lamella no such splice cuts is refused")
-    g.add_argument("--kerf", type=float, default=0.0,
-                   help="laser kerf, mm: outlines move out and holes in by kerf/2 (default 0: off)")
+                         "between joints, two widths plus two margins); every splice holds "
+                         "by two shared joints or two fasteners (one would be a hinge): a "
+                         "lamella no such splice cuts is refused")
+    g.add_argument("--kerf", type=float, default=FabParams.kerf,
+                   help="laser kerf, mm: outlines move out and holes in by kerf/2 (default "
+                        f"{FabParams.kerf:g}: off)")
     g.add_argument("--dxf-version", choices=DXF_VERSIONS, default=FabParams.dxf_version,
                    help="DXF version: " + choice_help(DXF_HELP, DXF_VERSIONS,
                                                       FabParams.dxf_version))
     g.add_argument("--segments", action="store_true",
                    help="write arcs as short segments instead of bulges")
     g.add_argument("--no-labels", action="store_true", help="do not engrave ids")
-    p.add_argument("--material", default="pp", metavar="NAME",
+    p.add_argument("--material", default=None, metavar="NAME",
                    help="strip material for the stress warning (gridshell check's presets; "
-                        "default pp)")
+                        f"default {DEFAULTS['material']})")
     p.add_argument("--no-plan", action="store_true", help="do not draw plan.png / plan.svg")
     p.add_argument("--force", action="store_true",
                    help="cut a design whose recomputed figures miss the paper's thresholds, or "
@@ -79,14 +85,17 @@ def add_args(p: argparse.ArgumentParser) -> None:
                         "default: refused, exit 2)")
 
 
-def _structure_warning(bundle: str, params, material: str, progress) -> str | None:
+def _structure_warning(bundle: str, params, material: str | None, progress) -> str | None:
     """The warning of :func:`gridshell.structure.check.overstress_warning` for these strips
-    (deployed and collapsed states, the sequence too when the bundle has one)."""
-    from gridshell.structure import Section, get_material
-    from gridshell.structure.check import check_bundle, overstress_warning
+    (deployed and collapsed states, the sequence too when the bundle has one;
+    :func:`gridshell.api.check_structure`, nothing written)."""
+    from gridshell.api import check_structure
+    from gridshell.structure.check import overstress_warning
 
     progress("checking the strips' stresses")
-    res = check_bundle(bundle, get_material(material), Section.from_params(params))
+    res = check_structure(bundle, material=material, width=params.width,
+                          thickness=params.thickness, scale=params.scale, write=False,
+                          picture=False).result
     warning = overstress_warning(res)
     if warning:
         progress(f"warning: {warning}")
@@ -102,14 +111,19 @@ def run(args: Any) -> int:
     from gridshell.cli.common import Progress, print_summary
 
     progress = Progress(args)
+    from gridshell.design.section import resolve_section
     from gridshell.structure import get_material
 
-    get_material(args.material)  # an unknown name is refused before any work
-    params = FabParams(width=args.width, thickness=args.thickness, hole=args.hole,
+    # the caller's strip, else the defaults: fabricate writes the bundle's fabrication report
+    # and does not read a previous one back (a stale or broken one never blocks a new cut)
+    strip = resolve_section(args.bundle, width=args.width, thickness=args.thickness,
+                            scale=args.scale, material=args.material, stored=False)
+    get_material(strip.material)  # an unknown name is refused before any work
+    params = FabParams(width=strip.width_mm, thickness=strip.thickness_mm, hole=args.hole,
                        joints=args.joints or FabParams.joints,
                        fallback_marks=args.joints is None, clearance=args.clearance,
                        margin=args.margin,
-                       axis=args.axis, scale=args.scale, sheet=args.sheet, gap=args.gap,
+                       axis=args.axis, scale=strip.scale, sheet=args.sheet, gap=args.gap,
                        rotation=args.rotation, overlap=args.overlap, kerf=args.kerf,
                        dxf_version=args.dxf_version,
                        segments=args.segments, labels=not args.no_labels)
@@ -143,7 +157,7 @@ def run(args: Any) -> int:
                                   for d in rep["pieces_split"]) or "none",
         "files": ", ".join(rep["files"]),
     }
-    structure = _structure_warning(args.bundle, params, args.material, progress)
+    structure = _structure_warning(args.bundle, params, strip.material, progress)
     if structure:
         summary["warning (structure)"] = structure
     if rep["joints_fallback"]:

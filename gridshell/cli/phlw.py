@@ -94,7 +94,8 @@ def run(args: Any) -> int:
     from gridshell.core.atomic import check_output
     from gridshell.geometry.bspline import uniform_params
     from gridshell.core.errors import ConvergenceError
-    from gridshell.ncp.phlw import optimize_phlw, row_relation_residual, write_phlw
+    from gridshell.api import optimize_phlw
+    from gridshell.ncp.phlw import row_relation_residual, write_phlw
     from gridshell.ncp.phlw.gates import phlw_gates
     from gridshell.cli.common import Progress, input_line, print_gates
 

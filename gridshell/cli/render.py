@@ -42,7 +42,7 @@ def run(args: Any) -> int:
     from gridshell.core.atomic import check_output
     from gridshell.design.bundle import read_design_json
     from gridshell.core.errors import InputError
-    from gridshell.workflow.outputs import write_outputs
+    from gridshell.api import write_outputs
     from gridshell.render.sequence import sequence_files
     from gridshell.cli.common import Progress, print_summary
 

@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 from pathlib import Path
 from typing import Any
 
@@ -19,13 +18,13 @@ def add_args(p: argparse.ArgumentParser) -> None:
     add_bundle_arg(p)
     p.add_argument("-o", "--out", metavar="OUT",
                    help="output directory, replaced atomically (default DIR/equilibrium)")
-    g = p.add_argument_group("strip (as 'gridshell fabricate': mm of the model)")
-    g.add_argument("--material", default="pp",
+    g = p.add_argument_group("strip (mm of the model; default: DIR/fabrication's, else 20 x 1 "
+                             "pp at 1:10)")
+    g.add_argument("--material", default=None,
                    help=f"strip material: {', '.join(material_names())} (default pp)")
-    g.add_argument("--width", type=float, default=20.0, help="strip width, mm (default 20)")
-    g.add_argument("--thickness", type=float, default=1.0,
-                   help="strip thickness, mm (default 1)")
-    g.add_argument("--scale", default="1:10", help="model scale, e.g. 1:10 (default), 1:1 or 0.1")
+    g.add_argument("--width", type=float, default=None, help="strip width, mm")
+    g.add_argument("--thickness", type=float, default=None, help="strip thickness, mm")
+    g.add_argument("--scale", default=None, help="model scale, e.g. 1:10, 1:1 or 0.1")
     g = p.add_argument_group("model")
     g.add_argument("--supports", default="boundary",
                    help="joints held at their design positions: 'boundary' (default: the joints "
@@ -55,62 +54,24 @@ def parse_supports(text: str):
 
 
 def run(args: Any) -> int:
-    from gridshell.fabrication.params import parse_scale
-
-    from gridshell.core.atomic import atomic_dir, check_output
-    from gridshell.design.bundle import finite_json, read_bundle
-    from gridshell.core.errors import InputError
-    from gridshell.geometry.meshfile import write_mesh, write_polylines
-    from gridshell.render.equilibrium import render_equilibrium
-    from gridshell.structure.equilibrium import simulate
-    from gridshell.structure.materials import get_material
-    from gridshell.structure.section import Section
+    from gridshell.api import simulate
     from gridshell.cli.common import Progress, print_summary
 
     progress = Progress(args)
-    bundle_dir = Path(args.bundle)
-    b = read_bundle(bundle_dir)
-    out = Path(args.out) if args.out else bundle_dir / "equilibrium"
-    check_output(out)
-    if args.per_bay < 1 or args.max_iter < 1:
-        raise InputError("--per-bay and --max-iter must be at least 1")
-    material = get_material(args.material)
-    section = Section(args.width, args.thickness, parse_scale(args.scale))
-    supports = parse_supports(args.supports)
-    progress(f"equilibrium of {b.kind} {bundle_dir} in {args.width:g} x {args.thickness:g} mm "
-             f"{material.label} at {args.scale}")
-    eq = simulate(b, material, section, supports=supports, gravity=args.gravity,
-                  per_bay=args.per_bay, max_iter=args.max_iter, progress=progress)
-    fig = eq.figures
-    family = {lm.id: lm.family for lm in b.net.lamellae}
-    fams = [family[i] for i in eq.model.lamella_ids]
-    record = {
-        "format": "gridshell.equilibrium", "version": 1,
-        "units": {"positions": "m of the design", "reactions": "N on the model",
-                  "energy": "J on the model", "deviation": "% of the design's bbox diagonal"},
-        "figures": fig,
-        "material": material.to_json(), "section": section.to_json(),
-        "supports": eq.supports.tolist(), "reactions_N": eq.reactions.tolist(),
-        "deviation_pct": eq.deviation.tolist(),
-        "stresses": eq.stresses,
-        "newton": eq.result.history,
-    }
-    progress(f"writing {out}")
-    with atomic_dir(out, owner="simulate", kind="elastic equilibrium") as tmp:
-        if len(b.net.loops):
-            write_mesh(tmp / "equilibrium.obj", eq.joints, b.net.loops)
-        write_polylines(tmp / "axes.obj", eq.axes)
-        (tmp / "equilibrium.json").write_text(
-            json.dumps(finite_json(record), indent=1, allow_nan=False), encoding="utf-8")
-        title = (f"{b.kind} equilibrium, {args.width:g} x {args.thickness:g} mm "
-                 f"{material.name} at {args.scale}: deviation max "
-                 f"{fig['deviation_max_pct']:.3g} % of diagonal, peak utilisation "
-                 f"{fig['utilisation_peak']:.2f}")
-        render_equilibrium(tmp / "equilibrium.png", eq.axes0, eq.axes, fams, b.net.joints,
-                           eq.joints, eq.deviation, eq.supports, title=title)
+    sim = simulate(args.bundle, args.out, material=args.material, width=args.width,
+                   thickness=args.thickness, scale=args.scale,
+                   supports=parse_supports(args.supports), gravity=args.gravity,
+                   per_bay=args.per_bay, max_iter=args.max_iter, progress=progress)
+    print_summary(args, "Simulate", summary(args, sim))
+    return 0
+
+
+def summary(args: Any, sim: Any) -> dict[str, Any]:
+    """The printed summary of a :class:`gridshell.workflow.structure.Simulation`."""
+    fig = sim.figures
     summary = {
-        "bundle": str(bundle_dir), "kind": b.kind, "strip": fig["section"],
-        "material": material.label, "rest state": fig["rest state"],
+        "bundle": str(Path(args.bundle)), "kind": sim.bundle.kind, "strip": fig["section"],
+        "material": sim.material.label, "rest state": fig["rest state"],
         "gravity": fig["gravity"], "rod model": fig["rod model"],
         "supports": f"{fig['supports']} joints held",
         "newton": fig["newton"],
@@ -127,9 +88,8 @@ def run(args: Any) -> int:
                        f"tau {fig['tau_peak_MPa']:.3g} MPa), {fig['utilisation_design']:.3g} "
                        "in the design shape",
         "time": f"{fig['wall_s']:.1f} s wall, {fig['cpu_s']:.1f} s CPU",
-        "output": str(out),
+        "output": str(sim.out),
     }
     if getattr(args, "json", False):
         summary = {**summary, "figures": fig}
-    print_summary(args, "Simulate", summary)
-    return 0
+    return summary

@@ -14,7 +14,7 @@ import sys
 from typing import Any
 
 from gridshell.design.bundle import finite_json
-from gridshell.design.verification import exit_code, verify_bundle
+from gridshell.design.verification import exit_code
 
 HELP = ("recompute the figures of a design bundle from its files, check them against the paper's "
         "thresholds and print JSON (exit 0 ok, 2 incomplete or inconsistent bundle, 4 a figure "
@@ -28,7 +28,9 @@ def add_args(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: Any) -> int:
-    res = verify_bundle(args.bundle)
+    from gridshell.api import verify
+
+    res = verify(args.bundle)
     if not args.per_loop:
         res.pop("per_loop")
     ok = res.pop("ok")

@@ -65,6 +65,7 @@ MOVED: dict[str, str] = {
     "gridshell.quadmesh": "gridshell.geometry.quadmesh",
     "gridshell.quality": "gridshell.measure.quality",
     "gridshell.recent": "gridshell.core.recent",
+    "gridshell.render.section": "gridshell.design.section",
     "gridshell.render.states": "gridshell.render.state_sheet",
     "gridshell.render.structure": "gridshell.render.utilisation",
     "gridshell.spline_batch": "gridshell.geometry.spline_batch",

@@ -22,10 +22,17 @@ from gridshell.corpus.surfaces import FAMILIES, Shape
 __all__ = ["COUNTS", "FAST", "MODES", "REFERENCES", "Reference", "build_reference", "get",
            "names", "select"]
 
-#: references per family (72 in all)
+#: references per family (100 in all); the last four families (the domes and hills architects
+#: draw) are written in the users' units and formats (:data:`_FILES`)
 COUNTS: dict[str, int] = {"revolution": 10, "associate": 8, "hill": 8, "dome": 7, "ridge": 5,
                           "saddle": 8, "monkey": 5, "sphere-cap": 4, "near-sphere": 5,
-                          "pseudosphere": 4, "near-pseudosphere": 5, "dini": 3}
+                          "pseudosphere": 4, "near-pseudosphere": 5, "dini": 3,
+                          "bump": 7, "round-dome": 7, "asym-hill": 7, "pavilion": 7}
+#: families whose target files come in a user's units and formats, not metres in OBJ
+_USER_FILES = ("bump", "round-dome", "asym-hill", "pavilion")
+#: (format, units) of those files, cycled: Rhino models in millimetres first
+_FILES = [("3dm", "mm"), ("obj", "mm"), ("ply", "m"), ("3dm", "cm"), ("off", "mm"),
+          ("obj", "m"), ("3dm", "m"), ("ply", "mm"), ("3dm", "mm")]
 
 #: the runs of the corpus: pipeline / mode -> CLI words after ``gridshell``
 MODES: dict[str, list[str]] = {"gg": ["gg"], "ncp-phlw": ["ncp", "--mode", "phlw"],
@@ -69,6 +76,11 @@ class Reference:
         saddle-like and dome-like references (K of one sign, no umbilic point); ncp-aa where
         K < 0
     no_net : runs that must answer "no net exists" (exit 3): ncp-aa where K > 0
+    tried : runs a user would try on the shapes architects draw although the surface does not
+        admit them by construction (an umbilic, K of both signs): the contract is exit 0 with
+        every figure, or a refusal (exit 3 / 4) with its reason, never a failing design
+    file_format, units : how the target file is written for a run (:meth:`write_target`):
+        "obj", "ply", "off" or "3dm" (a Rhino mesh); "m", "cm" or "mm"
     """
 
     name: str
@@ -92,6 +104,9 @@ class Reference:
     _f: Callable = field(repr=False, compare=False)
     _scale: float = field(repr=False, compare=False)
     _shape: Shape = field(repr=False, compare=False)
+    file_format: str = "obj"
+    units: str = "m"
+    tried: tuple[str, ...] = ()
 
     @property
     def scale(self) -> float:
@@ -117,6 +132,14 @@ class Reference:
         """``(V (rows*cols, 3), F)``: the quad or triangle mesh, faces consistently oriented."""
         return (self.grid().reshape(-1, 3),
                 grid_faces(self.rows, self.cols, self.mesh, self.diagonal))
+
+    def write_target(self, folder: str | Path) -> Path:
+        """Write the mesh as a user would bring it, in :attr:`file_format` and :attr:`units`,
+        into ``folder`` (``target.<ext>``; a .3dm says its unit, the others do not: pass
+        ``--units`` :attr:`units`); returns the path."""
+        from gridshell.corpus.files import write_target
+
+        return write_target(self, Path(folder))
 
     def write_obj(self, path: str | Path) -> Path:
         """Write the mesh as an OBJ file (exact coordinates; atomic); returns the path."""
@@ -159,7 +182,8 @@ class Reference:
                 "rotation": [list(r) for r in self.rotation], "offset": list(self.offset),
                 "revolution": self.revolution, "curvature": self.curvature,
                 "K_range": list(self.K_range), "umbilic_gap": self.umbilic_gap,
-                "modes": list(self.modes), "no_net": list(self.no_net)}
+                "modes": list(self.modes), "no_net": list(self.no_net),
+                "file_format": self.file_format, "units": self.units, "tried": list(self.tried)}
 
 
 def _jsonable(x: Any) -> Any:
@@ -279,7 +303,19 @@ def build_reference(family: str, k: int, index: int) -> Reference:
         rotation=tuple(tuple(float(x) for x in r) for r in R),
         offset=tuple(float(x) for x in t), revolution=shape.revolution, curvature=curv,
         K_range=(float(K.min()) / scale**2, float(K.max()) / scale**2), umbilic_gap=gap,
-        modes=tuple(modes), no_net=no_net, _f=f, _scale=scale, _shape=shape)
+        modes=tuple(modes), no_net=no_net, _f=f, _scale=scale, _shape=shape,
+        tried=tuple(m for m in ("ncp-phlw", "ncp-cnc", "ncp-aa") if family in _USER_FILES
+                    and m not in modes and m not in no_net),
+        **_file_of(family, k))
+
+
+def _file_of(family: str, k: int) -> dict[str, str]:
+    """The target file's format and units: metres in OBJ, or for the families users draw the
+    ``k``-th entry of :data:`_FILES` (offset per family, so that every family meets each)."""
+    if family not in _USER_FILES:
+        return {}
+    fmt, units = _FILES[(k + 2 * _USER_FILES.index(family)) % len(_FILES)]
+    return {"file_format": fmt, "units": units}
 
 
 def _build() -> tuple[Reference, ...]:
@@ -296,7 +332,7 @@ REFERENCES: tuple[Reference, ...] = _build()
 _BY_NAME = {r.name: r for r in REFERENCES}
 
 #: a small subset spanning families, sizes (0.5 m to 60 m), quads and triangles: the
-#: references of tests/test_corpus_pipelines.py
+#: references of tests/corpus/test_corpus_pipelines.py
 FAST: tuple[str, ...] = ("hill-06", "saddle-04", "revolution-02", "associate-03",
                          "pseudosphere-03", "dome-05")
 

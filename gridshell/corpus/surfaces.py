@@ -372,6 +372,87 @@ def make_near_sphere(rng: np.random.Generator) -> Shape:
     return s
 
 
+# ---- the shapes architects draw: domes and hills with an umbilic or near-umbilic top ------
+
+def _turned_shape(family: str, params: dict, terms: list[tuple], X: float, Y: float,
+                  turn: float) -> Shape:
+    """The graph of the height terms over the rectangle ``[-X, X] x [-Y, Y]`` turned by
+    ``turn`` (rad) in the plane: the bumps' axes are not the patch's (a user's hill drawn at
+    an angle to its footprint). Closed-form K as for :func:`_height_shape` (K is invariant
+    under a turn of the plane)."""
+    h = height_terms(terms)
+    c, s = np.cos(turn), np.sin(turn)
+
+    def local(a, b):
+        a, b = np.broadcast_arrays(np.asarray(a, float), np.asarray(b, float))
+        x, y = X * (2 * b - 1), Y * (2 * a - 1)
+        return x, y, c * x + s * y, -s * x + c * y
+
+    def f(a, b):
+        x, y, xl, yl = local(a, b)
+        return np.stack([x, y, h(xl, yl)[0]], axis=-1)
+
+    def K(a, b):
+        _, _, xl, yl = local(a, b)
+        _, hx, hy, hxx, hxy, hyy = h(xl, yl)
+        return (hxx * hyy - hxy**2) / (1 + hx**2 + hy**2) ** 2
+    p = dict(params, X=X, Y=Y, turn=turn, terms=[list(t) for t in terms])
+    return Shape(family, p, f, False, {"K": K, "height": h})
+
+
+def make_bump(rng: np.random.Generator) -> Shape:
+    """A single Gaussian bump ``h exp(-x'^2/sx^2 - y'^2/sy^2)`` on a flat skirt, its axes
+    turned against the footprint (K > 0 on the crown, K < 0 on the skirt; the crown is
+    near-umbilic when ``sx`` is close to ``sy``)."""
+    Y = _u(rng, 0.6, 1.0)
+    sx = _u(rng, 0.45, 0.8)
+    sy = sx * _u(rng, 0.8, 1.25)
+    terms = [("gauss", _u(rng, 0.3, 0.6), 0.0, 0.0, sx, sy * Y)]
+    return _turned_shape("bump", {"sx": sx, "sy": sy}, terms, 1.0, Y, _u(rng, 0.0, np.pi))
+
+
+def make_round_dome(rng: np.random.Generator) -> Shape:
+    """A paraboloid of revolution ``h (1 - ((x-x0)^2 + (y-y0)^2) / R^2)``, its crown off the
+    centre of the footprint: the dome of a pavilion, an umbilic point at the crown
+    (``k1 = k2 = 2h/R^2`` there), K > 0 everywhere, exactly of revolution."""
+    Y = _u(rng, 0.6, 1.0)
+    h = _u(rng, 0.3, 0.6)
+    x0, y0 = _u(rng, -0.2, 0.2), _u(rng, -0.2, 0.2) * Y
+    R2 = 1.0 + Y * Y
+    terms = [("poly", h * (1 - (x0 * x0 + y0 * y0) / R2), 0, 0), ("poly", -h / R2, 2, 0),
+             ("poly", -h / R2, 0, 2), ("poly", 2 * h * x0 / R2, 1, 0),
+             ("poly", 2 * h * y0 / R2, 0, 1)]
+    return _height_shape("round-dome", {"h": h, "x0": x0, "y0": y0}, terms, 1.0, Y,
+                         revolution=True)
+
+
+def make_asym_hill(rng: np.random.Generator) -> Shape:
+    """An asymmetric hill: a main bump off the centre, a shoulder and a cubic skew (one crest
+    that is not a point of symmetry; K of both signs, a near-umbilic region on the crest)."""
+    Y = _u(rng, 0.55, 0.9)
+    x0 = _u(rng, -0.35, 0.35)
+    terms: list[tuple] = [("gauss", _u(rng, 0.35, 0.55), x0, _u(rng, -0.2, 0.2) * Y,
+                           _u(rng, 0.55, 0.9), _u(rng, 0.5, 0.8) * Y),
+                          ("gauss", _u(rng, 0.08, 0.18), -x0 + _u(rng, -0.3, 0.3),
+                           _u(rng, -0.5, 0.5) * Y, _u(rng, 0.3, 0.5), _u(rng, 0.3, 0.5) * Y),
+                          ("poly", _u(rng, -0.06, 0.06), 3, 0),
+                          ("poly", _u(rng, -0.06, 0.06), 1, 2)]
+    return _turned_shape("asym-hill", {"x0": x0}, terms, 1.0, Y, _u(rng, 0.0, np.pi))
+
+
+def make_pavilion(rng: np.random.Generator) -> Shape:
+    """A pavilion hill as a user draws it: a 3:2 footprint (12 x 8 m in the canonical units
+    times the size bin), one broad bump of height 0.2-0.35 of the long side turned by a
+    random angle, and a second low one (K > 0 on the top, K < 0 around it)."""
+    Y = _u(rng, 0.6, 0.72)
+    terms: list[tuple] = [("gauss", _u(rng, 0.4, 0.7), 0.0, 0.0, _u(rng, 0.6, 0.85),
+                           _u(rng, 0.6, 0.85) * Y)]
+    if rng.uniform() < 0.5:
+        terms.append(("gauss", _u(rng, 0.05, 0.15), _u(rng, -0.6, 0.6), _u(rng, -0.5, 0.5) * Y,
+                      _u(rng, 0.25, 0.45), _u(rng, 0.25, 0.45) * Y))
+    return _turned_shape("pavilion", {"bumps": len(terms)}, terms, 1.0, Y, _u(rng, 0.0, np.pi))
+
+
 #: family -> generator, in registry order
 FAMILIES: dict[str, Callable[[np.random.Generator], Shape]] = {
     "revolution": make_revolution,
@@ -386,4 +467,8 @@ FAMILIES: dict[str, Callable[[np.random.Generator], Shape]] = {
     "pseudosphere": make_pseudosphere,
     "near-pseudosphere": make_near_pseudosphere,
     "dini": make_dini,
+    "bump": make_bump,
+    "round-dome": make_round_dome,
+    "asym-hill": make_asym_hill,
+    "pavilion": make_pavilion,
 }

@@ -10,8 +10,10 @@ from __future__ import annotations
 __all__ = ["export_3dm"]
 
 
-def export_3dm(bundle_dir, path, **kwargs):
-    """See :func:`gridshell.export.rhino.export_3dm`."""
-    from gridshell.export.rhino import export_3dm as _export
+def __getattr__(name: str):
+    """``export_3dm``: :func:`gridshell.export.rhino.export_3dm` itself, imported on first use."""
+    if name == "export_3dm":
+        from gridshell.export.rhino import export_3dm
 
-    return _export(bundle_dir, path, **kwargs)
+        return export_3dm
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

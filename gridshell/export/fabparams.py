@@ -5,41 +5,28 @@ The strip's real section is the cut strip's (mm of the physical model) divided b
 
 1. the caller's values (``--width``, ``--thickness``, ``--hole``, ``--scale`` ...);
 2. the bundle's fabrication report ``DIR/fabrication/fabrication.json`` (the parameters the
-   cut files were written with), when there is one;
-3. :class:`gridshell.fabrication.params.FabParams` defaults (20 x 1 mm, 3 mm holes, 1:10, 600 x 400 mm).
+   cut files were written with), when there is one, read by
+   :func:`gridshell.design.section.stored_params` (the one reader: a corrupt report is an
+   error naming it, as for every command);
+3. :class:`gridshell.fabrication.params.FabParams` defaults (20 x 1 mm, 3 mm holes, 1:10, 600 x 400 mm;
+   the strip's from :data:`gridshell.design.section.DEFAULTS`).
+
+The order and the strip's section are those of :func:`gridshell.design.section.resolve_section`
+(a test keeps the two the same for every bundle).
 
 The cut sheets are planned in memory with :func:`gridshell.fabrication.pipeline.plan_parts` from these
 parameters: the same nesting as ``gridshell fabricate`` writes (deterministic).
 """
 from __future__ import annotations
 
-import json
 from dataclasses import fields
 from pathlib import Path
 from typing import Any, Callable
 
 from gridshell.core.errors import InputError
+from gridshell.design.section import FABRICATION_REPORT, stored_params
 
 __all__ = ["FABRICATION_REPORT", "export_params", "plan_sheets"]
-
-#: where a bundle's cut files and their report live (``gridshell fabricate`` default)
-FABRICATION_REPORT = Path("fabrication") / "fabrication.json"
-
-
-def _stored(bundle_dir: Path | None) -> dict[str, Any]:
-    """The parameters of ``bundle_dir/fabrication/fabrication.json`` ({} when absent)."""
-    if bundle_dir is None:
-        return {}
-    f = Path(bundle_dir) / FABRICATION_REPORT
-    if not f.is_file():
-        return {}
-    try:
-        p = json.loads(f.read_text(encoding="utf-8")).get("params", {})
-    except (OSError, ValueError, AttributeError) as exc:
-        raise InputError(f"{f} is not a readable fabrication report ({exc}); re-run "
-                         "'gridshell fabricate' or remove it") from None
-    return p if isinstance(p, dict) else {}
-
 
 def export_params(bundle_dir: str | Path | None = None, params: Any = None,
                   **overrides: Any):
@@ -67,8 +54,8 @@ def export_params(bundle_dir: str | Path | None = None, params: Any = None,
         base = params.to_json() if isinstance(params, FabParams) else dict(params)
         source = "given parameters"
     else:
-        base = _stored(Path(bundle_dir) if bundle_dir is not None else None)
-        source = str(Path(bundle_dir) / FABRICATION_REPORT) if base else "defaults"
+        base, path = stored_params(bundle_dir)
+        source = path if base else "defaults"
     d = {k: v for k, v in base.items() if k in names}
     given = {k: v for k, v in overrides.items() if v is not None}
     if given:

@@ -58,7 +58,7 @@ from gridshell.core.errors import GridshellError, InputError, OutputError
 from gridshell.export import rhino_geometry as geo
 from gridshell.core.units import METRES, Units, bundle_units, parse_units
 
-__all__ = ["LAYERS", "RHINO_UNITS", "bundle_to_3dm", "export_3dm", "write_3dm"]
+__all__ = ["LAYERS", "RHINO_UNITS", "bundle_to_3dm", "export_3dm"]
 
 #: fixed layer name -> RGBA colour (0-255); sheet layers ("sheet 01", ...) follow them
 LAYERS: dict[str, tuple[int, int, int, int]] = {
@@ -458,19 +458,20 @@ def _check_finite(bundle) -> None:
                                  "this is a bug, please report it")
 
 
-def write_3dm(bundle, path: str | os.PathLike, *, width: float | None = None,
-              thickness: float | None = None, hole: float | None = None,
-              scale: Any = None, sheet: Any = None, params: Any = None, units: Any = None,
-              sheets: bool = True, force: bool = False,
-              progress: Callable[[str], None] | None = None) -> dict[str, Any]:
-    """Write a design bundle to a Rhino ``.3dm`` file (Rhino 8 format), atomically; returns
-    what was written (``path``, ``units``, object counts per layer, ``sheets``, the
-    fabrication parameters and their source, and ``notes``).
+def export_3dm(bundle, path: str | os.PathLike, *, width: float | None = None,
+               thickness: float | None = None, hole: float | None = None,
+               scale: Any = None, sheet: Any = None, params: Any = None, units: Any = None,
+               sheets: bool = True, force: bool = False,
+               progress: Callable[[str], None] | None = None) -> dict[str, Any]:
+    """Write a design to a Rhino ``.3dm`` file (Rhino 8 format), atomically; returns what was
+    written (``path``, ``units``, object counts per layer, ``sheets``, the fabrication
+    parameters and their source, and ``notes``). ``gridshell.export_3dm`` is this function.
 
     Parameters
     ----------
-    bundle : path-like or DesignBundle
-        The design bundle directory (or an in-memory bundle).
+    bundle : path-like, Design or DesignBundle
+        The design bundle directory, or a design in memory (the result of ``design_gg`` /
+        ``design_ncp``, or its bundle).
     path : path-like
         Output ``.3dm`` file.
     width, thickness, hole, scale, sheet : optional
@@ -490,12 +491,36 @@ def write_3dm(bundle, path: str | os.PathLike, *, width: float | None = None,
     The design check and the cut-sheet plan run in a second process (:mod:`gridshell.core.aside`,
     forked on Linux) while this one builds the rest of the model; the file is the same.
     """
+    bundle = _design_bundle(bundle)
     path = check_3dm_path(path)
     info = write_model(bundle, path, width=width, thickness=thickness, hole=hole, scale=scale,
                        sheet=sheet, params=params, units=units, sheets=sheets, force=force,
                        progress=progress, publish=True)
     info["path"] = str(path)
     return info
+
+
+def _design_bundle(design: Any) -> Any:
+    """A bundle directory or DesignBundle as it is; the bundle of a Design; else InputError."""
+    from gridshell.design.bundle import Design, DesignBundle
+
+    if isinstance(design, (str, os.PathLike, DesignBundle)):
+        return design
+    if isinstance(design, Design):
+        return design.bundle
+    raise InputError(f"expected a design (the result of design_gg / design_ncp), a "
+                     f"DesignBundle or a bundle directory, got {type(design).__name__}")
+
+
+def __getattr__(name: str) -> Any:
+    if name == "write_3dm":
+        import warnings
+
+        warnings.warn("gridshell.export.rhino.write_3dm is export_3dm now (the same function "
+                      "and result); write_3dm goes in the next release", DeprecationWarning,
+                      stacklevel=2)
+        return export_3dm
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def check_3dm_path(path: str | os.PathLike) -> Path:
@@ -512,11 +537,11 @@ def write_model(bundle, path: str | os.PathLike, *, width: float | None = None,
                 sheets: bool = True, force: bool = False,
                 progress: Callable[[str], None] | None = None, publish: bool = False,
                 shown: str | os.PathLike | None = None) -> dict[str, Any]:
-    """The body of :func:`write_3dm` (same parameters): build the model, then write it to
+    """The body of :func:`export_3dm` (same parameters): build the model, then write it to
     ``path`` - atomically with ``publish`` (:func:`gridshell.core.atomic.atomic_path`: temporary
     file, rename, manifest entry), else as it is, into a temporary file the caller publishes
     (:mod:`gridshell.workflow.outputs` runs this in a second process). ``shown`` is the path progress and
-    errors name (default ``path``). Returns what :func:`write_3dm` returns but ``path``."""
+    errors name (default ``path``). Returns what :func:`export_3dm` returns but ``path``."""
     from gridshell.core.aside import Aside
     from gridshell.design.bundle import read_bundle, read_design_json
     from gridshell.export.fabparams import export_params
@@ -589,9 +614,3 @@ def _cut_sheets(judged, bundle, fab, force: bool) -> tuple[bool, str, Any, Any, 
     if not (ok or force):
         return ok, why, None, fab, None
     return (ok, why, *plan_sheets(bundle, fab))
-
-
-def export_3dm(bundle, path: str | os.PathLike, **options: Any) -> Path:
-    """:func:`write_3dm`, returning ``path``."""
-    write_3dm(bundle, path, **options)
-    return Path(path)

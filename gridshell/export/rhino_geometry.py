@@ -27,7 +27,7 @@ def mesh(V: np.ndarray, F: np.ndarray, what: str = "surface"):
     verts.UseDoublePrecisionVertices = True     # float64 coordinates, as the bundle's
     # one Python-level call per vertex / face through map(), the arrays' columns as arguments
     # (rhino3dm 8 has no bulk constructor); same vertices and faces, same order, as adding
-    # them one by one (tests/test_export_rhino.py)
+    # them one by one (tests/export/test_export_rhino.py)
     if len(V):
         list(map(verts.AddPoint3d, *V.T.tolist()))
     n_corners = (F >= 0).sum(axis=1)

@@ -8,31 +8,15 @@ import math
 from dataclasses import asdict, dataclass
 
 from gridshell.core.errors import InputError
+from gridshell.design.section import DEFAULTS, parse_scale, scale_text
+
+__all__ = ["AXIS_PLACES", "DXF_VERSIONS", "FabParams", "JOINT_STYLES", "ROTATIONS", "parse_scale",
+           "parse_sheet", "scale_text"]
 
 JOINT_STYLES = ("hole", "slots", "marks")
 AXIS_PLACES = ("centre", "edge")
 ROTATIONS = ("free", "grain")
 DXF_VERSIONS = ("R2010", "R12")
-
-
-def parse_scale(text: str | float) -> float:
-    """Model/design length ratio from ``"1:10"``, ``"1:1"`` or ``"0.1"``; e.g. ``1:10 -> 0.1``."""
-    if isinstance(text, (int, float)):
-        value = float(text)
-    else:
-        s = str(text).strip()
-        try:
-            if ":" in s:
-                a, b = s.split(":")
-                value = float(a) / float(b)
-            else:
-                value = float(s)
-        except (ValueError, ZeroDivisionError):
-            raise InputError(f"scale {text!r} is not understood; "
-                             "write it as 1:10, 1:1 or 0.1") from None
-    if not math.isfinite(value) or value <= 0:
-        raise InputError(f"scale {text!r} must be positive; write it as 1:10, 1:1 or 0.1")
-    return value
 
 
 def parse_sheet(text: str | tuple[float, float]) -> tuple[float, float]:
@@ -108,14 +92,14 @@ class FabParams:
         Chord tolerance for tessellated arcs and curves.
     """
 
-    width: float = 20.0
-    thickness: float = 1.0
+    width: float = DEFAULTS["width"]
+    thickness: float = DEFAULTS["thickness"]
     hole: float = 3.0
     joints: str = "hole"
     clearance: float = 0.2
     margin: float = 15.0
     axis: str = "centre"
-    scale: float = 0.1
+    scale: float = DEFAULTS["scale"]
     sheet: tuple[float, float] = (600.0, 400.0)
     gap: float = 2.0
     rotation: str = "free"
@@ -218,12 +202,3 @@ class FabParams:
                              f"only orthogonal lamellae (AA, CNC, NCP designs) have; {design}"
                              "lamellae are tangent to the surface with the axis on the centre "
                              "line: use --axis centre")
-
-
-def scale_text(scale: float) -> str:
-    """``0.1 -> "1:10"``, ``2 -> "2:1"``, otherwise the number."""
-    if scale <= 1 and abs(1 / scale - round(1 / scale)) < 1e-9:
-        return f"1:{round(1 / scale)}"
-    if scale > 1 and abs(scale - round(scale)) < 1e-9:
-        return f"{round(scale)}:1"
-    return f"{scale:g}"

@@ -152,7 +152,7 @@ def ask_closest_points(Ps: list[np.ndarray], V: Any, F: np.ndarray | None = None
     before go to igl in one query, so that it builds its AABB tree of the mesh once instead
     of once per set (~10 ms for 20k triangles). igl answers each point from the tree alone,
     whatever the other points of its query: each set gets the arrays its own query gives
-    (tests/test_igl_adapter.py)."""
+    (tests/geometry/test_igl_adapter.py)."""
     Ps = [_points(P) for P in Ps]
     V, T, _ = triangulate(V, F)
     keys = [("closest", array_key(P, V, T)) for P in Ps]
@@ -283,7 +283,7 @@ def principal_curvature_at(V: Any, F: np.ndarray | None, vertices: np.ndarray,
     triangles with a corner within one ring less suffice (~half as many vertices for igl to
     fit). They are handed to igl in their order, their vertices renumbered in theirs, so
     that igl meets every neighbour in the same order and adds in the same order
-    (tests/test_bundle_cache.py compares with the whole mesh's figures)."""
+    (tests/design/test_bundle_cache.py compares with the whole mesh's figures)."""
     V, T, _ = triangulate(V, F)
     if int(radius) < 1:
         raise InputError(f"radius must be an integer >= 1, got {radius!r}")

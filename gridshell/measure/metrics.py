@@ -463,7 +463,7 @@ def _kn_at_joints(net: Net, axis_normals: Sequence[np.ndarray],
     same arithmetic row by row, for the joint rows of all lamellae at once instead of every
     row of each. None when a lamella's polyline or normals are ones that function refuses
     (not finite, a zero-length segment, a zero normal, shapes): the caller asks it, for its
-    error. tests/test_metrics.py compares with it."""
+    error. tests/measure/test_metrics.py compares with it."""
     from gridshell.geometry.diffgeo import _dot
 
     axes, normals, rows, keys, at = [], [], [], [], 0

@@ -36,19 +36,33 @@ THRESHOLDS: dict[str, tuple[str, float]] = {
 
 @dataclass(frozen=True)
 class Gate:
-    """One figure of a design against its threshold; ``value`` and ``limit`` in %."""
+    """One figure of a design (or of a step such as PHLW) and whether it holds.
+
+    A threshold gate has ``value`` and ``limit`` (both in %) and holds when the value is finite
+    and strictly below the limit. A gate judged by its own rule (the PHLW step's "not higher
+    than at the start", :mod:`gridshell.ncp.phlw.gates`) has no limit: ``held`` is its verdict
+    and ``detail`` says what was compared.
+    """
 
     name: str
     label: str
-    value: float | None
-    limit: float
+    value: float | None = None
+    limit: float | None = None
+    held: bool | None = None
+    detail: str | None = None
 
     @property
     def ok(self) -> bool:
-        return self.value is not None and math.isfinite(self.value) and self.value < self.limit
+        if self.held is not None:
+            return bool(self.held)
+        return (self.value is not None and self.limit is not None
+                and math.isfinite(self.value) and self.value < self.limit)
 
     def statement(self) -> str:
-        """``"Delta_a max 0.41 % < 3 %"`` / ``"Delta_a max 7.05 % >= 3 %"`` (no verdict word)."""
+        """``"Delta_a max 0.41 % < 3 %"`` / ``"Delta_a max 7.05 % >= 3 %"`` (no verdict word);
+        ``"label: detail"`` for a gate with its own rule."""
+        if self.detail is not None or self.limit is None:
+            return f"{self.label}: {self.detail or ('yes' if self.ok else 'no')}"
         if self.value is None or not math.isfinite(self.value):
             return f"{self.label}: not measured (limit {self.limit:g} %)"
         rel = "<" if self.ok else ">="
@@ -61,9 +75,17 @@ class Gate:
     @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> "Gate":
         """The gate of :meth:`as_dict`'s record."""
+        if d.get("limit") is None:
+            return cls(str(d["name"]), str(d["label"]), held=bool(d["ok"]),
+                       detail=d.get("detail"))
         return cls(str(d["name"]), str(d["label"]), d.get("value"), float(d["limit"]))
 
     def as_dict(self) -> dict[str, Any]:
+        """``{name, label, value, limit, ok}``; ``{name, label, ok, detail, line}`` for a gate
+        with its own rule."""
+        if self.limit is None:
+            return {"name": self.name, "label": self.label, "ok": self.ok,
+                    "detail": self.detail, "line": self.line()}
         return {"name": self.name, "label": self.label, "value": self.value,
                 "limit": self.limit, "ok": self.ok}
 

@@ -211,16 +211,17 @@ def _lamella_table(lamellae: list[dict]) -> str:
 
 
 def _fabrication_section(d: Path) -> str:
+    """The cut files' section: the fabrication report's counts (read by
+    :func:`gridshell.design.section.read_fabrication_report`: a corrupt report is an error),
+    the plan and the first sheets."""
+    from gridshell.design.section import read_fabrication_report
+
     fab = d / "fabrication"
     if not fab.is_dir():
         return ""
     parts = ['<section id="fabrication"><h2>Fabrication</h2>']
-    info = fab / "fabrication.json"
-    if info.is_file():
-        try:
-            rep = json.loads(info.read_text(encoding="utf-8"))
-        except (OSError, ValueError):
-            rep = {}
+    rep = read_fabrication_report(d)
+    if rep is not None:
         keys = ("shape", "n_strips", "n_pieces", "n_sheets", "n_joint_marks", "utilisation",
                 "material_used", "labels_dropped", "radius_mm")
         parts.append(_kv_table((k, rep[k]) for k in keys if k in rep))

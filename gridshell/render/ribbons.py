@@ -144,7 +144,7 @@ def render_ribbons(path: str | os.PathLike, axes: Sequence[np.ndarray],
     kind : {"GG", "NCP", "CNC", "AA"}
         GG lamellae lie tangent to the surface, the others stand orthogonal to it.
     width, thickness : float, optional
-        The strip's real section in metres (default :data:`gridshell.render.section.DEFAULT_CUT`
+        The strip's real section in metres (default :data:`gridshell.design.section.DEFAULT_CUT`
         at its scale: 200 x 10 mm).
     title : str, optional
     size : (w, h) int
@@ -169,7 +169,7 @@ def render_ribbons(path: str | os.PathLike, axes: Sequence[np.ndarray],
     from matplotlib.patches import Patch
 
     from gridshell.render.painter import Camera, Painter, strips_faces
-    from gridshell.render.section import bundle_section
+    from gridshell.design.section import resolve_section
 
     axes = [np.asarray(a, float).reshape(-1, 3) for a in axes]
     fams = [int(f) for f in families]
@@ -183,7 +183,7 @@ def render_ribbons(path: str | os.PathLike, axes: Sequence[np.ndarray],
     V = np.asarray(V, float).reshape(-1, 3)
     F = np.asarray(F, np.int64)
     J = None if joints is None else np.asarray(joints, float).reshape(-1, 3)
-    default = bundle_section(None)
+    default = resolve_section(None)
     w = default.width_m if width is None else float(width)
     t = default.thickness_m if thickness is None else float(thickness)
     if not (w > 0 and t > 0):
@@ -330,11 +330,11 @@ def render_bundle(bundle, path: str | os.PathLike | None = None, *,
 
     ``width`` and ``thickness`` are the strip's real section in metres (default the cut strip
     of the bundle's ``fabrication/fabrication.json`` divided by its scale, else 20 x 1 mm at
-    1:10 = 200 x 10 mm: :func:`gridshell.render.section.bundle_section`); the title says it.
+    1:10 = 200 x 10 mm: :func:`gridshell.design.section.resolve_section`); the title says it.
     Further keyword arguments go to :func:`render_ribbons`.
     """
     from gridshell.design.bundle import read_bundle
-    from gridshell.render.section import bundle_section
+    from gridshell.design.section import resolve_section
 
     directory = None
     if isinstance(bundle, (str, os.PathLike)):
@@ -346,7 +346,7 @@ def render_bundle(bundle, path: str | os.PathLike | None = None, *,
         if path is None:
             raise InputError("render_bundle: give an output path for an in-memory bundle")
     lams = b.net.lamellae
-    section = bundle_section(directory)
+    section = resolve_section(directory)
     if width is None and thickness is None:
         text = section.text()
     else:

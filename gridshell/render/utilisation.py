@@ -17,6 +17,7 @@ import numpy as np
 
 from gridshell.core.atomic import atomic_path
 from gridshell.core.errors import InputError
+from gridshell.design.section import DEFAULTS
 
 __all__ = ["render_utilisation", "structure_section", "utilisation_colours", "PICTURE"]
 
@@ -62,9 +63,9 @@ def render_utilisation(bundle, result: dict[str, Any], path: str | os.PathLike, 
         u = u if len(u) == len(lam.axis) else np.zeros(len(lam.axis))
         colours.append(utilisation_colours(np.maximum(u, np.r_[u[1:], u[-1]]), top))
     sec, mat = result.get("section", {}), result.get("material", {})
-    scale = float(sec.get("scale") or 0.1)
-    width = 1e-3 * float(sec.get("width_mm") or 20.0) / scale
-    thickness = 1e-3 * float(sec.get("thickness_mm") or 1.0) / scale
+    scale = float(sec.get("scale") or DEFAULTS["scale"])
+    width = 1e-3 * float(sec.get("width_mm") or DEFAULTS["width"]) / scale
+    thickness = 1e-3 * float(sec.get("thickness_mm") or DEFAULTS["thickness"]) / scale
     w = result.get("worst") or {}
     worst = (f", worst L{w.get('lamella')} ({w.get('utilisation', 0):.2f}) at "
              f"{float(w.get('s_m', 0.0)):.2f} m" if w.get("lamella") is not None else "")

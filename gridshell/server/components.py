@@ -177,11 +177,12 @@ def register(hops, workdir: Path) -> None:
                  hs.HopsString("Report", "R", "the recomputed figures (JSON)")])
     def verify(bundle_dir):
         from gridshell.design.bundle import finite_json
-        from gridshell.design.verification import verify_bundle
+        from gridshell.design.verification import design_verdict
 
-        res = verify_bundle(_bundle_path(bundle_dir))
-        warnings = [] if res["ok"] else ["the design fails its checks: " + "; ".join(
-            [c for c in res["checks"] if c.startswith("FAIL")] + res["problems"])]
+        verdict = design_verdict(_bundle_path(bundle_dir))
+        res = verdict.report
+        warnings = [] if verdict.ok else ["the design fails its checks: " + "; ".join(
+            [g.line() for g in verdict.gates if not g.ok] + list(verdict.problems))]
         return Reply(bool(res["ok"]), list(res["checks"]) + list(res["problems"]),
                      json.dumps(finite_json(res), default=_plain, allow_nan=False),
                      warnings=warnings)
@@ -207,11 +208,12 @@ def register(hops, workdir: Path) -> None:
                               access=hs.HopsParamAccess.LIST),
                  hs.HopsString("Report", "R", "sheets, material used, pieces (JSON)"),
                  hs.HopsString("Folder", "D", "folder of the DXF / SVG files")])
-    def fab(bundle_dir, scale="1:10", sheet="600x400", width=20.0, opts="{}", force=False):
+    def fab(bundle_dir, scale=None, sheet="600x400", width=None, opts="{}", force=False):
         from dataclasses import fields
 
         from gridshell.fabrication import FabParams, fabricate
 
+        from gridshell.design.section import resolve_section
         from gridshell.design.verification import require_design
 
         names = tuple(f.name for f in fields(FabParams) if f.name not in
@@ -219,7 +221,10 @@ def register(hops, workdir: Path) -> None:
         kw = options(opts, names, "Fabricate")
         path = _bundle_path(bundle_dir)
         verdict = require_design(str(path), bool(force), "set Force to cut it anyway")
-        params = FabParams(scale=scale, sheet=sheet, width=float(width), **kw)
+        strip = resolve_section(path, width=width, thickness=kw.pop("thickness", None),
+                                scale=scale, stored=False)   # as 'gridshell fabricate'
+        params = FabParams(scale=strip.scale, sheet=sheet, width=strip.width_mm,
+                           thickness=strip.thickness_mm, **kw)
         out = path / "fabrication"
         rep = fabricate(path, out, params, plan=False, keep_layout=True)
         layout = rep.pop("layout")

@@ -62,7 +62,7 @@ class Problem:
         """Add term ``fn`` with ``data`` and ``weight`` under ``name``; returns ``self``.
 
         ``fn`` must be registered with :func:`~gridshell.solver.terms.term`, so that the
-        finite-difference test (``tests/test_jacobians.py``) covers every term a problem uses.
+        finite-difference test (``tests/solver/test_jacobians.py``) covers every term a problem uses.
         """
         if registered_name(fn) is None:
             what = getattr(fn, "__qualname__", None) or type(fn).__name__

@@ -19,7 +19,7 @@ gradient and Hessian are exact):
   sum over the two edges' own directors reads a strip twisting at the rate ``tau`` as bent
   about its strong axis by ``h tau / 2`` per unit curvature; with a strip's ``(w/t)^2`` stiffness
   ratio that is first-order error in the energy that matters (+7 % on a 60-element helix,
-  tests/test_structure_rod.py); the mean directors make it second order.)
+  tests/structure/test_structure_rod.py); the mean directors make it second order.)
   ``w1`` bends the axis towards the width direction ``m1`` (strong axis, ``B1 = E t w^3/12``),
   ``w2`` towards the thickness direction ``m2`` (weak axis, ``B2 = E w t^3/12``);
 - twisting, per interior vertex (Bergou eq. 5): ``GJ (m_i - m_bar_i)^2 / l_bar_i`` with

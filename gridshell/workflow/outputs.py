@@ -39,7 +39,7 @@ def write_outputs(bundle: str | os.PathLike, *, png: bool = True, sequence: bool
     report : bool
         ``report.html`` (:func:`gridshell.render.report.write_report`), after the pictures.
     rhino : path-like, optional
-        The .3dm file (:func:`gridshell.export.rhino.write_3dm`, with ``rhino_options``: any
+        The .3dm file (:func:`gridshell.export.rhino.export_3dm`, with ``rhino_options``: any
         of its keyword arguments but ``progress``; the model is built in another process,
         which prints nothing).
     progress : callable, optional
@@ -49,7 +49,7 @@ def write_outputs(bundle: str | os.PathLike, *, png: bool = True, sequence: bool
     -------
     dict
         ``render`` (Path or None), ``sequence`` (the sequence renderer's result or None),
-        ``report`` (Path or None), ``rhino`` (what :func:`~gridshell.export.rhino.write_3dm`
+        ``report`` (Path or None), ``rhino`` (what :func:`~gridshell.export.rhino.export_3dm`
         returns, or None).
     """
     from gridshell.core.aside import Aside, can_fork

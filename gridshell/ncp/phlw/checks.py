@@ -68,7 +68,7 @@ def fit_rows(K: np.ndarray, H: np.ndarray, mode: Mode = "phlw", rtol: float = 1e
         beta = K.mean(axis=1)
     elif mode == "phlw":
         # all rows at once: the least-squares line of centred data (what np.polyfit(h, k, 1)
-        # returns per row, tests/test_phlw.py compares them)
+        # returns per row, tests/ncp/test_phlw.py compares them)
         hm, km = H.mean(axis=1), K.mean(axis=1)
         Hc = H - hm[:, None]
         var = np.einsum("ij,ij->i", Hc, Hc)

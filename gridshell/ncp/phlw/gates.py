@@ -1,4 +1,5 @@
-"""Quality gates of the PHLW step (``gridshell phlw``): the step's own figures, pass / fail.
+"""Quality gates of the PHLW step (``gridshell phlw``): the step's own figures as
+:class:`gridshell.measure.quality.Gate` objects (judged by their own rule, not a % limit).
 
 A PHLW / CNC / PK surface counts as designed when the optimization
 
@@ -16,10 +17,12 @@ from ``PHLWResult.report_before`` / ``report_after`` (plain dicts, see
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+import warnings
 from typing import Any, Mapping
 
-__all__ = ["ANGLE_FLOOR_DEG", "Check", "ENERGY_FLOOR", "RELATION_FLOOR", "phlw_gates"]
+from gridshell.measure.quality import Gate
+
+__all__ = ["ANGLE_FLOOR_DEG", "ENERGY_FLOOR", "RELATION_FLOOR", "phlw_gates"]
 
 #: E_PHLW below this per sample (dimensionless; an RMS residual of 1e-3) counts as zero
 ENERGY_FLOOR = 1e-6
@@ -29,22 +32,19 @@ RELATION_FLOOR = 1e-2
 ANGLE_FLOOR_DEG = 0.5
 
 
-@dataclass(frozen=True)
-class Check:
-    """One figure of the PHLW step: ``line()`` like :meth:`gridshell.measure.quality.Gate.line`."""
+def __getattr__(name: str) -> Any:
+    if name == "Check":
+        warnings.warn("gridshell.ncp.phlw.gates.Check is gridshell.measure.quality.Gate now: "
+                      "Gate(name, label, held=ok, detail=detail); Check goes in the next "
+                      "release", DeprecationWarning, stacklevel=2)
+        return _check
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
-    name: str
-    label: str
-    ok: bool
-    detail: str
 
-    def line(self) -> str:
-        """``"pass  E_PHLW not higher than at the start: 2.0e+03 -> 1.2e+02"``."""
-        return f"{'pass' if self.ok else 'FAIL'}  {self.label}: {self.detail}"
-
-    def as_dict(self) -> dict[str, Any]:
-        return {"name": self.name, "label": self.label, "ok": self.ok, "detail": self.detail,
-                "line": self.line()}
+def _check(name: str, label: str, ok: bool, detail: str) -> Gate:
+    """The :class:`~gridshell.measure.quality.Gate` the former ``Check(name, label, ok,
+    detail)`` made."""
+    return Gate(name, label, held=bool(ok), detail=detail)
 
 
 def _num(m: Mapping[str, Any], *keys: str) -> float:
@@ -58,20 +58,20 @@ def _num(m: Mapping[str, Any], *keys: str) -> float:
 
 
 def _not_higher(name: str, label: str, a: float, b: float, floor: float, unit: str = ""
-                ) -> Check:
+                ) -> Gate:
     ok = math.isfinite(b) and (b <= max(a, floor) if math.isfinite(a) else b <= floor)
     rel = "<=" if ok else ">"
     ref = f"start {a:.3g}{unit}" + (f", floor {floor:g}{unit}" if not (a >= floor) else "")
-    return Check(name, label, ok, f"{a:.3g}{unit} -> {b:.3g}{unit} ({rel} {ref})")
+    return _check(name, label, ok, f"{a:.3g}{unit} -> {b:.3g}{unit} ({rel} {ref})")
 
 
 def phlw_gates(before: Mapping[str, Any], after: Mapping[str, Any], converged: bool,
-               samples: int = 1) -> list[Check]:
+               samples: int = 1) -> list[Gate]:
     """The gates of a PHLW step from its figures before and after the optimization
     (``{"E_PHLW": {"total"}, "relation_max_rel", "angle_max_deg"}``) on ``samples``
     optimization samples. A figure that is missing or not finite fails."""
     return [
-        Check("converged", "optimizer converged", bool(converged),
+        _check("converged", "optimizer converged", bool(converged),
               "yes" if converged else "no (its iteration limits ran out first)"),
         _not_higher("energy", "E_PHLW not higher than at the start",
                     _num(before, "E_PHLW", "total"), _num(after, "E_PHLW", "total"),

@@ -5,7 +5,7 @@ Everything the page draws, in metres, as little-endian float32 / uint32 arrays i
 
 - the **surface** (``surface.obj``, triangulated);
 - the **strips**: each lamella axis resampled to ``m`` points by arc length and swept by the
-  real section (:func:`gridshell.render.section.bundle_section`) into a closed solid
+  real section (:func:`gridshell.design.section.resolve_section`) into a closed solid
   (:func:`gridshell.geometry.strips3d.strip_solid`), one vertex array per **state** of the alignment
   sequence (``sequence/frame_*.obj``, else the deployed and the aligned joints), one face array;
 - the **joints** of every state and the **net-loops** (quads of joint indices) with their
@@ -37,7 +37,7 @@ from gridshell.geometry.net import polyline_arclength
 from gridshell.geometry.strips3d import (is_tangent, nearest_vertex_normals, packed_strip_frames, strip_frames,
                          strip_solid_faces)
 from gridshell.geometry.vectors import row_norms, unit_rows as _unit
-from gridshell.render.section import bundle_section
+from gridshell.design.section import resolve_section
 
 __all__ = ["encode", "decode", "build_scene", "scene_json", "strip_solids_vertices",
            "MAX_SAMPLES", "MAX_STATES"]
@@ -290,7 +290,7 @@ def build_scene(bundle_dir: str | os.PathLike) -> dict[str, Any]:
 
     d = Path(bundle_dir)
     b = read_bundle(d)
-    section = bundle_section(d)
+    section = resolve_section(d)
     w, t = section.width_m, section.thickness_m
     tangent = is_tangent(b.kind)
     net = b.net
