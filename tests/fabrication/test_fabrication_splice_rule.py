@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from fab_cases import make_bundle
+from tests.helpers.fab_cases import make_bundle
 
 from gridshell.core.errors import InputError
 from gridshell.fabrication import FabParams
