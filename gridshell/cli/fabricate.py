@@ -63,7 +63,9 @@ def add_args(p: argparse.ArgumentParser) -> None:
     g.add_argument("--overlap", type=float, default=None,
                    help="splice overlap of lamellae split to fit a sheet, mm (default: at a joint, "
                         "one joint spacing plus two margins, so the pieces share two joints; "
-                        "between joints, two widths plus two margins)")
+                         "between joints, two widths plus two margins); every splice holds "
+                         "by two shared joints or two fasteners (one would be a hinge): a "
+                         "lamella no such splice cuts is refused")
     g.add_argument("--kerf", type=float, default=FabParams.kerf,
                    help="laser kerf, mm: outlines move out and holes in by kerf/2 (default "
                         f"{FabParams.kerf:g}: off)")
