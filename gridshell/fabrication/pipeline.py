@@ -95,7 +95,8 @@ def plan_parts(bundle: DesignBundle, params: FabParams,
 def fabricate(bundle: str | Path | DesignBundle, out_dir: str | Path,
               params: FabParams | dict[str, Any] | None = None,
               progress: Callable[[str], None] | None = None,
-              plan: bool = True, keep_layout: bool = False) -> dict[str, Any]:
+              plan: bool = True, keep_layout: bool = False,
+              structure: dict[str, Any] | None = None) -> dict[str, Any]:
     """Write cut files, cut list and plan of a design bundle to ``out_dir``.
 
     Parameters
@@ -112,23 +113,18 @@ def fabricate(bundle: str | Path | DesignBundle, out_dir: str | Path,
         Draw plan.png / plan.svg (the slowest step; off for quick checks).
     keep_layout : bool
         Also return the :class:`~gridshell.fabrication.nesting.Layout` under ``"layout"`` (not written).
+    structure : dict, optional
+        The structural verdict of these strips, computed by the caller (the API and the CLI:
+        ``verdict``, ``line``, ``max_utilisation``, ...); recorded as ``"structure"``.
 
     Returns
     -------
     dict
         The report also written to ``fabrication.json``: parameters, counts, utilisation,
-        split lamellae, files (``previews``: the sheet PNGs), and each piece's sheet and
-        placement (the rigid motion from strip coordinates, see :mod:`gridshell.fabrication.axis`, to
-        the sheet; mm and degrees).
+        split lamellae, files (``previews``: the sheet PNGs), the structural verdict, and each
+        piece's sheet and placement (the rigid motion from strip coordinates, see
+        :mod:`gridshell.fabrication.axis`, to the sheet; mm and degrees).
     """
-    # the writers (ezdxf, the previews, the cut list): only for writing, plan_parts does
-    # without them
-    from gridshell.fabrication.cutlist import cutlist_rows, write_cutlist
-    from gridshell.fabrication.dxf import write_sheet_dxf
-    from gridshell.fabrication.plan import write_plan
-    from gridshell.fabrication.preview import write_sheet_png
-    from gridshell.fabrication.svg import write_sheet_svg
-
     say = progress or (lambda msg: None)
     if params is None:
         params = FabParams()
@@ -143,17 +139,32 @@ def fabricate(bundle: str | Path | DesignBundle, out_dir: str | Path,
     _check_out(out, bundle_dir)
     parts, layout, info = plan_parts(bundle, params, say)
     params = info["params"]  # joints engraved as marks where holes would merge
+    report = fabrication_report(bundle, parts, layout, info, plan)
+    report["structure"] = structure
+    say(f"writing {out}")
+    write_fabrication(out, bundle, layout, params, report, plan, say)
+    report["out"] = str(out)
+    if keep_layout:
+        report["layout"] = layout
+    return report
+
+
+def sheet_names(n_sheets: int) -> list[str]:
+    """``sheet_01``, ``sheet_02``, ...: the stems of the sheets' files."""
+    return [f"sheet_{k + 1:02d}" for k in range(n_sheets)]
+
+
+def fabrication_report(bundle: DesignBundle, parts: list[Part], layout: Layout, info: dict,
+                       plan: bool) -> dict[str, Any]:
+    """The content of ``fabrication.json`` (:func:`fabricate`'s return) for the parts and
+    layout of :func:`plan_parts`; lengths in mm of the model."""
+    params = info["params"]
     W, H = params.sheet
     area = sum(p.area for p in parts)
-    util = area / (layout.n_sheets * W * H)
-    per_sheet = [sum(p.area for p in layout.on_sheet(k)) / (W * H) for k in range(layout.n_sheets)]
-    names = [f"sheet_{k + 1:02d}" for k in range(layout.n_sheets)]
-    previews = [f"{n}.png" for n in names]
+    names = sheet_names(layout.n_sheets)
     files = [f"{n}{ext}" for n in names for ext in (".dxf", ".svg", ".png")]
     files += ["cutlist.csv"] + (["plan.png", "plan.svg"] if plan else []) + [REPORT, MANIFEST]
-    mm = params.mm_per_m
-    axis_lengths = {int(lam.id): lam.length * mm for lam in bundle.net.lamellae}
-    report = {
+    return {
         "kind": bundle.kind,
         "shape": info["strips"][0].axis.kind,
         "params": params.to_json(),
@@ -162,8 +173,9 @@ def fabricate(bundle: str | Path | DesignBundle, out_dir: str | Path,
         "n_sheets": layout.n_sheets,
         "n_joint_marks": int(sum(len(p.strip.joint_s) for p in parts)),
         "n_design_joints": int(sum(len(lam.joints) for lam in bundle.net.lamellae)),
-        "utilisation": util,
-        "utilisation_per_sheet": per_sheet,
+        "utilisation": area / (layout.n_sheets * W * H),
+        "utilisation_per_sheet": [sum(p.area for p in layout.on_sheet(k)) / (W * H)
+                                  for k in range(layout.n_sheets)],
         "material_used": layout.used(),
         "material_used_per_sheet": [layout.used(k) for k in range(layout.n_sheets)],
         "pieces_split": info["split"],
@@ -172,16 +184,32 @@ def fabricate(bundle: str | Path | DesignBundle, out_dir: str | Path,
         "radius_mm": info["strips"][0].axis.radius,
         "sheet_files": "one DXF and one SVG per sheet, and a PNG preview of each",
         "files": files,
-        "previews": previews,
+        "previews": [f"{n}.png" for n in names],
         "pieces": [{"lamella": p.strip.lamella, "piece": p.strip.piece,
                     "n_pieces": p.strip.n_pieces, "sheet": s + 1,
                     "flat_length_mm": p.strip.length, "s0": p.strip.s0,
                     "motion": p.motion.to_json()}
                    for p, s in zip(layout.parts, layout.sheet_of)],
     }
-    say(f"writing {out}")
+
+
+def write_fabrication(out: Path, bundle: DesignBundle, layout: Layout, params: FabParams,
+                      report: dict[str, Any], plan: bool,
+                      say: Callable[[str], None]) -> None:
+    """Write the sheets (DXF, SVG, PNG), the cut list, the plan and ``report`` into ``out``
+    at once (:func:`gridshell.core.atomic.atomic_dir`)."""
+    # the writers (ezdxf, the previews, the cut list): only for writing, plan_parts does
+    # without them
+    from gridshell.fabrication.cutlist import cutlist_rows, write_cutlist
+    from gridshell.fabrication.dxf import write_sheet_dxf
+    from gridshell.fabrication.plan import write_plan
+    from gridshell.fabrication.preview import write_sheet_png
+    from gridshell.fabrication.svg import write_sheet_svg
+
+    W, H = params.sheet
+    axis_lengths = {int(lam.id): lam.length * params.mm_per_m for lam in bundle.net.lamellae}
     with atomic_dir(out, owner=OWNER, kind=f"fabrication of a {bundle.kind} design") as tmp:
-        for k, name in enumerate(names):
+        for k, name in enumerate(sheet_names(layout.n_sheets)):
             sp = layout.on_sheet(k)
             write_sheet_dxf(tmp / f"{name}.dxf", sp, (W, H), params)
             write_sheet_svg(tmp / f"{name}.svg", sp, (W, H), params,
@@ -198,10 +226,6 @@ def fabricate(bundle: str | Path | DesignBundle, out_dir: str | Path,
         (tmp / REPORT).write_text(json.dumps(finite_json(report), indent=1, allow_nan=False,
                                              default=_json_default),
                                   encoding="utf-8")
-    report["out"] = str(out)
-    if keep_layout:
-        report["layout"] = layout
-    return report
 
 
 def sheet_title(name: str, n_parts: int, params: FabParams) -> str:
