@@ -129,8 +129,6 @@ def _turns(P: np.ndarray) -> np.ndarray:
 def _running_median(x: np.ndarray, s: np.ndarray, window: float) -> np.ndarray:
     """The median of ``x`` over ``window`` of arc length around each sample (NaN ends filled
     from their neighbours)."""
-    from scipy.ndimage import median_filter
-
     x = np.asarray(x, float).copy()
     ok = np.isfinite(x)
     if not ok.any():
@@ -138,7 +136,12 @@ def _running_median(x: np.ndarray, s: np.ndarray, window: float) -> np.ndarray:
     x[~ok] = np.interp(np.flatnonzero(~ok), np.flatnonzero(ok), x[ok])
     h = float(np.median(np.diff(s))) if len(s) > 1 else 1.0
     n = int(min(len(x), max(3, round(window / max(h, 1e-12))))) | 1
-    return median_filter(x, size=n, mode="nearest")
+    if n > len(x):
+        n -= 2
+    if n < 3:
+        return x
+    padded = np.pad(x, n // 2, mode="edge")
+    return np.median(np.lib.stride_tricks.sliding_window_view(padded, n), axis=1)
 
 
 def _hairpin(P: np.ndarray, s: np.ndarray, window: float) -> tuple[float, float]:
@@ -147,19 +150,16 @@ def _hairpin(P: np.ndarray, s: np.ndarray, window: float) -> tuple[float, float]
     d = np.diff(P, axis=0)
     t = d / np.linalg.norm(d, axis=1)[:, None]
     sm = 0.5 * (s[:-1] + s[1:])
-    best, where = 0.0, 0.0
-    j = 0
-    for i in range(len(t)):                      # two-pointer sweep: O(k * window samples)
-        while j < len(t) and sm[j] - sm[i] <= window:
-            j += 1
-        if j - i < 2:
-            continue
-        c = np.clip(t[i + 1:j] @ t[i], -1.0, 1.0)
-        k = int(np.argmin(c))
-        ang = math.degrees(math.acos(c[k]))
-        if ang > best:
-            best, where = ang, 0.5 * (sm[i] + sm[i + 1 + k])
-    return best, where
+    best, where = 1.0, 0.0                   # the smallest cosine and where
+    for k in range(1, len(t)):               # segment pairs k apart, all at once
+        near = sm[k:] - sm[:-k] <= window
+        if not near.any():
+            break
+        c = np.where(near, (t[k:] * t[:-k]).sum(1), 1.0)
+        i = int(np.argmin(c))
+        if c[i] < best:
+            best, where = float(c[i]), 0.5 * (sm[i] + sm[i + k])
+    return math.degrees(math.acos(max(-1.0, min(1.0, best)))), where
 
 
 def _loop(P: np.ndarray, s: np.ndarray, width: float) -> tuple[float, float] | None:
