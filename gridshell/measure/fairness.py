@@ -56,7 +56,11 @@ HAIRPIN_WIDTHS = 3.0
 BEND_WIDTHS = 1.0
 #: axis samples farther than this from the design's surface (% of the diagonal) are off it
 OFF_SURFACE = 2.0
-#: a loop folds when its vector area turns by more than this between states (degrees) ...
+#: an axis that turns less than this in all (degrees) cannot come back within w/2 of itself
+#: after pi w of arc: its tangents stay within 80.9 degrees of the middle one, so the chord of
+#: any stretch of length L is at least L cos(80.9) = L / (2 pi) > w / 2 (the search is skipped)
+LOOP_TURNING_DEG = 160.0
+#: a net-loop folds when its vector area points more than this (degrees) away from a neighbour's ...
 FOLD_DEG = 150.0
 #: ... while its area is at least this share of its deployed area
 FOLD_MIN_AREA = 0.25
@@ -213,7 +217,8 @@ def lamella_fairness(lamella_id: int, axis: np.ndarray, normals: np.ndarray, *,
         int(lamella_id), float(r_in[i_in]) if np.isfinite(r_in[i_in]) else math.inf,
         float(s[i_in]), float(r[i_r]) if np.isfinite(r[i_r]) else math.inf, float(s[i_r]),
         float(np.nanmax(jump)) if jump.size and np.isfinite(jump).any() else nan,
-        float(turns[i_c]), float(s[i_c + 1]), hp, s_hp, _loop(P, s, width), off, s_off)
+        float(turns[i_c]), float(s[i_c + 1]), hp, s_hp,
+        _loop(P, s, width) if turns.sum() >= LOOP_TURNING_DEG else None, off, s_off)
 
 
 def _loop_pairs(Q: np.ndarray) -> np.ndarray:
