@@ -71,7 +71,8 @@ def demand_from(ks: list[StripCurvatures], lamella_ids: list[int], scale: float,
     model at ``scale``, as :func:`gridshell.structure.check.deployed_curvatures` gives them) and
     of the judged states of ``states`` (``check_bundle``'s ``"states"``: their largest
     curvatures on the model at ``scale``, the envelope rows)."""
-    ids = [np.full(len(k.weak), int(i)) for i, k in zip(lamella_ids, ks)]
+    # lamella ids as Python ints (a bundle's ids are any integers, not only int64's)
+    ids = [np.full(len(k.weak), int(i), dtype=object) for i, k in zip(lamella_ids, ks)]
     w = [k.weak * scale for k in ks]
     s = [k.strong * scale for k in ks]
     t = [k.twist * scale for k in ks]
@@ -81,11 +82,11 @@ def demand_from(ks: list[StripCurvatures], lamella_ids: list[int], scale: float,
             w.append(np.array([f["max_weak_curvature_per_m"] * scale]))
             s.append(np.array([f["max_strong_curvature_per_m"] * scale]))
             t.append(np.array([f["max_twist_rad_per_m"] * scale]))
-            ids.append(np.array([int(f["worst_lamella"])]))
+            ids.append(np.array([int(f["worst_lamella"])], dtype=object))
             names.append(f["name"])
     cat = lambda a: np.concatenate(a) if a else np.zeros(0)  # noqa: E731
     return Demand(cat(w), cat(s), cat(t), np.asarray(names, dtype=object),
-                  cat(ids).astype(np.int64))
+                  np.concatenate(ids) if ids else np.zeros(0, dtype=object))
 
 
 def utilisation(demand: Demand, material: Material, section: Section) -> np.ndarray:
