@@ -175,18 +175,30 @@ def verify(path: str | os.PathLike) -> dict[str, Any]:
 
 
 def fabricate(design: Any, out_dir: str | os.PathLike, params: Any = None, *,
-              force: bool = False, plan: bool = True, progress: Progress = None
-              ) -> dict[str, Any]:
+              force: bool = False, plan: bool = True, progress: Progress = None,
+              material: str | None = None) -> dict[str, Any]:
     """Cut files (DXF, SVG, PNG per sheet), cut list and plan of a design into ``out_dir``
     (:func:`gridshell.fabrication.pipeline.fabricate`; ``params``: a FabParams or a dict of its fields,
     mm of the model). A design that fails its figures (recomputed from the files of a bundle
-    directory) is refused with :class:`~gridshell.core.errors.InputError` unless ``force``."""
+    directory) is refused with :class:`~gridshell.core.errors.InputError`, one whose strips of
+    ``material`` (a preset name; default the strips' default material) would be overstressed
+    with :class:`~gridshell.structure.verdict.Overstressed`, unless ``force``; the structural
+    verdict is the report's ``"structure"``."""
+    from gridshell.fabrication.params import FabParams
     from gridshell.fabrication.pipeline import fabricate as _fabricate
+    from gridshell.structure import Section, get_material
+    from gridshell.design.section import DEFAULTS
+    from gridshell.structure.verdict import require_elastic, verdict_record
 
     bundle = design if isinstance(design, (str, os.PathLike)) else _parts(design)[0]
-    require_design(Path(bundle) if isinstance(bundle, (str, os.PathLike)) else bundle, force,
-                   "fabricate(..., force=True) cuts it anyway")
-    return _fabricate(bundle, out_dir, params, progress=progress, plan=plan)
+    where = Path(bundle) if isinstance(bundle, (str, os.PathLike)) else bundle
+    require_design(where, force, "fabricate(..., force=True) cuts it anyway")
+    fp = params if isinstance(params, FabParams) else FabParams(**(params or {}))
+    res = require_elastic(where, get_material(material or DEFAULTS["material"]),
+                          Section.from_params(fp), force,
+                          "fabricate(..., force=True) cuts it anyway")
+    return _fabricate(bundle, out_dir, fp, progress=progress, plan=plan,
+                      structure=verdict_record(res, force))
 
 
 #: the names the API takes from their modules as they are (the very functions, real signatures),

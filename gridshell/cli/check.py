@@ -50,6 +50,10 @@ def add_args(p: argparse.ArgumentParser) -> None:
                         "sequence)")
     p.add_argument("--no-picture", action="store_true",
                    help="do not draw DIR/structure.png (the strips coloured by utilisation)")
+    p.add_argument("--suggest", action="store_true",
+                   help="also print the sections of the material that hold (its stock "
+                        "thicknesses, the widths that stay elastic at the scale) and the "
+                        "smallest model scale at which this strip holds")
     p.add_argument("--top", type=int, default=12, metavar="N",
                    help="lamellae listed in the table, most utilised first (default 12; 0: all)")
 
@@ -98,17 +102,50 @@ def table(result: dict[str, Any], top: int = 12) -> list[str]:
 
 
 def verdict_line(result: dict[str, Any]) -> str:
-    """One line: the verdict, the governing utilisation and where."""
-    w = result["worst"]
-    sec = result["section"]
-    what = (f"{sec['width_mm']:g} x {sec['thickness_mm']:g} mm {result['material']['name']} "
-            f"at {sec['scale_text']}")
-    state = result["governing_state"]
-    where = (f"lamella {w['lamella']} at s = {w['s_m']:.3f} m (joint {w['joint']})"
-             if state == "deployed" else f"state {state}")
-    word = "ok" if result["verdict"] == "ok" else "OVERSTRESSED"
-    return (f"{word}: {what}, max utilisation {result['max_utilisation']:.2f} ({where}); "
-            f"thickest elastic strip {result['max_elastic_thickness_mm']:.2f} mm")
+    """One line: the verdict, the governing utilisation and where, what governs and what
+    would hold (:func:`gridshell.structure.verdict.verdict_line`)."""
+    from gridshell.structure.verdict import verdict_line as line
+
+    return line(result)
+
+
+def suggest_rows(bundle, result: dict[str, Any], material, section) -> list[dict[str, Any]]:
+    """Per stock thickness of the material the widths that hold at this scale
+    (:func:`gridshell.structure.sizing.stock_sections` on the check's curvatures)."""
+    from gridshell.structure.check import deployed_curvatures
+    from gridshell.structure.sizing import demand_from, stock_sections
+
+    _, ks, _ = deployed_curvatures(bundle, section)
+    demand = demand_from(ks, [lam.id for lam in bundle.net.lamellae], section.scale,
+                         result["states"])
+    return stock_sections(demand, material, section)
+
+
+def suggest_lines(rows: list[dict[str, Any]], result: dict[str, Any], material,
+                  section) -> list[str]:
+    """``--suggest``'s lines: the rows of :func:`suggest_rows` and the smallest scale at which
+    this strip holds."""
+    from gridshell.structure.sizing import MIN_EDGE_RATIO
+
+    sc = result["section"]["scale_text"]
+    lines = [f"  suggest   {material.name} sections that hold at {sc} (stock thicknesses; "
+             f"widths of the R10 series from {MIN_EDGE_RATIO:g} thicknesses; every state "
+             "checked on its largest curvatures):"]
+    for row in rows:
+        t, ws = row["thickness_mm"], row["widths_mm"]
+        if ws:
+            lines.append(f"    {t:g} mm thick: {ws[0]:g} to {ws[-1]:g} mm wide (widest "
+                         f"{row['widest_mm']:.1f} mm; utilisation {row['utilisation']:.2f} at "
+                         f"{t:g} x {ws[-1]:g} mm)")
+        else:
+            lines.append(f"    {t:g} mm thick: none" + (
+                f" (widest elastic strip {row['widest_mm']:.1f} mm, narrower than "
+                f"{MIN_EDGE_RATIO:g} thicknesses)" if row["widest_mm"] > 0 else ""))
+    adv = result["advice"]
+    lines.append(f"  scale     this {section.width_mm:g} x {section.thickness_mm:g} mm strip "
+                 f"holds at {adv['smallest_scale_text']} or a larger model (the smallest "
+                 "model that stays elastic)")
+    return lines
 
 
 def run(args: Any) -> int:
@@ -125,13 +162,21 @@ def run(args: Any) -> int:
                           thickness=args.thickness, scale=args.scale,
                           states=not args.no_states, picture=not args.no_picture,
                           progress=progress.callback)
+    from gridshell.design.bundle import read_bundle
+    from gridshell.structure.section import Section
+
     res, material, out, picture = chk.result, chk.material, chk.file, chk.picture
     code = 0 if res["verdict"] == "ok" else OVERSTRESSED
+    section = Section(chk.section.width_mm, chk.section.thickness_mm, chk.section.scale)
+    rows = (suggest_rows(read_bundle(args.bundle), res, material, section) if args.suggest
+            else None)
     if getattr(args, "json", False):
         summary = {k: v for k, v in res.items() if k not in ("lamellae", "states")}
         summary["states"] = {k: v for k, v in res["states"].items() if k != "frames"}
         summary["file"] = str(out)
         summary["picture"] = str(picture) if picture else None
+        if rows is not None:
+            summary["suggest"] = rows
         print(json.dumps(finite_json({"ok": code == 0, **summary}), indent=1, allow_nan=False))
         return code
     print(f"Structure of {args.bundle} ({res['kind']}, {res['orientation']} strips cut "
@@ -152,9 +197,17 @@ def run(args: Any) -> int:
                   f"(a lamella turns by more than {st['fold_deg']:g} deg between joints): "
                   f"{', '.join(st['unresolved'])}: not judged (the sequence is kinematic; "
                   "where it folds its stresses mean nothing)")
+        over = [f["name"] for f in st["frames"] if f.get("approximate") and f["resolved"]
+                and f["max_utilisation"] > 1.0]
+        if over:
+            print(f"  note      utilisation above 1 in {', '.join(over)}: "
+                  f"{st['approximate_path']}")
+    if rows is not None:
+        print("\n".join(suggest_lines(rows, res, material, section)))
     print(f"  files     {out}" + (f", {picture}" if picture else ""))
     print(verdict_line(res))
     if code and not getattr(args, "quiet", False):
-        print("gridshell check: overstressed (exit 4); a thinner strip, a larger scale or a "
-              "stronger material help", file=sys.stderr)
+        print("gridshell check: overstressed (exit 4); " + (res["advice"]["helps"] or "")
+              + ", as does a larger scale or a stronger material ('--suggest' lists the "
+              "sections that hold)", file=sys.stderr)
     return code

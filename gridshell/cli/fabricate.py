@@ -63,7 +63,9 @@ def add_args(p: argparse.ArgumentParser) -> None:
     g.add_argument("--overlap", type=float, default=None,
                    help="splice overlap of lamellae split to fit a sheet, mm (default: at a joint, "
                         "one joint spacing plus two margins, so the pieces share two joints; "
-                        "between joints, two widths plus two margins)")
+                         "between joints, two widths plus two margins); every splice holds "
+                         "by two shared joints or two fasteners (one would be a hinge): a "
+                         "lamella no such splice cuts is refused")
     g.add_argument("--kerf", type=float, default=FabParams.kerf,
                    help="laser kerf, mm: outlines move out and holes in by kerf/2 (default "
                         f"{FabParams.kerf:g}: off)")
@@ -74,30 +76,36 @@ def add_args(p: argparse.ArgumentParser) -> None:
                    help="write arcs as short segments instead of bulges")
     g.add_argument("--no-labels", action="store_true", help="do not engrave ids")
     p.add_argument("--material", default=None, metavar="NAME",
-                   help="strip material for the stress warning (gridshell check's presets; "
-                        f"default {DEFAULTS['material']})")
+                   help="strip material of the structural check (gridshell check's presets; "
+                        f"default {DEFAULTS['material']}): strips that would not stay elastic "
+                        "are not cut")
     p.add_argument("--no-plan", action="store_true", help="do not draw plan.png / plan.svg")
     p.add_argument("--force", action="store_true",
                    help="cut a design whose recomputed figures miss the paper's thresholds, or "
                         "whose files disagree with design.json ('gridshell verify' lists them; "
-                        "default: refused, exit 2)")
+                        "default: refused, exit 2), or whose strips would be overstressed in "
+                        "the material ('gridshell check'; default: refused, exit 4)")
 
 
-def _structure_warning(bundle: str, params, material: str | None, progress) -> str | None:
-    """The warning of :func:`gridshell.structure.check.overstress_warning` for these strips
-    (deployed and collapsed states, the sequence too when the bundle has one;
-    :func:`gridshell.api.check_structure`, nothing written)."""
+def _structure(bundle: str, params, material: str, force: bool,
+               progress) -> dict[str, Any]:
+    """The structural verdict of these strips before any file is written
+    (:func:`gridshell.api.check_structure`, nothing written: deployed and collapsed states, the
+    sequence too when the bundle has one): refused (exit 4,
+    :func:`gridshell.structure.verdict.refuse_overstressed`) when overstressed, unless
+    ``force``; the record ``fabrication.json`` keeps."""
     from gridshell.api import check_structure
-    from gridshell.structure.check import overstress_warning
+    from gridshell.structure.verdict import refuse_overstressed, verdict_record
 
     progress("checking the strips' stresses")
     res = check_structure(bundle, material=material, width=params.width,
                           thickness=params.thickness, scale=params.scale, write=False,
                           picture=False).result
-    warning = overstress_warning(res)
-    if warning:
-        progress(f"warning: {warning}")
-    return warning
+    refuse_overstressed(res, force, "pass --force to cut it anyway ('gridshell check "
+                        "--suggest' lists the sections that hold)")
+    if res["verdict"] != "ok":
+        progress("warning: the strips are overstressed; cut anyway (--force)")
+    return verdict_record(res, force)
 
 
 def run(args: Any) -> int:
@@ -133,7 +141,9 @@ def run(args: Any) -> int:
                              "them - pass --force to cut it anyway")
     if not verdict.ok:
         progress("warning: the design fails its checks; cut anyway (--force)")
-    rep = fabricate(args.bundle, out, params, progress=progress.callback, plan=not args.no_plan)
+    structure = _structure(args.bundle, params, strip.material, args.force, progress)
+    rep = fabricate(args.bundle, out, params, progress=progress.callback, plan=not args.no_plan,
+                    structure=structure)
     from gridshell.measure.quality import gate_summary
 
     gates = list(verdict.gates)
@@ -155,9 +165,8 @@ def run(args: Any) -> int:
                                   for d in rep["pieces_split"]) or "none",
         "files": ", ".join(rep["files"]),
     }
-    structure = _structure_warning(args.bundle, params, strip.material, progress)
-    if structure:
-        summary["warning (structure)"] = structure
+    summary["structure"] = (("cut with --force: " if structure["forced"] else "")
+                            + structure["line"])
     if rep["joints_fallback"]:
         summary["warning"] = rep["joints_fallback"]
     if rep["labels_dropped"]:

@@ -95,7 +95,8 @@ def plan_parts(bundle: DesignBundle, params: FabParams,
 def fabricate(bundle: str | Path | DesignBundle, out_dir: str | Path,
               params: FabParams | dict[str, Any] | None = None,
               progress: Callable[[str], None] | None = None,
-              plan: bool = True, keep_layout: bool = False) -> dict[str, Any]:
+              plan: bool = True, keep_layout: bool = False,
+              structure: dict[str, Any] | None = None) -> dict[str, Any]:
     """Write cut files, cut list and plan of a design bundle to ``out_dir``.
 
     Parameters
@@ -112,37 +113,19 @@ def fabricate(bundle: str | Path | DesignBundle, out_dir: str | Path,
         Draw plan.png / plan.svg (the slowest step; off for quick checks).
     keep_layout : bool
         Also return the :class:`~gridshell.fabrication.nesting.Layout` under ``"layout"`` (not written).
+    structure : dict, optional
+        The structural verdict of these strips, computed by the caller (the API and the CLI:
+        ``verdict``, ``line``, ``max_utilisation``, ...); recorded as ``"structure"``.
 
     Returns
     -------
     dict
         The report also written to ``fabrication.json``: parameters, counts, utilisation,
-        split lamellae, files (``previews``: the sheet PNGs), and each piece's sheet and
-        placement (the rigid motion from strip coordinates, see :mod:`gridshell.fabrication.axis`, to
-        the sheet; mm and degrees).
+        split lamellae, files (``previews``: the sheet PNGs), the structural verdict, and each
+        piece's sheet and placement (the rigid motion from strip coordinates, see
+        :mod:`gridshell.fabrication.axis`, to the sheet; mm and degrees).
     """
     say = progress or (lambda msg: None)
-    bundle, bundle_dir, params = _fabrication_inputs(bundle, params, say)
-    out = Path(out_dir)
-    _check_out(out, bundle_dir)
-    parts, layout, info = plan_parts(bundle, params, say)
-    params = info["params"]  # joints engraved as marks where holes would merge
-    names = [f"sheet_{k + 1:02d}" for k in range(layout.n_sheets)]
-    report = _fabrication_report(bundle, parts, layout, info, params, names, plan)
-    say(f"writing {out}")
-    _write_fabrication(out, bundle, layout, params, names, report, plan, say)
-    report["out"] = str(out)
-    if keep_layout:
-        report["layout"] = layout
-    return report
-
-
-def _fabrication_inputs(bundle: str | Path | DesignBundle,
-                        params: FabParams | dict[str, Any] | None,
-                        say: Callable[[str], None]
-                        ) -> tuple[DesignBundle, Path | None, FabParams]:
-    """The bundle (read from its directory if a path), its directory (None for a bundle
-    object) and the parameters (defaults for None, a dict as FabParams fields)."""
     if params is None:
         params = FabParams()
     elif isinstance(params, dict):
@@ -152,15 +135,33 @@ def _fabrication_inputs(bundle: str | Path | DesignBundle,
         bundle_dir = Path(bundle)
         say(f"reading {bundle_dir}")
         bundle = read_bundle(bundle_dir)
-    return bundle, bundle_dir, params
+    out = Path(out_dir)
+    _check_out(out, bundle_dir)
+    parts, layout, info = plan_parts(bundle, params, say)
+    params = info["params"]  # joints engraved as marks where holes would merge
+    report = fabrication_report(bundle, parts, layout, info, plan)
+    report["structure"] = structure
+    say(f"writing {out}")
+    write_fabrication(out, bundle, layout, params, report, plan, say)
+    report["out"] = str(out)
+    if keep_layout:
+        report["layout"] = layout
+    return report
 
 
-def _fabrication_report(bundle: DesignBundle, parts: list, layout: Any, info: dict[str, Any],
-                        params: FabParams, names: list[str], plan: bool) -> dict[str, Any]:
-    """fabrication.json's content: parameters, counts, utilisation, split lamellae, the files
-    and each piece's sheet and placement (mm, degrees)."""
+def sheet_names(n_sheets: int) -> list[str]:
+    """``sheet_01``, ``sheet_02``, ...: the stems of the sheets' files."""
+    return [f"sheet_{k + 1:02d}" for k in range(n_sheets)]
+
+
+def fabrication_report(bundle: DesignBundle, parts: list[Part], layout: Layout, info: dict,
+                       plan: bool) -> dict[str, Any]:
+    """The content of ``fabrication.json`` (:func:`fabricate`'s return) for the parts and
+    layout of :func:`plan_parts`; lengths in mm of the model."""
+    params = info["params"]
     W, H = params.sheet
     area = sum(p.area for p in parts)
+    names = sheet_names(layout.n_sheets)
     files = [f"{n}{ext}" for n in names for ext in (".dxf", ".svg", ".png")]
     files += ["cutlist.csv"] + (["plan.png", "plan.svg"] if plan else []) + [REPORT, MANIFEST]
     return {
@@ -192,11 +193,11 @@ def _fabrication_report(bundle: DesignBundle, parts: list, layout: Any, info: di
     }
 
 
-def _write_fabrication(out: Path, bundle: DesignBundle, layout: Any, params: FabParams,
-                       names: list[str], report: dict[str, Any], plan: bool,
-                       say: Callable[[str], None]) -> None:
-    """The sheets (DXF, SVG, PNG), the cut list, the plan and fabrication.json, written into
-    ``out`` atomically."""
+def write_fabrication(out: Path, bundle: DesignBundle, layout: Layout, params: FabParams,
+                      report: dict[str, Any], plan: bool,
+                      say: Callable[[str], None]) -> None:
+    """Write the sheets (DXF, SVG, PNG), the cut list, the plan and ``report`` into ``out``
+    at once (:func:`gridshell.core.atomic.atomic_dir`)."""
     # the writers (ezdxf, the previews, the cut list): only for writing, plan_parts does
     # without them
     from gridshell.fabrication.cutlist import cutlist_rows, write_cutlist
@@ -208,7 +209,7 @@ def _write_fabrication(out: Path, bundle: DesignBundle, layout: Any, params: Fab
     W, H = params.sheet
     axis_lengths = {int(lam.id): lam.length * params.mm_per_m for lam in bundle.net.lamellae}
     with atomic_dir(out, owner=OWNER, kind=f"fabrication of a {bundle.kind} design") as tmp:
-        for k, name in enumerate(names):
+        for k, name in enumerate(sheet_names(layout.n_sheets)):
             sp = layout.on_sheet(k)
             write_sheet_dxf(tmp / f"{name}.dxf", sp, (W, H), params)
             write_sheet_svg(tmp / f"{name}.svg", sp, (W, H), params,

@@ -1,7 +1,11 @@
-"""Splitting lamellae longer than the sheet into spliced pieces (issue items 4 and 13).
+"""Splitting lamellae longer than the sheet into spliced pieces.
 
 A lamella that does not fit the sheet is cut into overlapping pieces, each as long as the
 sheet allows, by two kinds of lap splice:
+
+Every splice holds its two pieces by at least two fasteners (:data:`MIN_SHARED`): shared
+joints of a joint splice, the two fasteners of a span splice; a splice of one would be a
+hinge and is never made. So no piece is shorter than its overlaps.
 
 * a **joint splice** at joint ``k``: the next piece starts one end margin before
   joint ``k`` (like any strip before its first joint) and the previous piece ends ``overlap``
@@ -34,6 +38,9 @@ from gridshell.core.errors import InputError
 from gridshell.fabrication.joints import feature_halfwidth
 from gridshell.fabrication.params import FabParams
 from gridshell.fabrication.strip import Strip
+
+#: joints (or fasteners) every splice's two pieces share: one would be a hinge
+MIN_SHARED = 2
 
 
 def chord_frame(strip: Strip) -> tuple[np.ndarray, np.ndarray]:
@@ -82,6 +89,8 @@ def _joint_splices(strip: Strip, params: FabParams, start: float, first: int,
             break
         nxt = js[k] - m
         shared = [int(i) for i in np.flatnonzero((js >= nxt - 1e-9) & (js <= end + 1e-9))]
+        if len(shared) < MIN_SHARED:
+            continue                    # one shared joint would be a hinge
         found.append({"kind": "joint", "overlap": float(ov), "from": float(nxt),
                       "to": float(end), "splice_joint": int(k), "splice_name": joint_name(strip, k),
                       "shared_joints": shared,
@@ -104,10 +113,16 @@ def span_overlap(params: FabParams) -> float:
 
 def span_fasteners(c: float, ov: float, params: FabParams) -> list[float]:
     """Fastener positions of the span splice overlapping ``[c, c + ov]``: one end margin
-    inside each end, or one in the middle if the two would merge."""
+    inside each end (:func:`span_overlap_holds` tells whether the two stay apart)."""
     m = params.margin
+    return [c + m, c + ov - m]
+
+
+def span_overlap_holds(params: FabParams) -> bool:
+    """Whether a span overlap has room for its two fasteners, one end margin inside each
+    end and not merging (else a span splice would be a hinge and is not made)."""
     need = 2 * feature_halfwidth(params) + 0.5
-    return [c + m, c + ov - m] if ov - 2 * m >= need else [c + ov / 2]
+    return span_overlap(params) - 2 * params.margin >= need
 
 
 def _span_splice(strip: Strip, params: FabParams, start: float,
@@ -117,6 +132,8 @@ def _span_splice(strip: Strip, params: FabParams, start: float,
     The overlap ``[c, c + ov]`` lies between two consecutive stations of ``s0, joints, s1``,
     one end margin clear of both and of ``floor`` (the end of the previous overlap)."""
     m, ov = params.margin, span_overlap(params)
+    if not span_overlap_holds(params):
+        return None
     B = np.concatenate([[strip.s0], strip.joint_s, [strip.s1]])
     fits = lambda c: fits_sheet(strip.sub(start, c + ov), params)  # noqa: E731
     best = None
@@ -193,6 +210,8 @@ def _windows(strip: Strip, params: FabParams) -> list[tuple[int, float, float]]:
     """``(i, lo, hi)``: where a span overlap may start, one end margin clear of the
     stations ``i`` and ``i + 1`` of ``s0, joints, s1``; non-empty ones, in order."""
     m, ov = params.margin, span_overlap(params)
+    if not span_overlap_holds(params):
+        return []
     B = np.concatenate([[strip.s0], strip.joint_s, [strip.s1]])
     return [(i, B[i] + m, B[i + 1] - m - ov) for i in range(len(B) - 1)
             if B[i + 1] - m - ov >= B[i] + m]
@@ -263,6 +282,17 @@ def _span_plan(strip: Strip, params: FabParams) -> list[dict] | None:
     return [_span_note(strip, params, c, i) for i, c in chosen[::-1]]
 
 
+def _why_unsplit(strip: Strip, params: FabParams) -> str:
+    """Why no splice plan exists (the reason of the refusal), one clause."""
+    if not span_overlap_holds(params):
+        return (f"a {span_overlap(params):g} mm overlap between joints leaves no room for "
+                f"two fasteners {params.margin:g} mm inside its ends, and no piece reaches "
+                "two shared joints (a splice of one shared joint would be a hinge; raise "
+                "--overlap)")
+    return ("no piece that fits reaches far enough to share two joints (or two fasteners "
+            "between joints) with the next one (a splice of one would be a hinge)")
+
+
 def split_strip(strip: Strip, params: FabParams) -> list[Strip]:
     """``[strip]`` if it fits the sheet, else its spliced pieces (numbered, with splice notes
     and, for span splices, the fasteners in ``splice_s``)."""
@@ -278,8 +308,8 @@ def split_strip(strip: Strip, params: FabParams) -> list[Strip]:
     if splices is None:
         raise InputError(
             f"lamella {strip.lamella} does not fit the {params.sheet[0]:g} x "
-            f"{params.sheet[1]:g} mm sheet even in pieces spliced between joints "
-            f"({strip.length:.1f} mm long, {strip.width:g} mm wide at this scale); use a "
+            f"{params.sheet[1]:g} mm sheet even in spliced pieces ({strip.length:.1f} mm long, "
+            f"{strip.width:g} mm wide at this scale): {_why_unsplit(strip, params)}; use a "
             "larger --sheet or a smaller --scale")
     starts = [strip.s0] + [sp["from"] for sp in splices]
     ends = [sp["to"] for sp in splices] + [strip.s1]

@@ -56,7 +56,11 @@ HAIRPIN_WIDTHS = 3.0
 BEND_WIDTHS = 1.0
 #: axis samples farther than this from the design's surface (% of the diagonal) are off it
 OFF_SURFACE = 2.0
-#: a loop folds when its vector area turns by more than this between states (degrees) ...
+#: an axis that turns less than this in all (degrees) cannot come back within w/2 of itself
+#: after pi w of arc: its tangents stay within 80.9 degrees of the middle one, so the chord of
+#: any stretch of length L is at least L cos(80.9) = L / (2 pi) > w / 2 (the search is skipped)
+LOOP_TURNING_DEG = 160.0
+#: a net-loop folds when its vector area points more than this (degrees) away from a neighbour's ...
 FOLD_DEG = 150.0
 #: ... while its area is at least this share of its deployed area
 FOLD_MIN_AREA = 0.25
@@ -129,8 +133,6 @@ def _turns(P: np.ndarray) -> np.ndarray:
 def _running_median(x: np.ndarray, s: np.ndarray, window: float) -> np.ndarray:
     """The median of ``x`` over ``window`` of arc length around each sample (NaN ends filled
     from their neighbours)."""
-    from scipy.ndimage import median_filter
-
     x = np.asarray(x, float).copy()
     ok = np.isfinite(x)
     if not ok.any():
@@ -138,7 +140,12 @@ def _running_median(x: np.ndarray, s: np.ndarray, window: float) -> np.ndarray:
     x[~ok] = np.interp(np.flatnonzero(~ok), np.flatnonzero(ok), x[ok])
     h = float(np.median(np.diff(s))) if len(s) > 1 else 1.0
     n = int(min(len(x), max(3, round(window / max(h, 1e-12))))) | 1
-    return median_filter(x, size=n, mode="nearest")
+    if n > len(x):
+        n -= 2
+    if n < 3:
+        return x
+    padded = np.pad(x, n // 2, mode="edge")
+    return np.median(np.lib.stride_tricks.sliding_window_view(padded, n), axis=1)
 
 
 def _hairpin(P: np.ndarray, s: np.ndarray, window: float) -> tuple[float, float]:
@@ -147,19 +154,16 @@ def _hairpin(P: np.ndarray, s: np.ndarray, window: float) -> tuple[float, float]
     d = np.diff(P, axis=0)
     t = d / np.linalg.norm(d, axis=1)[:, None]
     sm = 0.5 * (s[:-1] + s[1:])
-    best, where = 0.0, 0.0
-    j = 0
-    for i in range(len(t)):                      # two-pointer sweep: O(k * window samples)
-        while j < len(t) and sm[j] - sm[i] <= window:
-            j += 1
-        if j - i < 2:
-            continue
-        c = np.clip(t[i + 1:j] @ t[i], -1.0, 1.0)
-        k = int(np.argmin(c))
-        ang = math.degrees(math.acos(c[k]))
-        if ang > best:
-            best, where = ang, 0.5 * (sm[i] + sm[i + 1 + k])
-    return best, where
+    best, where = 1.0, 0.0                   # the smallest cosine and where
+    for k in range(1, len(t)):               # segment pairs k apart, all at once
+        near = sm[k:] - sm[:-k] <= window
+        if not near.any():
+            break
+        c = np.where(near, (t[k:] * t[:-k]).sum(1), 1.0)
+        i = int(np.argmin(c))
+        if c[i] < best:
+            best, where = float(c[i]), 0.5 * (sm[i] + sm[i + k])
+    return math.degrees(math.acos(max(-1.0, min(1.0, best)))), where
 
 
 def _loop(P: np.ndarray, s: np.ndarray, width: float) -> tuple[float, float] | None:
@@ -213,7 +217,8 @@ def lamella_fairness(lamella_id: int, axis: np.ndarray, normals: np.ndarray, *,
         int(lamella_id), float(r_in[i_in]) if np.isfinite(r_in[i_in]) else math.inf,
         float(s[i_in]), float(r[i_r]) if np.isfinite(r[i_r]) else math.inf, float(s[i_r]),
         float(np.nanmax(jump)) if jump.size and np.isfinite(jump).any() else nan,
-        float(turns[i_c]), float(s[i_c + 1]), hp, s_hp, _loop(P, s, width), off, s_off)
+        float(turns[i_c]), float(s[i_c + 1]), hp, s_hp,
+        _loop(P, s, width) if turns.sum() >= LOOP_TURNING_DEG else None, off, s_off)
 
 
 def _loop_pairs(Q: np.ndarray) -> np.ndarray:

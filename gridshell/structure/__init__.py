@@ -2,6 +2,8 @@
 
 Reads a design bundle and the fabrication parameters (width, thickness, scale); never imports
 a pipeline (gg/, ncp/, fabrication/) nor the CLI. SI units inside: metres, pascals, kg/m^3.
+``check`` writes structure.json; ``verdict`` judges it (and refuses cutting an overstressed
+design); ``sizing`` finds the sections and scales of a material that hold.
 
 May import: :mod:`gridshell.core`, :mod:`gridshell.geometry`, :mod:`gridshell.measure`,
 :mod:`gridshell.design`; never a pipeline, render or fabrication.

@@ -21,7 +21,8 @@ from gridshell.structure.cutshape import collapse_curvature, cut_curvature, cut_
 from gridshell.structure.frames import darboux_curvatures, surface_normals
 from gridshell.structure.materials import Material
 from gridshell.structure.section import Section
-from gridshell.structure.states import bundle_states
+from gridshell.structure.sizing import advice, demand_from
+from gridshell.structure.states import bundle_states, is_judged
 from gridshell.structure.stresses import (KIND_ORIENTATION, StripCurvatures, max_elastic_thickness,
                        strip_curvatures, strip_stresses)
 
@@ -121,7 +122,8 @@ def check_bundle(bundle: DesignBundle | str | Path, material: Material, section:
         "max_elastic_thickness_mm", "min_radius_m", "worst": {...}}``. ``verdict`` is
         ``"ok"`` when every evaluated state stays elastic (``max_utilisation <= 1``),
         ``"overstressed"`` otherwise; states of a folded sequence (``states["unresolved"]``)
-        are listed, not judged.
+        and the intermediate states of an approximate path (``states["approximate"]``) are
+        listed, not judged.
     """
     path = None if bundle_dir is None else Path(bundle_dir)
     if not isinstance(bundle, DesignBundle):
@@ -142,9 +144,10 @@ def check_bundle(bundle: DesignBundle | str | Path, material: Material, section:
         say("stresses in the collapsed state and the alignment sequence")
         out_states = bundle_states(bundle, path, section, material)
         for st in out_states["frames"]:    # the deployed state: the dense check above
-            if st["t"] > 0 and st["resolved"] and st["max_utilisation"] > u_all:
+            if st["t"] > 0 and is_judged(st) and st["max_utilisation"] > u_all:
                 governing, u_all = st["name"], st["max_utilisation"]
     finite_min = [r["min_radius_m"] for r in lams if np.isfinite(r["min_radius_m"])]
+    demand = demand_from(ks, [lam.id for lam in bundle.net.lamellae], section.scale, out_states)
     return {
         "format": "gridshell.structure", "version": 1,
         "kind": bundle.kind, "orientation": KIND_ORIENTATION[bundle.kind],
@@ -166,6 +169,7 @@ def check_bundle(bundle: DesignBundle | str | Path, material: Material, section:
                   "min_radius_m": "smallest bending radius of the real strip, metres "
                                   "(null: the strip stays straight)",
                   "curvatures": "of the real strip (model), 1/m; stresses MPa"},
+        "advice": advice(demand, material, section, u_all, governing),
         "states": out_states,
         "lamellae": lams,
     }
@@ -179,26 +183,3 @@ def write_structure_json(bundle_dir: str | Path, result: dict[str, Any]) -> Path
     out = Path(bundle_dir) / FILENAME
     write_text(out, json.dumps(finite_json(result), indent=1, allow_nan=False) + "\n")
     return out
-
-
-def overstress_warning(result: dict[str, Any]) -> str | None:
-    """One line naming the overstressed lamellae of ``result`` (:func:`check_bundle`) and where
-    the worst one is (None when every state stays elastic): what ``fabricate`` warns with."""
-    if result["verdict"] == "ok":
-        return None
-    sec = result["section"]
-    strip = (f"{sec['width_mm']:g} x {sec['thickness_mm']:g} mm {result['material']['name']} "
-             f"at {sec['scale_text']}")
-    bad = [r for r in result["lamellae"] if r["max_utilisation"] > 1.0]
-    if bad:
-        w = max(bad, key=lambda r: r["max_utilisation"])
-        more = f" ({len(bad)} lamellae above 1)" if len(bad) > 1 else ""
-        return (f"{strip} overstressed: lamella {w['id']} at s = {w['worst_s_m']:.3f} m "
-                f"(joint {w['worst_joint']}), utilisation {w['max_utilisation']:.2f} > 1{more}; "
-                f"a strip thinner than {result['max_elastic_thickness_mm']:.2f} mm stays elastic "
-                "('gridshell check' for the details)")
-    st = result["governing_state"]
-    frame = next((f for f in result["states"].get("frames", []) if f["name"] == st), {})
-    return (f"{strip} overstressed in the alignment state {st}: lamella "
-            f"{frame.get('worst_lamella')} at joint {frame.get('worst_joint')}, utilisation "
-            f"{result['max_utilisation']:.2f} > 1 ('gridshell check' for the details)")

@@ -8,6 +8,9 @@ timbers, minimum longitudinal strength of the pultruded GFRP); it carries no saf
 Strips are cut with the fibre / face grain along the lamella; the values are the ones along
 that direction. Values are typical, rounded mid-range figures of the source named in
 ``source``: measure the actual sheet for anything that will carry load.
+``sheet_thicknesses_mm`` are common stock thicknesses (polymer sheet 0.5-5 mm; aircraft birch
+plywood 0.8-3 mm and Finnish birch plywood 4-18 mm; sawn spruce boards of EN 1313-1's
+preferred thicknesses; pultruded GFRP flats; aluminium sheet), what ``check --suggest`` tries.
 """
 from __future__ import annotations
 
@@ -43,6 +46,9 @@ class Material:
         of ``allowable_stress`` and ``E * allowable_strain`` governs.
     source : str
         Where the figures come from.
+    sheet_thicknesses_mm : tuple of float
+        Thicknesses the material is sold in (sheets, boards, pultruded flats), mm: the
+        sections ``gridshell check --suggest`` tries.
     """
 
     name: str
@@ -54,6 +60,7 @@ class Material:
     allowable_stress: float
     allowable_strain: float | None = None
     source: str = ""
+    sheet_thicknesses_mm: tuple[float, ...] = ()
 
     def __post_init__(self) -> None:
         for key in ("E", "G", "density", "allowable_stress"):
@@ -100,38 +107,45 @@ MATERIALS: dict[str, Material] = {m.name: m for m in (
              density=905.0, allowable_stress=32e6,
              source="MatWeb, 'Overview of materials for Polypropylene, Homopolymer': tensile "
                     "modulus 1.1-2.0 GPa, yield 31-37 MPa, density 0.90-0.91 g/cm3; Poisson "
-                    "0.42 (Ashby, Materials Selection in Mechanical Design, PP record)"),
+                    "0.42 (Ashby, Materials Selection in Mechanical Design, PP record)",
+             sheet_thicknesses_mm=(0.5, 0.8, 1.0, 1.5, 2.0, 3.0, 4.0, 5.0)),
     Material("petg", "PETG (amorphous copolyester sheet)", E=2.0e9, G=_iso_G(2.0e9, 0.38),
              nu=0.38, density=1270.0, allowable_stress=50e6,
              source="Eastman Eastar 6763 data sheet: tensile modulus 2010 MPa, tensile stress "
                     "at yield 50 MPa, density 1.27 g/cm3; Poisson 0.38 typical of PET "
-                    "copolyesters (Ashby)"),
+                    "copolyesters (Ashby)",
+             sheet_thicknesses_mm=(0.5, 0.75, 1.0, 1.5, 2.0, 3.0, 4.0, 5.0)),
     Material("birch-plywood", "birch plywood (thin, along the face grain)", E=9.0e9, G=0.62e9,
              nu=None, density=680.0, allowable_stress=40e6,
              source="Finnish birch plywood (EN 636) handbook figures for thin 3- and 5-ply "
                     "panels bent along the face grain, rounded down: E_m about 9-12 GPa, "
-                    "f_m,k about 40-60 MPa, in-plane shear modulus 620 MPa, 680 kg/m3"),
+                    "f_m,k about 40-60 MPa, in-plane shear modulus 620 MPa, 680 kg/m3",
+             sheet_thicknesses_mm=(0.8, 1.0, 1.5, 2.0, 3.0, 4.0, 6.5, 9.0, 12.0, 15.0, 18.0)),
     Material("spruce", "spruce, strength class C24 (along the grain)", E=11.0e9, G=0.69e9,
              nu=None, density=420.0, allowable_stress=24e6,
              source="EN 338:2016 strength class C24: E0,mean 11.0 GPa, G_mean 0.69 GPa, "
                     "rho_mean 420 kg/m3, characteristic bending strength f_m,k 24 MPa "
-                    "(no k_mod / gamma_M applied)"),
+                    "(no k_mod / gamma_M applied)",
+             sheet_thicknesses_mm=(10.0, 12.0, 15.0, 19.0, 22.0, 25.0, 30.0, 40.0, 50.0)),
     Material("gfrp", "GFRP, pultruded (along the fibres)", E=23.0e9, G=3.0e9, nu=None,
              density=1850.0, allowable_stress=240e6, allowable_strain=0.01,
              source="EN 13706-3 grade E23: longitudinal modulus >= 23 GPa, longitudinal "
                     "tensile strength >= 240 MPa; in-plane shear modulus about 3 GPa and "
                     "density 1.8-1.9 g/cm3 typical of pultruded E-glass/polyester profiles; "
                     "1 % strain, the limit used for bent GFRP gridshells (Douthe, Baverel & "
-                    "Caron 2006)"),
+                    "Caron 2006)",
+             sheet_thicknesses_mm=(1.0, 1.5, 2.0, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0)),
     Material("aluminium", "aluminium 6061-T6", E=69.0e9, G=26.0e9, nu=0.33, density=2700.0,
              allowable_stress=276e6,
              source="ASM Aerospace Specification Metals, aluminium 6061-T6: E 68.9 GPa, "
-                    "G 26 GPa, Poisson 0.33, 2.70 g/cm3, tensile yield 276 MPa"),
+                    "G 26 GPa, Poisson 0.33, 2.70 g/cm3, tensile yield 276 MPa",
+             sheet_thicknesses_mm=(0.5, 0.8, 1.0, 1.5, 2.0, 3.0, 4.0, 5.0, 6.0)),
 )}
 
 _ALIASES = {
     "polypropylene": "pp", "petg": "petg", "pet-g": "petg", "plywood": "birch-plywood",
     "birch": "birch-plywood", "birch_plywood": "birch-plywood", "c24": "spruce",
+    "spruce-c24": "spruce", "spruce_c24": "spruce", "glass-fibre-reinforced-polymer": "gfrp",
     "timber": "spruce", "glass-fibre": "gfrp", "fiberglass": "gfrp", "fibreglass": "gfrp",
     "aluminum": "aluminium", "al": "aluminium", "alu": "aluminium", "6061": "aluminium",
 }

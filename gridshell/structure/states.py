@@ -51,6 +51,12 @@ METHODS = {"tangent": METHOD_GG, "orthogonal": METHOD}
 
 _FRAME = re.compile(r"^frame_(\d+)\.obj$")
 
+#: the intermediate states of the sequence are an approximate path (splines through the
+#: joints of a kinematic sequence, not the strips' physical path): their utilisation is
+#: reported, not judged; the deployed and the collapsed state are the design's own
+APPROXIMATE = ("intermediate states: a spline through the joints of the kinematic sequence, not "
+               "the strips' physical path; reported, not judged")
+
 #: a state whose lamellae turn by more than this between consecutive joint-to-joint chords
 #: (degrees) is folded: a spline through the joints no longer describes a strip there, and the
 #: state is reported as unresolved instead of judged (a folded kinematic sequence)
@@ -181,7 +187,8 @@ def bundle_states(bundle: DesignBundle, path: Path | None, section: Section,
     """``structure.json["states"]``: the record of :func:`state_record` for every frame of the
     alignment sequence (``frame_000`` deployed ... last = collapsed) or, without a sequence,
     for the deployed and the collapsed joints; ``frames`` in order, each with ``name`` and
-    ``t`` (0 deployed, 1 collapsed); ``collapsed``; ``unresolved``: the names of the folded
+    ``t`` (0 deployed, 1 collapsed) and ``approximate`` (the intermediate states:
+    :data:`APPROXIMATE`, not judged); ``collapsed``; ``unresolved``: the names of the folded
     states (not judged); ``sequence_max_utilisation`` over the resolved ones."""
     n = len(bundle.net.joints)
     METHOD = METHODS[KIND_ORIENTATION[bundle.kind]]     # noqa: N806 (this kind's method)
@@ -202,13 +209,21 @@ def bundle_states(bundle: DesignBundle, path: Path | None, section: Section,
         elif k == len(named) - 1 and r_col is not None:
             N = r_col
         rec = state_record(bundle, np.asarray(V, float), N, section, material, curve)
-        out.append({"name": name, "t": k / K, **rec})
+        out.append({"name": name, "t": k / K, "approximate": 0 < k < len(named) - 1, **rec})
     collapsed = out[-1]
     judged = [f["max_utilisation"] for f in out if f["resolved"]]
     return {"method": METHOD, "fold_deg": FOLD_DEG, "frames": out,
+            "approximate_path": APPROXIMATE,
+            "approximate": [f["name"] for f in out if f["approximate"]],
             "unresolved": [f["name"] for f in out if not f["resolved"]],
             "collapsed": {"name": collapsed["name"],
                           "max_utilisation": collapsed["max_utilisation"],
                           "worst_lamella": collapsed["worst_lamella"],
                           "worst_joint": collapsed["worst_joint"]},
             "sequence_max_utilisation": max(judged, default=0.0)}
+
+
+def is_judged(frame: dict[str, Any]) -> bool:
+    """Whether the state ``frame`` (of :func:`bundle_states`) counts in the verdict: resolved
+    (not folded) and not on an approximate path (:data:`APPROXIMATE`)."""
+    return bool(frame["resolved"]) and not frame.get("approximate", False)

@@ -143,11 +143,14 @@ def test_report_and_fabricate_use_the_check(tmp_path, capsys):
     page = (d / "report.html").read_text()
     assert 'id="structure"' in page and "overstressed" in page
     capsys.readouterr()
-    code = main(["fabricate", str(d), "--scale", "1:200", "--force", "--width", "5",
-                 "--hole", "1", "--margin", "5", "--joints", "marks"])
+    fab = ["fabricate", str(d), "--scale", "1:200", "--width", "5", "--hole", "1", "--margin",
+           "5", "--joints", "marks"]
+    code = main(fab + ["--force"])    # the synthetic bundle fails verify too
     out = capsys.readouterr().out
     assert code == 0
-    assert "warning (structure)" in out and "lamella" in out and "overstressed" in out
+    assert "cut with --force: OVERSTRESSED" in out and "lamella" in out
+    rep = json.loads((d / "fabrication" / "fabrication.json").read_text())
+    assert rep["structure"]["verdict"] == "overstressed" and rep["structure"]["forced"]
 
 
 def test_strip_defaults_from_the_cut_files(tmp_path, capsys):
