@@ -28,6 +28,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping
 
+import numpy as np
+
 from gridshell.core.errors import InputError
 from gridshell.geometry.strips3d import real_section_m
 
@@ -61,11 +63,14 @@ def built_width_m(width_mm: float | None = None, scale: float | None = None) -> 
 WIDTH_PER_DIAGONAL = 0.01
 
 
-def design_width_m(diagonal: float) -> float:
+def design_width_m(V: Any) -> float:
     """The strip width a design is judged with before it is cut (its lamella fairness),
     metres: the default strip at the built scale (:func:`built_width_m`), at most
-    :data:`WIDTH_PER_DIAGONAL` of the design's ``diagonal`` (metres)."""
-    return min(built_width_m(), WIDTH_PER_DIAGONAL * float(diagonal))
+    :data:`WIDTH_PER_DIAGONAL` of the bounding-box diagonal of the design's points ``V (n, 3)``
+    (metres)."""
+    P = np.asarray(V, float).reshape(-1, 3)
+    diagonal = float(np.linalg.norm(P.max(0) - P.min(0))) if len(P) else 0.0
+    return min(built_width_m(), WIDTH_PER_DIAGONAL * diagonal)
 
 
 def parse_scale(text: str | float) -> float:

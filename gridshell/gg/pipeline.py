@@ -551,11 +551,6 @@ def _sequence_stage(s: dict[str, Any]) -> dict[str, Any]:
     return {"sequence": seq, "metrics": metrics}
 
 
-def _design_width(V: np.ndarray) -> float:
-    """The strip width the design's fairness is judged with (metres, :func:`design_width_m`)."""
-    return design_width_m(float(np.linalg.norm(np.ptp(np.asarray(V, float), axis=0))))
-
-
 @stage("fairness", needs=("net", "surface_V", "surface_F", "sequence", "metrics"),
        gives=("metrics",))
 def _fairness_stage(s: dict[str, Any]) -> dict[str, Any]:
@@ -564,7 +559,7 @@ def _fairness_stage(s: dict[str, Any]) -> dict[str, Any]:
     corners, hairpins, loops, distance from the surface, folds of the alignment states)."""
     seq = s["sequence"]
     fair = net_fairness(s["net"], s["surface_V"], s["surface_F"], tangent=True,
-                        width=_design_width(s["surface_V"]),
+                        width=design_width_m(s["surface_V"]),
                         states=None if seq is None else seq.V)
     return {"metrics": {**s["metrics"], "fairness": fair}}
 

@@ -332,7 +332,7 @@ def _mode_figures(mode: str, n: float | None, col: CollapseResult,
 
 @stage("metrics", needs=("surface", "traced", "collapse", "post", "sequence",
                          "collapse_direction", "n", "opts"),
-       gives=("metrics", "gates", "mesh", "aligned_2d"))
+       gives=("metrics", "gates", "mesh", "aligned_2d", "out_net"))
 def _metrics_stage(state: dict[str, Any]) -> dict[str, Any]:
     """The design's figures and the paper's gates on them (``metrics["quality"]``)."""
     o: NCPOptions = state["opts"]
@@ -342,15 +342,18 @@ def _metrics_stage(state: dict[str, Any]) -> dict[str, Any]:
     A2 = _register_2d((seq.aligned - seq.centroid) @ B.T, post.Vt)
     metrics = _design_figures(surf, state["traced"], col, post, seq, mesh)
     metrics.update(_mode_figures(o.mode, state["n"], col, A2))
-    # fairness of the lamellae the bundle holds (carried onto the post-optimized joints)
-    metrics["fairness"] = net_fairness(move_joints(state["traced"].net, post.V), mesh.V, mesh.F,
-                                       tangent=False, width=design_width_m(float(np.linalg.norm(
-                                           np.ptp(mesh.V, axis=0)))), states=seq.V,
+    # the lamellae carried onto the post-optimized joints: axes.obj and joint_s (the cut
+    # files' joint positions) describe the gridshell that aligns, not the traced net; their
+    # fairness is the design's
+    out_net = move_joints(state["traced"].net, post.V)
+    metrics["fairness"] = net_fairness(out_net, mesh.V, mesh.F,
+                                       tangent=False, width=design_width_m(mesh.V), states=seq.V,
                                        gate_folds=False)
     gates = design_gates(KIND[o.mode], metrics)
     metrics["quality"] = {"ok": passed(gates), "summary": gate_summary(gates),
                           "gates": [{**g.as_dict(), "line": g.line()} for g in gates]}
-    return {"metrics": metrics, "gates": gates, "mesh": mesh, "aligned_2d": A2}
+    return {"metrics": metrics, "gates": gates, "mesh": mesh, "aligned_2d": A2,
+            "out_net": out_net}
 
 
 @stage("gate", needs=("metrics", "gates", "info", "traced", "post", "notes", "opts", "timings",
@@ -413,15 +416,12 @@ def _report(state: dict[str, Any], metrics: dict[str, Any]) -> dict[str, Any]:
 
 @stage("bundle", needs=("surface", "traced", "collapse", "post", "sequence",
                         "collapse_direction", "metrics", "mesh", "aligned_2d", "notes", "info",
-                        "input_units", "opts"), gives=("design",))
+                        "input_units", "opts", "out_net"), gives=("design",))
 def _bundle_stage(state: dict[str, Any]) -> dict[str, Any]:
     """The design: the bundle (the lamellae on the post-optimized joints) and the report."""
     o: NCPOptions = state["opts"]
     traced, col, post, seq = state["traced"], state["collapse"], state["post"], state["sequence"]
-    metrics, mesh = state["metrics"], state["mesh"]
-    # the lamellae carried onto the post-optimized joints: axes.obj and joint_s (the cut
-    # files' joint positions) describe the gridshell that aligns, not the traced net
-    out_net = move_joints(traced.net, post.V)
+    metrics, mesh, out_net = state["metrics"], state["mesh"], state["out_net"]
     bundle = DesignBundle(kind=KIND[o.mode], net=out_net, aligned=seq.aligned, surface_V=mesh.V,
                           surface_F=mesh.F, metrics=metrics,
                           params=_params(o, state["collapse_direction"], post, state["notes"],
