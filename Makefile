@@ -54,7 +54,7 @@ $(STAMP): pyproject.toml
 	fi
 	cmake_bin=$$($(CMAKE_BIN)); \
 	PATH="$${cmake_bin:+$$cmake_bin:}$$PATH" CMAKE_POLICY_VERSION_MINIMUM=3.5 \
-	  $(PY) -m pip install --quiet -e ".[test,server]" || { \
+	  $(PY) -m pip install --quiet -e ".[test,server,sweep]" || { \
 	  echo >&2 "error: installing gridshell and its dependencies failed (see above); openmesh"; \
 	  echo >&2 "  builds from source with cmake and a C++ compiler, and pip needs the network"; \
 	  exit 1; }
