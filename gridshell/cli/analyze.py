@@ -6,6 +6,8 @@ import argparse
 from pathlib import Path
 from typing import Any
 
+from gridshell.cli.values import count, number
+
 HELP = ("before any design: where GG and each NCP mode can exist on a target (K sign, umbilic "
         "regions, the largest admissible patch, a quick GG trial), the pipeline to run; writes "
         "analysis.json and analysis.png")
@@ -22,10 +24,10 @@ def add_args(p: argparse.ArgumentParser) -> None:
                    help="directory for analysis.json and analysis.png (default: TARGET's name "
                         "+ '-analysis' in the current directory; replaced only if it is an "
                         "earlier analysis or empty)")
-    p.add_argument("--samples", type=int, default=64, metavar="N",
+    p.add_argument("--samples", type=count(8, maximum=400), default=64, metavar="N",
                    help="samples of the fitted surface per parameter direction (8..400; "
                         "default 64)")
-    p.add_argument("--min-coverage", type=float, default=MIN_COVERAGE, metavar="PCT",
+    p.add_argument("--min-coverage", type=number(0.0, maximum=100.0), default=MIN_COVERAGE, metavar="PCT",
                    help="share of the target an NCP mode's largest regular patch must cover to "
                         f"be recommended, %% (default {MIN_COVERAGE:g})")
     p.add_argument("--no-trial", action="store_true",
@@ -35,14 +37,8 @@ def add_args(p: argparse.ArgumentParser) -> None:
 
 
 def _check(args: Any) -> Path | None:
-    """Refuse bad options before any work; the output directory (None with --no-files)."""
+    """The output directory (None with --no-files); the options were checked when parsed."""
     from gridshell.core.atomic import check_output
-    from gridshell.core.errors import InputError
-
-    if not 8 <= args.samples <= 400:
-        raise InputError(f"--samples {args.samples}: give 8 to 400 samples per direction")
-    if not 0.0 <= args.min_coverage <= 100.0:
-        raise InputError(f"--min-coverage {args.min_coverage:g}: give a share from 0 to 100 %")
     if args.no_files:
         return None
     out = Path(args.output) if args.output else Path(f"{Path(args.target).stem}-analysis")

@@ -14,6 +14,8 @@ import json
 import sys
 from typing import Any
 
+from gridshell.cli.values import checked, count, number, positive
+
 HELP = ("stresses the design imposes on its strips (bending about both axes, twist) for a "
         "material and section; writes DIR/structure.json (exit 0 elastic, 4 overstressed)")
 
@@ -22,29 +24,34 @@ OVERSTRESSED = 4
 
 
 def add_args(p: argparse.ArgumentParser) -> None:
+    from gridshell.structure.materials import get_material
+    from gridshell.design.section import parse_scale
     from gridshell.structure import MATERIALS
     from gridshell.cli.common import add_bundle_arg
 
     add_bundle_arg(p, "; structure.json goes into it")
     g = p.add_argument_group("material")
-    g.add_argument("--material", default=None, metavar="NAME",
+    g.add_argument("--material",
+                   type=checked(get_material, "material"), default=None, metavar="NAME",
                    help="preset: " + "; ".join(f"{k}: {m.label}" for k, m in MATERIALS.items())
                         + " (default pp unless --E and --allowable give your own)")
-    g.add_argument("--E", dest="E", type=float, metavar="GPA", help="Young's modulus, GPa")
-    g.add_argument("--G", dest="G", type=float, metavar="GPA",
+    g.add_argument("--E", dest="E", type=positive, metavar="GPA", help="Young's modulus, GPa")
+    g.add_argument("--G", dest="G", type=positive, metavar="GPA",
                    help="shear modulus, GPa (default: from E and the Poisson ratio for an "
                         "isotropic material, the preset's for timber and GFRP)")
-    g.add_argument("--nu", type=float, help="Poisson ratio")
-    g.add_argument("--allowable", type=float, metavar="MPA",
+    g.add_argument("--nu", type=number(-1.0, strict=True, maximum=0.5), help="Poisson ratio")
+    g.add_argument("--allowable", type=positive, metavar="MPA",
                    help="allowable (elastic limit) stress, MPa")
-    g.add_argument("--allowable-strain", type=float, metavar="PERCENT",
+    g.add_argument("--allowable-strain", type=number(0.0, strict=True, maximum=100.0),
+                   metavar="PERCENT",
                    help="allowable strain, %% (the smaller of stress and E x strain governs)")
-    g.add_argument("--density", type=float, metavar="KG_M3", help="density, kg/m^3")
+    g.add_argument("--density", type=positive, metavar="KG_M3", help="density, kg/m^3")
     g = p.add_argument_group("strip (mm of the model; default: DIR/fabrication's, else 20 x 1 "
                              "at 1:10)")
-    g.add_argument("--width", type=float, help="strip width, mm")
-    g.add_argument("--thickness", type=float, help="strip thickness, mm")
-    g.add_argument("--scale", help="model scale, e.g. 1:10, 1:1 or 0.1")
+    g.add_argument("--width", type=positive, help="strip width, mm")
+    g.add_argument("--thickness", type=positive, help="strip thickness, mm")
+    g.add_argument("--scale",
+                   type=checked(parse_scale, "scale"), help="model scale, e.g. 1:10, 1:1 or 0.1")
     p.add_argument("--no-states", action="store_true",
                    help="deployed state only (not the collapsed state nor the alignment "
                         "sequence)")
@@ -54,7 +61,7 @@ def add_args(p: argparse.ArgumentParser) -> None:
                    help="also print the sections of the material that hold (its stock "
                         "thicknesses, the widths that stay elastic at the scale) and the "
                         "smallest model scale at which this strip holds")
-    p.add_argument("--top", type=int, default=12, metavar="N",
+    p.add_argument("--top", type=count(0, "0: none listed"), default=12, metavar="N",
                    help="lamellae listed in the table, most utilised first (default 12; 0: all)")
 
 

@@ -5,12 +5,16 @@ import argparse
 from pathlib import Path
 from typing import Any
 
+from gridshell.cli.values import checked, positive
+
 HELP = ("export a design bundle to Rhino .3dm: lamellae as strips of their real width and "
         "thickness, joint holes, the surface, the collapsed state and the cut sheets, in the "
         "input's unit and frame")
 
 
 def add_args(p: argparse.ArgumentParser) -> None:
+    from gridshell.design.section import parse_scale
+    from gridshell.fabrication.params import parse_sheet
     from gridshell.cli.common import add_bundle_arg
 
     add_bundle_arg(p)
@@ -19,13 +23,17 @@ def add_args(p: argparse.ArgumentParser) -> None:
     g = p.add_argument_group(
         "strips (mm of the cut model; default: DIR/fabrication/fabrication.json when "
         "'gridshell fabricate' wrote one, else 20 x 1 mm, 3 mm holes at 1:10)")
-    g.add_argument("--width", type=float, metavar="MM",
+    g.add_argument("--width", type=positive, metavar="MM",
                    help="cut strip width; the strip's real width is width / scale")
-    g.add_argument("--thickness", type=float, metavar="MM",
+    g.add_argument("--thickness", type=positive, metavar="MM",
                    help="cut strip (sheet) thickness; real thickness = thickness / scale")
-    g.add_argument("--hole", type=float, metavar="MM", help="joint hole diameter")
-    g.add_argument("--scale", metavar="S", help="model scale, e.g. 1:10, 1:1 or 0.1")
-    g.add_argument("--sheet", metavar="WxH", help="sheet size in mm, e.g. 600x400")
+    g.add_argument("--hole", type=positive, metavar="MM", help="joint hole diameter")
+    g.add_argument("--scale",
+                   type=checked(parse_scale, "scale"),
+                   metavar="S", help="model scale, e.g. 1:10, 1:1 or 0.1")
+    g.add_argument("--sheet",
+                   type=checked(parse_sheet, "sheet"),
+                   metavar="WxH", help="sheet size in mm, e.g. 600x400")
     p.add_argument("--units", metavar="UNIT",
                    help="unit of the Rhino model: m, cm, mm, in or ft (default: the unit the "
                         "design was made in, as design.json records it; metres if none)")

@@ -6,6 +6,7 @@ from pathlib import Path
 from typing import Any
 
 from gridshell.cli.common import add_bundle_arg, choice_help
+from gridshell.cli.values import checked, nonnegative, positive
 
 HELP = ("cut files of a design bundle: flat lamellae with joint holes, slots or marks and "
         "engraved ids, nested on sheets as DXF and SVG with PNG previews, with a cut list and an "
@@ -23,6 +24,9 @@ DXF_HELP = {"R2010": "AutoCAD 2010", "R12": "through ezdxf's R12 export"}
 
 
 def add_args(p: argparse.ArgumentParser) -> None:
+    from gridshell.structure.materials import get_material
+    from gridshell.design.section import parse_scale
+    from gridshell.fabrication.params import parse_sheet
     from gridshell.fabrication.params import AXIS_PLACES, DXF_VERSIONS, JOINT_STYLES, ROTATIONS, FabParams
     from gridshell.design.section import DEFAULTS, scale_text
 
@@ -30,43 +34,43 @@ def add_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("-o", "--out", metavar="OUT",
                    help="output directory, replaced atomically (default DIR/fabrication)")
     g = p.add_argument_group("strips (mm of the model)")
-    g.add_argument("--width", type=float, default=None,
+    g.add_argument("--width", type=positive, default=None,
                    help=f"strip width (default {DEFAULTS['width']:g})")
-    g.add_argument("--thickness", type=float, default=None,
+    g.add_argument("--thickness", type=positive, default=None,
                    help=f"sheet thickness (default {DEFAULTS['thickness']:g})")
-    g.add_argument("--margin", type=float, default=FabParams.margin,
+    g.add_argument("--margin", type=nonnegative, default=FabParams.margin,
                    help=f"strip length beyond the end joints (default {FabParams.margin:g})")
     g.add_argument("--axis", choices=AXIS_PLACES, default=FabParams.axis,
                    help="place of the lamella axis on the strip: "
                         + choice_help(AXIS_HELP, AXIS_PLACES, FabParams.axis))
-    g.add_argument("--scale", default=None,
+    g.add_argument("--scale", type=checked(parse_scale, "scale"), default=None,
                    help=f"model scale, e.g. {scale_text(DEFAULTS['scale'])} (default), 1:1 or 0.1")
     g = p.add_argument_group("joints")
     g.add_argument("--joints", choices=JOINT_STYLES, default=None,
                    help=choice_help(JOINT_HELP, JOINT_STYLES, FabParams.joints) +
                    "; by default joints too close for holes at this scale are engraved as "
                    "marks (with a warning), an explicit --joints refuses them instead")
-    g.add_argument("--hole", type=float, default=FabParams.hole,
+    g.add_argument("--hole", type=nonnegative, default=FabParams.hole,
                    help=f"hole diameter, mm (default {FabParams.hole:g})")
-    g.add_argument("--clearance", type=float, default=FabParams.clearance,
+    g.add_argument("--clearance", type=nonnegative, default=FabParams.clearance,
                    help=f"slot width = thickness + clearance, mm (default {FabParams.clearance:g})")
     g = p.add_argument_group("sheets and cutting")
     sheet = "x".join(f"{v:g}" for v in FabParams.sheet)
-    g.add_argument("--sheet", default=sheet,
+    g.add_argument("--sheet", type=checked(parse_sheet, "sheet"), default=sheet,
                    help=f"sheet size WIDTHxHEIGHT mm (default {sheet})")
-    g.add_argument("--gap", type=float, default=FabParams.gap,
+    g.add_argument("--gap", type=nonnegative, default=FabParams.gap,
                    help=f"gap between parts and to the sheet edges, mm (default {FabParams.gap:g})")
     g.add_argument("--rotation", choices=ROTATIONS, default=FabParams.rotation,
                    help="how parts may turn on the sheet: free (any angle, isotropic sheets such "
                         "as polypropylene; default) or grain (along the sheet's long side, "
                         "turned by 180 degrees at most: plywood grain along the strips)")
-    g.add_argument("--overlap", type=float, default=None,
+    g.add_argument("--overlap", type=positive, default=None,
                    help="splice overlap of lamellae split to fit a sheet, mm (default: at a joint, "
                         "one joint spacing plus two margins, so the pieces share two joints; "
                          "between joints, two widths plus two margins); every splice holds "
                          "by two shared joints or two fasteners (one would be a hinge): a "
                          "lamella no such splice cuts is refused")
-    g.add_argument("--kerf", type=float, default=FabParams.kerf,
+    g.add_argument("--kerf", type=nonnegative, default=FabParams.kerf,
                    help="laser kerf, mm: outlines move out and holes in by kerf/2 (default "
                         f"{FabParams.kerf:g}: off)")
     g.add_argument("--dxf-version", choices=DXF_VERSIONS, default=FabParams.dxf_version,
@@ -75,7 +79,8 @@ def add_args(p: argparse.ArgumentParser) -> None:
     g.add_argument("--segments", action="store_true",
                    help="write arcs as short segments instead of bulges")
     g.add_argument("--no-labels", action="store_true", help="do not engrave ids")
-    p.add_argument("--material", default=None, metavar="NAME",
+    p.add_argument("--material",
+                   type=checked(get_material, "material"), default=None, metavar="NAME",
                    help="strip material of the structural check (gridshell check's presets; "
                         f"default {DEFAULTS['material']}): strips that would not stay elastic "
                         "are not cut")

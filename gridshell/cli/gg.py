@@ -5,6 +5,8 @@ import argparse
 import math
 from typing import Any
 
+from gridshell.cli.values import angle_between, count, fraction, number, positive
+
 HELP = "design a geodesic (GG) alignable gridshell on a target surface and write a design bundle"
 
 
@@ -19,38 +21,39 @@ def add_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--meridians", choices=("rows", "cols"), default="cols",
                    help="for a quad-grid target: grid lines that become the meridians "
                         "(geodesics of the designed surface); default cols")
-    p.add_argument("--grid", nargs=2, type=int, metavar=("R", "C"),
+    p.add_argument("--grid", nargs=2, type=count(4), metavar=("R", "C"),
                    help="resolution of the designed mesh: R parallels x C meridians")
-    p.add_argument("--direction", type=float, metavar="DEG",
+    p.add_argument("--direction", type=number(), metavar="DEG",
                    help="meridian direction in degrees, for triangle-mesh targets")
     g = p.add_mutually_exclusive_group()
-    g.add_argument("--lamellae", type=int, metavar="N",
+    g.add_argument("--lamellae", type=count(2), metavar="N",
                    help="lamellae per family crossing the reference parallel (default 10)")
-    g.add_argument("--spacing", type=float, metavar="M",
+    g.add_argument("--spacing", type=positive, metavar="M",
                    help="spacing of the lamellae along the reference parallel, metres")
-    g.add_argument("--offsets", nargs="+", type=float, metavar="M",
+    g.add_argument("--offsets", nargs="+", type=number(), metavar="M",
                    help="non-uniform spacing (paper Fig. 18): positions of the lamellae of both "
                         "families on the reference parallel, metres of arc length from the "
                         "first meridian, at least 2; --offsets1 / --offsets3 override one family")
-    p.add_argument("--offsets1", nargs="+", type=float, metavar="M",
+    p.add_argument("--offsets1", nargs="+", type=number(), metavar="M",
                    help="positions of the C1 lamellae only (metres, as --offsets)")
-    p.add_argument("--offsets3", nargs="+", type=float, metavar="M",
+    p.add_argument("--offsets3", nargs="+", type=number(), metavar="M",
                    help="positions of the C3 lamellae only (metres, as --offsets)")
-    p.add_argument("--angle", type=float, default=90.0, metavar="DEG",
+    p.add_argument("--angle", type=angle_between(0.0, 180.0), default=90.0, metavar="DEG",
                    help="crossing angle of the two families on the reference parallel, "
                         "degrees (default 90)")
-    p.add_argument("--at", type=float, default=0.5, metavar="FRAC",
+    p.add_argument("--at", type=fraction, default=0.5, metavar="FRAC",
                    help="reference parallel as a fraction of the meridian length (default 0.5)")
-    p.add_argument("--rounds", type=int, default=10, metavar="N",
+    p.add_argument("--rounds", type=count(1), default=10, metavar="N",
                    help="outer rounds of the surface optimization (default 10)")
-    p.add_argument("--polish", type=int, default=20, metavar="N",
+    p.add_argument("--polish", type=count(0, "0: no final projection"), default=20, metavar="N",
                    help="most iterations of the final projection onto the constraints; it "
                         "stops once the figures hold and stagnate (default 20)")
     p.add_argument("--allow-unconverged", action="store_true",
                    help="write the design even if it misses the paper's figures (Delta_a mean "
                         "< 1 %%, max < 3 %%; default: exit code 4, nothing written); the bundle "
                         "is marked as failing")
-    p.add_argument("--frames", type=int, default=12, metavar="N",
+    p.add_argument("--frames", type=count(0, "0: no sequence", maximum=1000), default=12,
+                   metavar="N",
                    help="steps of the alignment sequence from the deployed to the collapsed net "
                         "(sequence/frame_*.obj, with pictures alignment.gif and states.png); "
                         "0: none (default 12)")
@@ -116,7 +119,8 @@ def run(args: Any) -> int:
                                 f"edge-length spread {surf['length_residual_rel_max']:.2e}, "
                                 f"polish stopped: {surf['polish_stop']}",
         "joints / loops / lamellae": f"{m['n_joints']} / {m['n_loops']} / "
-                                     f"{m['n_lamellae']['C1']} + {m['n_lamellae']['C3']}",
+                                     f"{m['n_lamellae']['C1']} + {m['n_lamellae']['C3']}"
+                                     + _asked(m.get("lamellae_count")),
         "Delta_a straight [%]": m["alignability"],
         "Delta_a arc [%]": m["alignability_arc"],
         "geodesic turning [%]": m["geodesic_turning"],
@@ -142,3 +146,9 @@ def run(args: Any) -> int:
         print(f"  verdict: {verdict}")
     return 0
 
+
+def _asked(counted: dict | None) -> str:
+    """`` (10 asked: ...)`` where the lamellae made per family differ from those asked."""
+    if not counted or counted.get("made") == counted.get("asked"):
+        return ""
+    return f" ({counted['asked']} asked: {counted.get('why', 'the nearest possible')})"

@@ -63,6 +63,14 @@ class _Version(argparse.Action):
         parser.exit()
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse with a one-line error: what is wrong and where the options are described
+    (argparse's own prints the whole usage block first)."""
+
+    def error(self, message: str):  # noqa: D102 - argparse's hook
+        self.exit(2, f"{self.prog}: error: {message} ({self.prog} --help lists the options)\n")
+
+
 def build_parser(commands: Iterable[str] | None = None) -> argparse.ArgumentParser:
     """The argument parser of the ``gridshell`` command.
 
@@ -70,7 +78,7 @@ def build_parser(commands: Iterable[str] | None = None) -> argparse.ArgumentPars
     listed either way; :func:`main` adds the options of the one it runs only, because some
     take their choices from registries whose modules are slow to import (``fabricate``).
     """
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="gridshell",
         description="Design alignable lamella gridshells: from a target surface to cut files.")
     parser.add_argument("--version", action=_Version)
@@ -104,7 +112,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     from gridshell.cli.outcome import parse_or_explain, run_command
 
     parser = build_parser(_requested(argv))
-    args = parse_or_explain(lambda: parser.parse_args(argv), argv)
+    try:  # a bad option or value: one line and exit 2, before any work; --help: exit 0
+        args = parse_or_explain(lambda: parser.parse_args(argv), argv)
+    except SystemExit as exc:
+        return exc.code if isinstance(exc.code, int) else 2
     if not getattr(args, "command", None):
         parser.print_help(sys.stderr)
         print(f"\ngridshell: error: give a command, one of {', '.join(SUBCOMMANDS)} "

@@ -5,6 +5,7 @@ import argparse
 from typing import Any
 
 from gridshell.cli.common import choice_help
+from gridshell.cli.values import count, nonnegative, number, positive
 
 HELP = ("trace a normal-curvature-preserving alignable net on a PHLW / CNC / PK surface, "
         "post-optimize it, simulate its alignment and write a design bundle (NCP, CNC or AA)")
@@ -31,33 +32,37 @@ def add_args(p: argparse.ArgumentParser) -> None:
                    help=choice_help(MODE_HELP, modes, modes[0],
                                     lambda m: f"{MODE_HELP.get(m, m)} (kind {KIND[m]})"))
     g = p.add_mutually_exclusive_group()
-    g.add_argument("--curves", type=int, metavar="N",
+    g.add_argument("--curves", type=count(1), metavar="N",
                    help="curves per family, uniformly subdivided level values (default 10)")
-    g.add_argument("--spacing", type=float, metavar="M",
+    g.add_argument("--spacing", type=positive, metavar="M",
                    help="spacing of the curves, metres")
-    p.add_argument("--n", type=float, metavar="1/M",
+    p.add_argument("--n", type=number(), metavar="1/M",
                    help="cnc: the normal curvature of the net (default: fitted)")
-    p.add_argument("--samples", nargs=2, type=int, default=(48, 48), metavar=("RU", "RV"),
+    p.add_argument("--samples", nargs=2, type=count(4), default=(48, 48), metavar=("RU", "RV"),
                    help="direction samples of the level-set fit (default 48 48)")
-    p.add_argument("--levelset-ctrl", nargs=2, type=int, default=(12, 12), metavar=("NU", "NV"),
+    p.add_argument("--levelset-ctrl", nargs=2, type=count(4), default=(12, 12),
+                   metavar=("NU", "NV"),
                    help="control points of the level functions (default 12 12)")
-    p.add_argument("--omega-f", type=float, default=0.01, metavar="W",
+    p.add_argument("--omega-f", type=nonnegative, default=0.01, metavar="W",
                    help="fairness weight of the level functions (default 0.01; the paper uses 0.1)")
-    p.add_argument("--collapse-samples", nargs=2, type=int, default=(1200, 1200),
+    p.add_argument("--collapse-samples", nargs=2, type=count(4), default=(1200, 1200),
                    metavar=("RU", "RV"), help="collapse-curve sampling (default 1200 1200)")
-    p.add_argument("--rounds", type=int, default=3,
+    p.add_argument("--rounds", type=count(0, "0: no post-optimization"), default=3,
                    help="post-optimization rounds (default 3)")
-    p.add_argument("--frames", type=int, default=12,
-                   help="steps of the alignment sequence (default 12)")
+    p.add_argument("--frames", default=12, metavar="N",
+                   type=count(1, "the simulated path to the collapsed state is part of the design",
+                              maximum=1000),
+                   help="steps of the simulated alignment sequence, at least 1: the simulation "
+                        "is the proof that the design collapses (default 12)")
     p.add_argument("--no-render", action="store_true",
                    help="skip the PNG pictures, PNG frames and alignment.gif")
-    p.add_argument("--phlw-ctrl", nargs=2, type=int, default=(9, 9), metavar=("NU", "NV"),
+    p.add_argument("--phlw-ctrl", nargs=2, type=count(4), default=(9, 9), metavar=("NU", "NV"),
                    help="mesh input: control points of the PHLW B-spline (default 9 9)")
-    p.add_argument("--phlw-samples", nargs=2, type=int, default=(18, 18), metavar=("RU", "RV"),
+    p.add_argument("--phlw-samples", nargs=2, type=count(4), default=(18, 18), metavar=("RU", "RV"),
                    help="mesh input: PHLW optimization samples (default 18 18)")
-    p.add_argument("--phlw-outer", type=int, default=4,
+    p.add_argument("--phlw-outer", type=count(1), default=4,
                    help="mesh input: PHLW outer rounds (default 4)")
-    p.add_argument("--phlw-max-iter", type=int, default=40,
+    p.add_argument("--phlw-max-iter", type=count(1), default=40,
                    help="mesh input: PHLW iterations per round (default 40)")
     p.add_argument("--phlw-align", action="store_true",
                    help="mesh input: turn the reference's parametrization onto its mean principal "

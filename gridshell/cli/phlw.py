@@ -5,6 +5,7 @@ import argparse
 from typing import Any
 
 from gridshell.cli.common import choice_help
+from gridshell.cli.values import count, nonnegative
 
 HELP = ("optimize a B-spline towards a PHLW (phlw), constant-normal-curvature (cnc) or "
         "PK (aa) surface near a reference mesh; writes surface.json/.obj, rows.csv, "
@@ -31,22 +32,23 @@ def add_args(p: argparse.ArgumentParser) -> None:
                    help="output directory (replaced atomically)")
     p.add_argument("--mode", choices=MODES, default=MODES[0],
                    help=choice_help(MODE_HELP, MODES, MODES[0]))
-    p.add_argument("--degree", nargs=2, type=int, default=(4, 4), metavar=("DU", "DV"),
+    p.add_argument("--degree", nargs=2, type=count(1), default=(4, 4), metavar=("DU", "DV"),
                    help="B-spline bi-degree (default 4 4)")
-    p.add_argument("--ctrl", nargs=2, type=int, default=(9, 9), metavar=("NU", "NV"),
+    p.add_argument("--ctrl", nargs=2, type=count(2), default=(9, 9), metavar=("NU", "NV"),
                    help="control points in u and v (default 9 9)")
-    p.add_argument("--samples", nargs=2, type=int, default=(18, 18), metavar=("RU", "RV"),
+    p.add_argument("--samples", nargs=2, type=count(4), default=(18, 18), metavar=("RU", "RV"),
                    help="optimization samples in u and v (default 18 18)")
-    p.add_argument("--check-samples", nargs=2, type=int, default=(60, 60), metavar=("RU", "RV"),
+    p.add_argument("--check-samples", nargs=2, type=count(4), default=(60, 60),
+                   metavar=("RU", "RV"),
                    help="denser sampling for the check and surface.obj (default 60 60)")
     p.add_argument("--transpose", action="store_true",
                    help="swap u and v of the reference grid (rows follow the other family)")
     p.add_argument("--align", action="store_true",
                    help="turn the reference's parametrization onto its mean principal directions "
                         "(as far as coverage allows) before the PHLW step (default: keep it)")
-    p.add_argument("--outer", type=int, default=4,
+    p.add_argument("--outer", type=count(1), default=4,
                    help="outer rounds (closest points refreshed) (default 4)")
-    p.add_argument("--max-iter", type=int, default=60,
+    p.add_argument("--max-iter", type=count(1), default=60,
                    help="Levenberg-Marquardt iterations per round (default 60)")
     p.add_argument("--allow-unconverged", action="store_true",
                    help="write a surface whose optimization did not converge, raised its "
@@ -57,7 +59,7 @@ def add_args(p: argparse.ArgumentParser) -> None:
                         "4 unless --allow-unconverged")
     for key, default in (("closeness", None), ("gliding", None), ("target", None), ("beta", None),
                          ("constraints", None)):
-        p.add_argument(f"--w-{key}", type=float, default=default, metavar="W",
+        p.add_argument(f"--w-{key}", type=nonnegative, default=default, metavar="W",
                        help=f"weight of the {key} term (default: see gridshell.ncp.phlw."
                             "DEFAULT_WEIGHTS)")
 

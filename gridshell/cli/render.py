@@ -5,6 +5,8 @@ import argparse
 from pathlib import Path
 from typing import Any
 
+from gridshell.cli.values import count, positive
+
 HELP = ("render a design bundle: render.png (lamellae as strips of their real width), "
         "alignment.gif when the bundle has an alignment sequence, and optionally report.html "
         "(with an interactive 3D view) and a Rhino .3dm")
@@ -19,11 +21,11 @@ def add_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--3dm", dest="rhino", metavar="PATH",
                    help="also export the design to this Rhino .3dm file ('gridshell export' "
                         "with its defaults: strips, holes, surface, collapsed state, cut sheets)")
-    p.add_argument("--width", type=float, metavar="MM",
+    p.add_argument("--width", type=positive, metavar="MM",
                    help="strip width in mm at full size (default the cut strip's width over "
                         "the scale, from DIR/fabrication/fabrication.json, else 20 mm at 1:10 "
                         "= 200 mm)")
-    p.add_argument("--size", nargs=2, type=int, default=(1200, 900), metavar=("W", "H"),
+    p.add_argument("--size", nargs=2, type=count(64, maximum=10000), default=(1200, 900), metavar=("W", "H"),
                    help="render.png size in pixels (default 1200 900)")
     p.add_argument("--no-sequence", action="store_true",
                    help="do not render the alignment sequence")

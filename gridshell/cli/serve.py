@@ -5,13 +5,15 @@ import argparse
 import sys
 from typing import Any
 
+from gridshell.cli.values import port
+
 HELP = ("start a Hops server with the Grasshopper components GG design, NCP design, verify and "
         "fabricate (point a Hops component at http://localhost:PORT/gg, /ncp, /verify, "
         "/fabricate)")
 
 
 def add_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--port", type=int, default=5000, help="TCP port (default 5000)")
+    p.add_argument("--port", type=port, default=5000, help="TCP port (default 5000)")
     p.add_argument("--host", default="127.0.0.1",
                    help="address to listen on (default 127.0.0.1: this computer only)")
     p.add_argument("--workdir", metavar="DIR",

@@ -5,6 +5,8 @@ import argparse
 from pathlib import Path
 from typing import Any
 
+from gridshell.cli.values import checked, count, positive
+
 HELP = ("elastic equilibrium of the deployed gridshell: every lamella a discrete elastic rod of "
         "the real strip, joints that turn about their axis only, supports held at the design; "
         "writes the equilibrium as OBJ with a picture over the design and prints its deviation, "
@@ -12,6 +14,8 @@ HELP = ("elastic equilibrium of the deployed gridshell: every lamella a discrete
 
 
 def add_args(p: argparse.ArgumentParser) -> None:
+    from gridshell.structure.materials import get_material
+    from gridshell.design.section import parse_scale
     from gridshell.structure.materials import material_names
     from gridshell.cli.common import add_bundle_arg
 
@@ -20,19 +24,21 @@ def add_args(p: argparse.ArgumentParser) -> None:
                    help="output directory, replaced atomically (default DIR/equilibrium)")
     g = p.add_argument_group("strip (mm of the model; default: DIR/fabrication's, else 20 x 1 "
                              "pp at 1:10)")
-    g.add_argument("--material", default=None,
+    g.add_argument("--material", type=checked(get_material, "material"), default=None,
                    help=f"strip material: {', '.join(material_names())} (default pp)")
-    g.add_argument("--width", type=float, default=None, help="strip width, mm")
-    g.add_argument("--thickness", type=float, default=None, help="strip thickness, mm")
-    g.add_argument("--scale", default=None, help="model scale, e.g. 1:10, 1:1 or 0.1")
+    g.add_argument("--width", type=positive, default=None, help="strip width, mm")
+    g.add_argument("--thickness", type=positive, default=None, help="strip thickness, mm")
+    g.add_argument("--scale",
+                   type=checked(parse_scale, "scale"),
+                   default=None, help="model scale, e.g. 1:10, 1:1 or 0.1")
     g = p.add_argument_group("model")
     g.add_argument("--supports", default="boundary",
                    help="joints held at their design positions: 'boundary' (default: the joints "
                         "on the net's boundary) or joint indices such as 0,5,17")
     g.add_argument("--gravity", action="store_true", help="add the strips' self-weight (-z)")
-    g.add_argument("--per-bay", type=int, default=3,
+    g.add_argument("--per-bay", type=count(1), default=3,
                    help="rod elements between neighbouring joints (default 3)")
-    g.add_argument("--max-iter", type=int, default=100,
+    g.add_argument("--max-iter", type=count(1), default=100,
                    help="Newton iterations at most (default 100)")
 
 

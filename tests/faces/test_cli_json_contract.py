@@ -109,11 +109,10 @@ def test_a_success_is_one_json_object_and_quiet(bundles, capsys, command):
 
 @pytest.mark.parametrize("command", sorted(SUBCOMMANDS))
 def test_a_usage_error_with_json_is_one_json_object(capsys, command):
-    with pytest.raises(SystemExit) as exc:
-        main([command, "--json", "-v", "-q"])
+    code = main([command, "--json", "-v", "-q"])
     cap = capsys.readouterr()
     payload = json.loads(cap.out)
-    assert exc.value.code == 2 and payload["ok"] is False and payload["error"] == "UsageError"
+    assert code == 2 and payload["ok"] is False and payload["error"] == "UsageError"
     assert "not allowed with" in payload["message"] and "not allowed with" in cap.err
 
 
