@@ -24,9 +24,8 @@ import os
 from pathlib import Path
 from typing import Any, Callable, Sequence
 
-from gridshell.design.bundle import Design, DesignBundle, read_bundle, write_bundle
-from gridshell.core.errors import InputError
-from gridshell.design.verification import require_design, verify_bundle
+from gridshell.design.bundle import Design, DesignBundle, read_bundle
+from gridshell.design.verification import verify_bundle
 
 __all__ = ["Design", "DesignBundle", "analyze", "check_structure", "design_gg", "design_ncp", "export_3dm",
            "fabricate", "optimize_phlw", "read", "simulate", "verify", "write", "write_outputs"]
@@ -114,14 +113,10 @@ def optimize_phlw(surf: Any, reference: Any, *, mode: str = "phlw",
 
 
 def _parts(design: Any, report: dict | None = None) -> tuple[DesignBundle, dict | None]:
-    """``(bundle, report)`` of a :class:`Design` (or ``(bundle, report)`` pair) or a bare
-    bundle with an optional ``report``."""
-    if isinstance(design, DesignBundle):
-        return design, report
-    if isinstance(design, tuple) and len(design) == 2 and isinstance(design[0], DesignBundle):
-        return design[0], report if report is not None else design[1]
-    raise InputError(f"expected a design (the result of design_gg / design_ncp) or a "
-                     f"DesignBundle, got {type(design).__name__}")
+    """``(bundle, report)`` of a design (:func:`gridshell.workflow.cut.design_parts`)."""
+    from gridshell.workflow.cut import design_parts
+
+    return design_parts(design, report)
 
 
 def write(path: str | os.PathLike, design: Design | DesignBundle, report: dict | None = None,
@@ -129,37 +124,11 @@ def write(path: str | os.PathLike, design: Design | DesignBundle, report: dict |
     """Write a design to the bundle directory ``path`` atomically; returns ``path``.
 
     One call and one layout for every kind (GG, NCP, CNC, AA): design.json, net.obj,
-    aligned.obj, axes.obj, surface.obj, report.json, the alignment sequence
-    ``sequence/frame_*.obj`` and, with ``render``, the pictures (``preview.png`` /
-    ``delta_*.png``, ``sequence/frame_*.png``, ``alignment.gif``); and what a kind has of its
-    own: revolution.obj and states.png (GG), surface.json, axes_r.npy, aligned_r.npy and
-    collapse.png (NCP kinds). See :func:`gridshell.gg.pipeline.gg_files` and
-    :func:`gridshell.ncp.pipeline.ncp_files`.
+    aligned.obj, axes.obj, surface.obj, report.json, the alignment sequence and, with
+    ``render``, the pictures; see :func:`gridshell.workflow.cut.write_design`."""
+    from gridshell.workflow.cut import write_design
 
-    Parameters
-    ----------
-    design : Design (the result of :func:`design_gg` / :func:`design_ncp`) or DesignBundle
-    report : dict, optional
-        The run's report when ``design`` is a bare bundle. An NCP design needs it (its
-        ``"state"`` holds the surface and the rotation axes); for a GG bundle without one the
-        alignment sequence is computed (``frames`` steps; 0: none).
-    render : bool
-        Also draw the pictures and the animation (the slowest part).
-    """
-    bundle, report = _parts(design, report)
-    if bundle.kind == "GG":
-        from gridshell.gg.pipeline import gg_files
-
-        extra = gg_files(bundle, report, render=render, frames=frames, progress=progress)
-    else:
-        if not isinstance(report, dict) or "state" not in report:
-            raise InputError(f"an {bundle.kind} design is written with the report of "
-                             "design_ncp (it holds the B-spline and the rotation axes): "
-                             "write(path, design_ncp(...))")
-        from gridshell.ncp.pipeline import ncp_files
-
-        extra = ncp_files(bundle, report, render=render, progress=progress)
-    return write_bundle(path, bundle, extra=extra)
+    return write_design(path, design, report, render=render, frames=frames, progress=progress)
 
 
 def read(path: str | os.PathLike) -> DesignBundle:
@@ -178,27 +147,12 @@ def fabricate(design: Any, out_dir: str | os.PathLike, params: Any = None, *,
               force: bool = False, plan: bool = True, progress: Progress = None,
               material: str | None = None) -> dict[str, Any]:
     """Cut files (DXF, SVG, PNG per sheet), cut list and plan of a design into ``out_dir``
-    (:func:`gridshell.fabrication.pipeline.fabricate`; ``params``: a FabParams or a dict of its fields,
-    mm of the model). A design that fails its figures (recomputed from the files of a bundle
-    directory) is refused with :class:`~gridshell.core.errors.InputError`, one whose strips of
-    ``material`` (a preset name; default the strips' default material) would be overstressed
-    with :class:`~gridshell.structure.verdict.Overstressed`, unless ``force``; the structural
-    verdict is the report's ``"structure"``."""
-    from gridshell.fabrication.params import FabParams
-    from gridshell.fabrication.pipeline import fabricate as _fabricate
-    from gridshell.structure import Section, get_material
-    from gridshell.design.section import DEFAULTS
-    from gridshell.structure.verdict import require_elastic, verdict_record
+    (:func:`gridshell.workflow.cut.fabricate_checked`: refused when its figures or its strips'
+    stresses fail, unless ``force``)."""
+    from gridshell.workflow.cut import fabricate_checked
 
-    bundle = design if isinstance(design, (str, os.PathLike)) else _parts(design)[0]
-    where = Path(bundle) if isinstance(bundle, (str, os.PathLike)) else bundle
-    require_design(where, force, "fabricate(..., force=True) cuts it anyway")
-    fp = params if isinstance(params, FabParams) else FabParams(**(params or {}))
-    res = require_elastic(where, get_material(material or DEFAULTS["material"]),
-                          Section.from_params(fp), force,
-                          "fabricate(..., force=True) cuts it anyway")
-    return _fabricate(bundle, out_dir, fp, progress=progress, plan=plan,
-                      structure=verdict_record(res, force))
+    return fabricate_checked(design, out_dir, params, force=force, plan=plan,
+                             progress=progress, material=material)
 
 
 #: the names the API takes from their modules as they are (the very functions, real signatures),
