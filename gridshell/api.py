@@ -14,6 +14,8 @@
     gs.export_3dm("out/gg", "out/gg/gg.3dm")    # strips, holes, surface, cut sheets for Rhino
     gs.write_outputs("out/gg", report=True, rhino="out/gg/gg.3dm")  # render.png, report.html,
                                                 # and the .3dm built meanwhile (two cores)
+    study = gs.Study("target.obj", {"lamellae": [8, 12], "material": ["pp", "petg"]})
+    gs.sweep(study, "out/study").table          # every variant on Dask: a pandas DataFrame
 
 The functions are those of the modules that implement them (named in each docstring); the
 ``gridshell`` command calls the same ones.
@@ -28,7 +30,8 @@ from gridshell.design.bundle import Design, DesignBundle, read_bundle
 from gridshell.design.verification import verify_bundle
 
 __all__ = ["Design", "DesignBundle", "analyze", "check_structure", "design_gg", "design_ncp", "export_3dm",
-           "fabricate", "optimize_phlw", "read", "simulate", "verify", "write", "write_outputs"]
+           "fabricate", "load_results", "optimize_phlw", "read", "simulate", "Study", "sweep", "verify",
+           "write", "write_outputs"]
 
 Progress = Callable[[str], None] | None
 
@@ -160,7 +163,10 @@ def fabricate(design: Any, out_dir: str | os.PathLike, params: Any = None, *,
 _FROM = {"check_structure": "gridshell.workflow.structure",
          "simulate": "gridshell.workflow.structure",
          "export_3dm": "gridshell.export.rhino",
-         "write_outputs": "gridshell.workflow.outputs"}
+         "write_outputs": "gridshell.workflow.outputs",
+         "sweep": "gridshell.workflow.sweep",
+         "Study": "gridshell.workflow.study",
+         "load_results": "gridshell.workflow.sweep"}
 
 
 def __getattr__(name: str) -> Any:

@@ -30,6 +30,7 @@ SUBCOMMANDS: dict[str, str] = {
     "check": "check",
     "serve": "serve",
     "simulate": "simulate",
+    "sweep": "sweep",
 }
 
 

@@ -172,7 +172,7 @@ def best_keys(table: Any) -> list[str]:
 def write_sweep_page(table: Any, out: str | os.PathLike, varied: Sequence[str],
                      pictures: dict[str, Path] | None = None) -> Path:
     """``out/sweep.html`` and ``out/sweep.png`` of the results ``table`` (a DataFrame of
-    :func:`gridshell.workflow.sweep.run_sweep`); ``varied``: the parameters the study varies;
+    :func:`gridshell.workflow.sweep.sweep`); ``varied``: the parameters the study varies;
     ``pictures``: key -> PNG of a variant. Returns the page's path."""
     from gridshell.core.atomic import write_bytes, write_text
 

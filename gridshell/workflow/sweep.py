@@ -1,6 +1,6 @@
 """A design study on Dask: every variant of a :class:`~gridshell.workflow.study.Study` as one task.
 
-:func:`run_sweep` designs, verifies, checks and cuts each variant
+:func:`sweep` designs, verifies, checks and cuts each variant
 (:func:`gridshell.workflow.variant.run_variant`) on a ``dask.distributed`` cluster: a
 ``LocalCluster`` of ``workers`` processes with one thread (and one BLAS thread) each by
 default, or a running cluster at ``scheduler`` (``tcp://HOST:8786``: ``dask scheduler`` and
@@ -36,7 +36,7 @@ from gridshell.core.errors import InputError, OutputError
 from gridshell.workflow.study import Study, file_sha256, variant_key
 from gridshell.workflow.variant import COLUMNS, ROW, run_variant
 
-__all__ = ["SweepResult", "load_results", "run_sweep"]
+__all__ = ["SweepResult", "load_results", "sweep"]
 
 Progress = Callable[[str], None] | None
 VARIANTS = "variants"
@@ -46,7 +46,7 @@ INSTALL = "pip install 'gridshell[sweep]' (or 'make venv' in a checkout)"
 
 @dataclass(frozen=True)
 class SweepResult:
-    """What :func:`run_sweep` did: the results ``table`` (a pandas DataFrame, one row per
+    """What :func:`sweep` did: the results ``table`` (a pandas DataFrame, one row per
     variant), how many variants ran now and how many were already done, the files written."""
 
     table: Any
@@ -126,7 +126,7 @@ def _client(distributed: Any, workers: int, scheduler: str | None) -> tuple[Any,
     return distributed.Client(cluster), cluster
 
 
-def run_sweep(study: Study, out: str | os.PathLike, *, workers: int | None = None,
+def sweep(study: Study, out: str | os.PathLike, *, workers: int | None = None,
               scheduler: str | None = None, progress: Progress = None,
               bar: bool = False, page: bool = True) -> SweepResult:
     """Run every variant of ``study`` not yet done in ``out`` on Dask; the results table.
@@ -174,7 +174,6 @@ def _compute(todo: list, study: Study, variants: Path, workers: int | None,
                    for k, p in todo]
         if bar:
             distributed.progress(futures, notebook=False)
-        t0 = time.perf_counter()
         for fut in distributed.as_completed(futures):
             k = fut.key[len("variant-"):]
             try:
@@ -185,14 +184,25 @@ def _compute(todo: list, study: Study, variants: Path, workers: int | None,
                                   f"{str(exc)[:300]}"}
             rows[k] = row
             if not bar:
-                say(f"[{time.perf_counter() - t0:6.1f}s] {len(rows)}/{len(todo)} "
+                say(f"{len(rows)}/{len(todo)} "
                     f"{_label(row, study)}: exit {row.get('code')} "
                     f"{row.get('stage', '')} {row.get('time_s', 0) or 0:.1f} s")
     finally:
         client.close()
         if cluster is not None:
             cluster.close()
+        _sweep_temporary(variants)
     return rows
+
+
+def _sweep_temporary(variants: Path) -> None:
+    """Remove the temporary directories of tasks whose worker was killed (``.KEY.*.tmp``, made
+    by :func:`gridshell.workflow.variant.run_variant`; every task has ended here)."""
+    import shutil
+
+    for p in variants.glob(".*.tmp"):
+        if p.is_dir() and not p.is_symlink():
+            shutil.rmtree(p, ignore_errors=True)
 
 
 def _pictures(variants: Path, keys: list[str], say: Callable[[str], None]) -> dict[str, Path]:
