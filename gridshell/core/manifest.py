@@ -31,7 +31,7 @@ from pathlib import Path
 from typing import Any, Sequence
 
 __all__ = ["FORMAT", "MANIFEST", "build", "owner_of", "read", "refusal", "register",
-           "set_command", "write"]
+           "set_command", "sha256_of", "unchanged", "write"]
 
 MANIFEST = "manifest.json"
 FORMAT = "gridshell.manifest"
@@ -61,12 +61,27 @@ def is_temporary(path: Path) -> bool:
     return path.name.startswith(".") and path.name.endswith((".tmp", ".old"))
 
 
-def _sha256(path: Path) -> str:
+def sha256_of(path: str | os.PathLike) -> str:
+    """SHA-256 of a file's bytes (hex)."""
     h = hashlib.sha256()
     with open(path, "rb") as f:
         for block in iter(lambda: f.read(1 << 20), b""):
             h.update(block)
     return h.hexdigest()
+
+
+_sha256 = sha256_of
+
+
+def unchanged(directory: str | os.PathLike, rel: str) -> bool:
+    """Whether ``directory/rel`` is listed in the directory's manifest with the size and
+    SHA-256 it has now: a file the tool wrote and nobody changed since (replaceable)."""
+    m = read(directory)
+    path = Path(directory) / rel
+    rec = (m or {}).get("files", {}).get(rel)
+    if not isinstance(rec, dict) or path.is_symlink() or not path.is_file():
+        return False
+    return rec.get("size") == path.stat().st_size and rec.get("sha256") == sha256_of(path)
 
 
 def _record(path: Path) -> dict[str, Any]:

@@ -275,11 +275,9 @@ def variant_key(target_sha256: str, params: Mapping[str, Any], version: str,
 
 def file_sha256(path: str | os.PathLike) -> str:
     """sha256 of a file's bytes (the target's part of every variant's key)."""
-    h = hashlib.sha256()
+    from gridshell.core.manifest import sha256_of
+
     try:
-        with open(path, "rb") as f:
-            for block in iter(lambda: f.read(1 << 20), b""):
-                h.update(block)
+        return sha256_of(path)
     except OSError as exc:
         raise InputError(f"cannot read the target {path}: {exc.strerror or exc}") from None
-    return h.hexdigest()

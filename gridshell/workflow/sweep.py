@@ -41,6 +41,9 @@ __all__ = ["SweepResult", "load_results", "sweep"]
 Progress = Callable[[str], None] | None
 VARIANTS = "variants"
 STUDY = "study.json"
+#: the files a sweep writes at the top of its directory (each replaced only while the
+#: directory's manifest lists it unchanged)
+OWN = (STUDY, "results.parquet", "results.csv", "sweep.html", "sweep.png")
 INSTALL = "pip install 'gridshell[sweep]' (or 'make venv' in a checkout)"
 
 
@@ -59,16 +62,14 @@ class SweepResult:
 
 def _dask() -> Any:
     try:
-        import distributed  # noqa: F401
+        import distributed
         import pandas  # noqa: F401
     except ImportError:
         raise InputError(f"gridshell sweep runs on Dask: {INSTALL}") from None
-    import distributed
-
     return distributed
 
 
-def _plan(study: Study, out: Path) -> list[tuple[str, dict[str, Any]]]:
+def _plan(study: Study) -> list[tuple[str, dict[str, Any]]]:
     """``[(key, params)]`` of every variant, in the study's order (duplicates once)."""
     from gridshell.core.version import __version__
 
@@ -96,10 +97,23 @@ def _prepare(study: Study, out: Path) -> Path:
                           "empty or new -o directory (nothing in it is deleted)")
     from gridshell.core.atomic import write_text
 
+    require_own(out)
     write_text(sfile, json.dumps(study.as_dict(), indent=1) + "\n")
     variants = out / VARIANTS
     variants.mkdir(exist_ok=True)
+    _manifest(out)  # study.json is the sweep's own from here on
     return variants
+
+
+def require_own(out: Path) -> None:
+    """Refuse (OutputError) when a file the sweep is about to replace is not one it wrote:
+    not listed unchanged in ``out``'s manifest (checked again before the table and the page)."""
+    from gridshell.core.manifest import unchanged
+
+    for name in OWN:
+        if (out / name).exists() and not unchanged(out, name):
+            raise OutputError(f"{out / name} was not written by gridshell sweep or changed since; "
+                              "move it away or choose another -o (nothing is replaced)")
 
 
 def _done(variants: Path, key: str) -> dict[str, Any] | None:
@@ -139,7 +153,7 @@ def sweep(study: Study, out: str | os.PathLike, *, workers: int | None = None,
     out = Path(out)
     if not Path(study.target).is_file():
         raise InputError(f"the study's target {study.target} is not a file; give a mesh or .3dm")
-    plan = _plan(study, out)
+    plan = _plan(study)
     variants = _prepare(study, out)
     rows = {k: r for k, _ in plan if (r := _done(variants, k)) is not None}
     todo = [(k, p) for k, p in plan if k not in rows]
@@ -148,6 +162,7 @@ def sweep(study: Study, out: str | os.PathLike, *, workers: int | None = None,
     if todo:
         rows.update(_compute(todo, study, variants, workers, scheduler, say, bar))
     table = _table([rows[k] for k, _ in plan if k in rows], study)
+    require_own(out)
     results = _write_table(table, out)
     pic = None
     if page:
@@ -191,18 +206,20 @@ def _compute(todo: list, study: Study, variants: Path, workers: int | None,
         client.close()
         if cluster is not None:
             cluster.close()
-        _sweep_temporary(variants)
+        _sweep_temporary(variants, [k for k, _ in todo])
     return rows
 
 
-def _sweep_temporary(variants: Path) -> None:
-    """Remove the temporary directories of tasks whose worker was killed (``.KEY.*.tmp``, made
-    by :func:`gridshell.workflow.variant.run_variant`; every task has ended here)."""
+def _sweep_temporary(variants: Path, keys: list[str]) -> None:
+    """Remove the temporary directories of this run's tasks whose worker was killed
+    (``.KEY.*.tmp``, made by :func:`gridshell.workflow.variant.run_variant`; every task has
+    ended here): only those names, only directories, never through a link."""
     import shutil
 
-    for p in variants.glob(".*.tmp"):
-        if p.is_dir() and not p.is_symlink():
-            shutil.rmtree(p, ignore_errors=True)
+    for k in keys:
+        for p in variants.glob(f".{k}.*.tmp"):
+            if p.is_dir() and not p.is_symlink():
+                shutil.rmtree(p, ignore_errors=True)
 
 
 def _pictures(variants: Path, keys: list[str], say: Callable[[str], None]) -> dict[str, Path]:
@@ -254,9 +271,15 @@ def _write_table(table: Any, out: Path) -> Path:
 
 
 def _manifest(out: Path) -> None:
+    """The study directory's manifest: the sweep's own files and the variants (each with a
+    manifest of its own); files a user added are not claimed."""
     from gridshell.core import manifest
 
-    manifest.write(out, manifest.build(out, "sweep", "design study"))
+    m = manifest.build(out, "sweep", "design study")
+    m["files"] = {f: r for f, r in m["files"].items() if f in OWN}
+    m["outputs"] = [o for o in m["outputs"] if o.startswith(VARIANTS + "/")]
+    m["dirs"] = [d for d in m["dirs"] if d == VARIANTS or d.startswith(VARIANTS + "/")]
+    manifest.write(out, m)
 
 
 def load_results(out: str | os.PathLike) -> Any:

@@ -109,3 +109,27 @@ def test_a_killed_worker_loses_only_its_task(tmp_path):
     assert set(t["code"]) == {0}
     dirs = sorted(p.name for p in (tmp_path / "s" / "variants").iterdir())
     assert dirs == sorted(t["key"])            # no half-written variant left behind
+
+
+def test_files_the_user_put_in_a_study_are_never_replaced_nor_claimed(local, tmp_path):
+    import shutil
+
+    from gridshell.core.errors import OutputError
+    from gridshell.core.manifest import read
+
+    st, out, _ = local
+    mine = tmp_path / "study"
+    shutil.copytree(out, mine)
+    (mine / "notes.txt").write_text("my notes")
+    sweep(st, mine, workers=1, page=False)             # nothing to run: table rewritten
+    assert "notes.txt" not in read(mine)["files"] and (mine / "notes.txt").is_file()
+    (mine / "sweep.html").write_text("my page")
+    with pytest.raises(OutputError, match="sweep.html"):
+        sweep(st, mine, workers=1)
+    assert (mine / "sweep.html").read_text() == "my page"
+    stranger = tmp_path / "other"
+    stranger.mkdir()
+    (stranger / "data.csv").write_text("1")
+    with pytest.raises(OutputError, match="not a study"):
+        sweep(st, stranger, workers=1)
+    assert sorted(p.name for p in stranger.iterdir()) == ["data.csv"]
