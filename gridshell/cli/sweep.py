@@ -80,9 +80,8 @@ def study_of(args: Any) -> Any:
         target, samples, sampling, seed, units, fixed = args.target, 0, "grid", 0, args.units, {}
     if not values and not ranges:
         raise InputError("nothing varies: give --vary NAME=V1,V2 (e.g. --vary lamellae=8,12,16)")
-    if ranges:
-        samples = args.samples or samples or 8
-        sampling = args.sampling or (sampling if sampling != "grid" else "lhs")
+    if ranges:  # a study with ranges samples them by Latin hypercube unless told (Study)
+        samples, sampling = args.samples or samples or 8, args.sampling or sampling
     return Study(str(target), values, ranges, samples=samples, sampling=sampling,
                  seed=seed if args.seed is None else args.seed, units=units, fixed=fixed)
 
