@@ -29,6 +29,9 @@ references (success: exit 0, converged, no energy increase).
     .venv/bin/python benchmarks/corpus.py --subset saddle,dome-01 --only ncp
     .venv/bin/python benchmarks/corpus.py --list                # the references and their runs
     .venv/bin/python benchmarks/corpus.py --report a.json b.json  # the table of saved runs
+
+The runs are tasks of a Dask cluster (the engine of ``gridshell sweep``): ``--jobs N`` local
+worker processes, or ``--scheduler tcp://HOST:8786`` for a running one.
 """
 from __future__ import annotations
 
@@ -42,7 +45,6 @@ import subprocess
 import sys
 import tempfile
 import time
-from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
 
@@ -349,6 +351,39 @@ def summary(records: list[dict[str, Any]]) -> str:
     return "\n".join(out)
 
 
+def _run_on_dask(jobs: list[tuple[Reference, str]], work: Path, args: Any,
+                 t0: float) -> list[dict[str, Any]]:
+    """Every job as a task of a Dask cluster (:func:`gridshell.workflow.sweep.open_client`:
+    ``--jobs`` local worker processes, or ``--scheduler``), the records in the jobs' order;
+    one progress line per finished run, the records so far in ``--json`` after each."""
+    from distributed import as_completed
+
+    from gridshell.workflow.sweep import open_client
+
+    client, cluster = open_client(max(1, min(args.jobs, len(jobs) or 1)), args.scheduler)
+    done: dict[int, dict[str, Any]] = {}
+    try:
+        futures = {client.submit(run_one, ref, mode, work, args.timeout, args.fab_args.split(),
+                                 key=f"corpus-{i}-{ref.name}-{mode}", pure=False): i
+                   for i, (ref, mode) in enumerate(jobs)}
+        for fut in as_completed(list(futures)):
+            rec = fut.result()
+            done[futures[fut]] = rec
+            print(f"[{time.perf_counter() - t0:7.0f}s] {len(done):3d}/{len(jobs)} "
+                  f"{rec['reference']} {rec['mode']}: "
+                  f"{'timeout' if rec['code'] is None else 'exit ' + str(rec['code'])} "
+                  f"{rec['time']:.1f} s {'ok' if success(rec) else rec['message'][:100]}",
+                  file=sys.stderr, flush=True)
+            if args.json:  # partial results survive an interrupted run
+                Path(args.json).write_text(json.dumps([done[i] for i in sorted(done)],
+                                                      indent=1, default=str))
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+    return [done[i] for i in sorted(done)]
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--subset", help="references: names, families or 'fast', comma-separated")
@@ -358,7 +393,11 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--every", type=int, default=1, help="every N-th reference (default 1)")
     ap.add_argument("--start", type=int, default=0,
                     help="first reference for --every (e.g. --every 2 --start 1: the other half)")
-    ap.add_argument("--jobs", type=int, default=1, help="runs at a time (default 1)")
+    ap.add_argument("--jobs", type=int, default=1,
+                    help="runs at a time: worker processes of a local Dask cluster (default 1)")
+    ap.add_argument("--scheduler", metavar="tcp://HOST:8786",
+                    help="run on a running Dask cluster instead (its workers need this "
+                         "checkout and --keep DIR on a shared filesystem)")
     ap.add_argument("--timeout", type=float, default=180.0, help="seconds per command")
     ap.add_argument("--no-net", action="store_true",
                     help="also the runs that must answer 'no net exists' (aa on K > 0)")
@@ -410,21 +449,7 @@ def main(argv: list[str] | None = None) -> int:
     with tempfile.TemporaryDirectory(prefix="gridshell-corpus-") as tmp:
         work = Path(args.keep) if args.keep else Path(tmp)
         work.mkdir(parents=True, exist_ok=True)
-        done: list[dict[str, Any]] = []
-
-        def one(job: tuple[Reference, str]) -> dict[str, Any]:
-            rec = run_one(job[0], job[1], work, args.timeout, args.fab_args.split())
-            done.append(rec)
-            print(f"[{time.perf_counter() - t0:7.0f}s] {len(done):3d}/{len(jobs)} "
-                  f"{rec['reference']} {rec['mode']}: "
-                  f"{'timeout' if rec['code'] is None else 'exit ' + str(rec['code'])} "
-                  f"{rec['time']:.1f} s {'ok' if success(rec) else rec['message'][:100]}",
-                  file=sys.stderr, flush=True)
-            if args.json:  # partial results survive an interrupted run
-                Path(args.json).write_text(json.dumps(done, indent=1, default=str))
-            return rec
-        with ThreadPoolExecutor(max_workers=max(1, args.jobs)) as ex:
-            records = list(ex.map(one, jobs))
+        records = _run_on_dask(jobs, work, args, t0)
     if args.json:
         Path(args.json).write_text(json.dumps(records, indent=1, default=str))
     print(table(records))

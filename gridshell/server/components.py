@@ -14,6 +14,8 @@ route          inputs                                                   outputs
 ``/fabricate`` Bundle, Scale, Sheet, Width, Options, Force              Cut, Score,
                                                                         Engrave, Sheets,
                                                                         Report, Folder
+``/sweep``     Target (mesh, m), Vary (NAME=VALUES list), Workers,      Table, Best, Page,
+               Surface (m)                                              Folder
 =============  ======================================================  ==================
 
 A design component takes a mesh (Target / Reference) or a NURBS surface or single-face Brep
@@ -26,6 +28,11 @@ Designs are written as bundles into the server's work directory; ``Bundle`` is t
 only (:mod:`gridshell.server.guard`). ``Options`` is a JSON object of further keywords of
 :func:`gridshell.gg.pipeline.design_gg`, :func:`gridshell.ncp.pipeline.design_ncp` or
 :class:`fabrication.FabParams` (``{}`` for none). Metrics and reports are JSON text.
+
+``/sweep`` runs a small study (at most :data:`MAX_SWEEP` variants, ``Vary`` items as
+``gridshell sweep --vary``) on the same engine as the CLI (a Dask LocalCluster of ``Workers``
+processes, at most the cores): the target is stored as ``target.3dm`` (metres) in the
+study's folder, read back as the CLI reads it; Table is the results as JSON rows.
 
 A failure never leaves a dead component: the reply carries the tool's one-line message in
 ``errors`` (Hops shows it on the component, its outputs empty), and a design that misses the
@@ -54,6 +61,8 @@ NCP_OPTIONS = ("spacing", "n", "samples", "levelset_ctrl", "levelset_degree", "o
 _PAIRS = ("samples", "levelset_ctrl", "levelset_degree", "trace_grid", "collapse_samples",
           "surface_samples")
 SHEET_SPACING = 50.0   # mm between the sheets laid out along x in the Fabricate outputs
+#: the largest study ``/sweep`` runs (a bigger one belongs to ``gridshell sweep``)
+MAX_SWEEP = 24
 
 
 class Reply:
@@ -230,6 +239,50 @@ def fabricate_component(resolve: Callable[[Any], Path], bundle_dir: str,
                  json.dumps(summary, default=_plain), str(out), warnings=warnings)
 
 
+def sweep_component(new_dir: Callable[[str], Path], target: Any = None, vary: Any = None,
+                    workers: int = 2, surface: Any = None) -> Reply:
+    """The ``/sweep`` component: every variant of ``vary`` (``NAME=V1,V2`` items, as
+    ``gridshell sweep --vary``) on ``target`` (a Rhino mesh) or ``surface`` (NURBS), metres,
+    run by :func:`gridshell.workflow.sweep.sweep` into ``new_dir("sweep")``; the table as
+    JSON rows, the best variant (elastic, cut, least utilisation), sweep.html and the folder."""
+    import os
+
+    from gridshell.api import sweep
+    from gridshell.design.bundle import finite_json
+    from gridshell.geometry import rhino_adapter as rh
+    from gridshell.workflow.study import Study, parse_vary
+
+    items = [vary] if isinstance(vary, str) else list(vary or [])
+    values, ranges = parse_vary([str(v) for v in items if str(v).strip()])
+    if not values or ranges:
+        raise InputError("Vary: give NAME=V1,V2 items (e.g. lamellae=6,8 and kind=gg,cnc); "
+                         "ranges are for 'gridshell sweep --samples'")
+    study_size = len(Study("target.3dm", values))
+    if study_size > MAX_SWEEP:
+        raise InputError(f"Vary gives {study_size} variants, more than the server's "
+                         f"{MAX_SWEEP}; give fewer values or run 'gridshell sweep'")
+    cores = os.cpu_count() or 1
+    if not 1 <= int(workers) <= cores:
+        raise InputError(f"Workers {workers}: give 1 to {cores} (the server's cores)")
+    obj = _one_target(target, surface, "Target")
+    rhino.target_input(obj)                                  # a bad target: its message now
+    out = new_dir("sweep")
+    out.mkdir(parents=True)
+    model = rh.Model3dm("Meters", 1e-6).model
+    model.Objects.Add(obj)
+    if not rh.write_file(model, out / "target.3dm"):
+        raise InputError("could not store the target as a .3dm; connect a mesh or a surface")
+    res = sweep(Study(str(out / "target.3dm"), values), out / "study", workers=int(workers))
+    rows = finite_json(res.table.to_dict(orient="records"))
+    ok = [r for r in rows if r.get("code") == 0 and r.get("max_utilisation") is not None]
+    best = min(ok, key=lambda r: r["max_utilisation"]) if ok else None
+    best_text = (", ".join(f"{k}={best[k]}" for k in values) + f" (key {best['key']})"
+                 if best else "")
+    warnings = [] if ok else ["no variant was cut: see the Table's code and message"]
+    return Reply(json.dumps(rows, default=_plain, allow_nan=False), best_text,
+                 str(res.page or ""), str(out / "study"), warnings=warnings)
+
+
 def _sheet_curves(layout: Any, tolerance: float) -> tuple[list, list, list, list]:
     """``(cut, score, engrave, sheets)`` curves (mm) of a nesting layout: each sheet shifted
     along x by its width and :data:`SHEET_SPACING`; outlines flattened to ``tolerance`` mm."""
@@ -354,8 +407,26 @@ def _fabricate_spec(hs) -> dict[str, Any]:
                  hs.HopsString("Folder", "D", "folder of the DXF / SVG files")])
 
 
+def _sweep_spec(hs) -> dict[str, Any]:
+    """The Hops declaration of ``/sweep``."""
+    return dict(
+        rule="/sweep", name="Design study", nickname="Sweep",
+        description=f"A small design study (at most {MAX_SWEEP} variants): every combination "
+                    "of the Vary values designed, verified, checked and cut",
+        category="Gridshell", subcategory="Explore",
+        inputs=[hs.HopsMesh("Target", "T", "target mesh, metres", optional=True),
+                hs.HopsString("Vary", "V", "NAME=V1,V2 per item, e.g. lamellae=6,8 and "
+                              "kind=gg,cnc", access=hs.HopsParamAccess.LIST),
+                hs.HopsInteger("Workers", "W", "processes (default 2)", optional=True),
+                _surface_param(hs)],
+        outputs=[hs.HopsString("Table", "T", "one row per variant (JSON)"),
+                 hs.HopsString("Best", "B", "the elastic cut variant of least utilisation"),
+                 hs.HopsString("Page", "P", "sweep.html"),
+                 hs.HopsString("Folder", "D", "the study's folder (variants/, results)")])
+
+
 def register(hops, workdir: Path, resolve: Callable[[Any], Path]) -> None:
-    """Register the five components on ``hops`` (a ghhops_server Hops middleware); designs
+    """Register the six components on ``hops`` (a ghhops_server Hops middleware); designs
     go into new folders of ``workdir``, bundles are taken where ``resolve`` accepts them.
     Each handler's parameters are its inputs in order (Hops passes them so, a missing
     optional input as its default)."""
@@ -383,6 +454,10 @@ def register(hops, workdir: Path, resolve: Callable[[Any], Path]) -> None:
     @hops.component(**_fabricate_spec(hs))
     def fab(bundle_dir, scale=None, sheet="600x400", width=None, opts="{}", force=False):
         return fabricate_component(resolve, bundle_dir, scale, sheet, width, opts, force)
+
+    @hops.component(**_sweep_spec(hs))
+    def study(target=None, vary=None, workers=2, surface=None):
+        return sweep_component(new_dir, target, vary, workers, surface)
 
 
 def make_app(workdir: str | Path | None = None, *, allow: tuple = (), host: str = "127.0.0.1",

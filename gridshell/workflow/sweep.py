@@ -36,7 +36,7 @@ from gridshell.core.errors import InputError, OutputError
 from gridshell.workflow.study import Study, file_sha256, variant_key
 from gridshell.workflow.variant import COLUMNS, ROW, run_variant
 
-__all__ = ["SweepResult", "load_results", "sweep"]
+__all__ = ["SweepResult", "load_results", "open_client", "sweep"]
 
 Progress = Callable[[str], None] | None
 VARIANTS = "variants"
@@ -124,9 +124,13 @@ def _done(variants: Path, key: str) -> dict[str, Any] | None:
         return None
 
 
-def _client(distributed: Any, workers: int, scheduler: str | None) -> tuple[Any, Any]:
-    """``(client, cluster)``: a client of the running cluster at ``scheduler``, or of a new
-    LocalCluster of ``workers`` single-threaded processes (cluster None for a remote one)."""
+def open_client(workers: int, scheduler: str | None = None,
+                distributed: Any = None) -> tuple[Any, Any]:
+    """``(client, cluster)``: a ``dask.distributed`` client of the running cluster at
+    ``scheduler``, or of a new LocalCluster of ``workers`` single-threaded processes (cluster
+    None for a remote one); close both when done. The one door to Dask of the sweep and the
+    corpus runner (benchmarks/corpus.py)."""
+    distributed = distributed or _dask()
     if scheduler:
         try:
             return distributed.Client(scheduler, timeout="10s"), None
@@ -180,7 +184,7 @@ def _compute(todo: list, study: Study, variants: Path, workers: int | None,
     """Run ``todo`` on the cluster; the rows by key (as each task ends, so Ctrl-C keeps them)."""
     distributed = _dask()
     n = max(1, int(workers or os.cpu_count() or 1))
-    client, cluster = _client(distributed, min(n, len(todo)), scheduler)
+    client, cluster = open_client(min(n, len(todo)), scheduler, distributed)
     rows: dict[str, dict] = {}
     try:
         target = str(Path(study.target).resolve())

@@ -41,6 +41,8 @@ def _fails(msg: str) -> None:
 class _TwoArgs(Exception):
     def __init__(self, a, b):       # pickles as (a b,), cannot be rebuilt from its args
         super().__init__(f"{a} {b}")
+        self.lock = threading.Lock()    # and holds a lock, which no reducer pickles (tblib's,
+                                        # installed by dask, rebuilds the two-argument class)
 
 
 def _fails_oddly() -> None:
