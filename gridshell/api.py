@@ -57,7 +57,7 @@ def analyze(target: Any, *, units: Any = None, clean: bool = True, obj: str | No
 
 
 def design_gg(target: Any, *, meridians: str = "cols", grid: tuple[int, int] | None = None,
-              direction: float | None = None, n_lamellae: int | None = 10,
+              direction: float | None = None, n_lamellae: int | None = None,
               spacing: float | None = None, crossing_angle: float = 90.0,
               at_parallel: float = 0.5,
               offsets: tuple[Sequence[float], Sequence[float]] | None = None,
@@ -89,10 +89,13 @@ def design_ncp(source: Any, *, mode: str = "phlw", curves: int | tuple[int, int]
                allow_unconverged: bool = False, strict: bool = False, units: Any = None,
                clean: bool = True, obj: str | None = None, progress: Progress = None) -> Design:
     """Design an NCP gridshell (PHLW, CNC or AA) on a reference surface: ``(bundle,
-    report)``; parameters and results of :func:`gridshell.ncp.pipeline.design_ncp`."""
-    from gridshell.ncp import pipeline
+    report)``; parameters and results of :func:`gridshell.ncp.pipeline.design_ncp`. Where
+    the PHLW step fails on a reference with no regular patch of the mode (the analysis's
+    finding), :class:`~gridshell.core.errors.NoNetError` (exit 3) says so
+    (:func:`gridshell.analysis.admissible.design_ncp_explained`)."""
+    from gridshell.analysis.admissible import design_ncp_explained
 
-    return pipeline.design_ncp(
+    return design_ncp_explained(
         source, mode=mode, curves=curves, spacing=spacing, n=n, samples=samples,
         levelset_ctrl=levelset_ctrl, levelset_degree=levelset_degree, omega_f=omega_f,
         trace_grid=trace_grid, collapse_samples=collapse_samples,

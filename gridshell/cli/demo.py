@@ -28,11 +28,11 @@ MARKER = "demo.json"
 
 #: sizes of the full and the --quick demo
 SIZES: dict[str, dict[str, Any]] = {
-    "full": {"gg": {"grid": (16, 16), "n_lamellae": 8, "frames": 12},
+    "full": {"gg": {"grid": (16, 16), "n_lamellae": 18, "frames": 12},
              "phlw": {"samples": (18, 18), "outer": 4, "max_iter": 40},
              "ncp": {"curves": 12, "samples": (48, 48), "collapse_samples": (1200, 1200),
                      "frames": 12, "postopt_rounds": 3}},
-    "quick": {"gg": {"grid": (12, 12), "n_lamellae": 6, "frames": 4},
+    "quick": {"gg": {"grid": (12, 12), "n_lamellae": 12, "frames": 4},
               "phlw": {"samples": (10, 10), "outer": 1, "max_iter": 10},
               "ncp": {"curves": 8, "samples": (32, 32), "collapse_samples": (400, 400),
                       "frames": 4, "postopt_rounds": 2}},
@@ -119,7 +119,7 @@ def _gg(root: Path, sizes: dict, progress) -> dict[str, Any]:
     t0 = time.perf_counter()
     target = data.path("dome.obj")
     progress(f"GG: designing a geodesic gridshell on {target.name} (grid "
-             f"{sizes['grid'][0]} x {sizes['grid'][1]}, {sizes['n_lamellae']} lamellae)")
+             f"{sizes['grid'][0]} x {sizes['grid'][1]}, {sizes['n_lamellae']} lamellae per family)")
     design = design_gg(target, grid=sizes["grid"], n_lamellae=sizes["n_lamellae"],
                        frames=sizes["frames"], progress=progress.detail)
     bundle, report = design

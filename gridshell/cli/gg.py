@@ -27,7 +27,10 @@ def add_args(p: argparse.ArgumentParser) -> None:
                    help="meridian direction in degrees, for triangle-mesh targets")
     g = p.add_mutually_exclusive_group()
     g.add_argument("--lamellae", type=count(2), metavar="N",
-                   help="lamellae per family crossing the reference parallel (default 10)")
+                   help="lamellae made per family: the evenly spaced geodesics that reach "
+                        "the surface, as many as asked where the shape allows (default: the "
+                        "spacing that puts 10 of each family across the reference parallel; "
+                        "the summary says what was made)")
     g.add_argument("--spacing", type=positive, metavar="M",
                    help="spacing of the lamellae along the reference parallel, metres")
     g.add_argument("--offsets", nargs="+", type=number(), metavar="M",
@@ -95,7 +98,7 @@ def run(args: Any) -> int:
                          f"{args.frames}; e.g. 12")
     check_output(args.output, marker="design.json")
     progress = Progress(args)
-    n = args.lamellae if args.lamellae is not None or args.spacing is not None else 10
+    n = args.lamellae
     design = design_gg(args.target, meridians=args.meridians,
                        grid=tuple(args.grid) if args.grid else None,
                        direction=args.direction, n_lamellae=n, spacing=args.spacing,

@@ -18,6 +18,7 @@ from gridshell.core.errors import GridshellError
 
 #: subcommand name -> module in gridshell.cli with ``HELP``, ``add_args(parser)`` and ``run(args)``
 SUBCOMMANDS: dict[str, str] = {
+    "build": "build",
     "analyze": "analyze",
     "gg": "gg",
     "phlw": "phlw",

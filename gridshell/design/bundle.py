@@ -177,13 +177,15 @@ def _jsonable(obj: Any) -> Any:
 
 
 def write_bundle(path: str | Path, bundle: DesignBundle,
-                 extra: dict[str, bytes | Callable[[Path], None]] | None = None) -> Path:
+                 extra: dict[str, bytes | Callable[[Path], None]] | None = None,
+                 owner: str | None = None) -> Path:
     """Write ``bundle`` to directory ``path`` atomically; ``extra`` maps file names to bytes
-    or to a callable that writes that file given its full path. Returns ``path``."""
+    or to a callable that writes that file given its full path; ``owner``: the command the
+    manifest names (default ``gg`` / ``ncp`` by kind). Returns ``path``."""
     from gridshell.geometry.meshfile import write_mesh, write_polylines
 
     path = Path(path)
-    with atomic_dir(path, owner="gg" if bundle.kind == "GG" else "ncp",
+    with atomic_dir(path, owner=owner or ("gg" if bundle.kind == "GG" else "ncp"),
                     kind=f"design bundle {bundle.kind}") as tmp:
         d = bundle.design_json()
         d["metrics"], d["params"] = finite_json(d["metrics"]), finite_json(d["params"])

@@ -132,10 +132,12 @@ def mesh_arrays(m: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return V, P, np.where(tri, 3, 4).astype(np.int64)
 
 
-def mesh(V: np.ndarray, F: np.ndarray, what: str = "surface") -> Any:
+def mesh(V: np.ndarray, F: np.ndarray, what: str = "surface", compact: bool = True) -> Any:
     """A Rhino mesh of vertices ``V (n,3)`` (stored in double precision, as the bundle's) and
     triangle / quad faces ``F (m,3|4)`` (negative indices pad a triangle in a quad array);
-    :class:`InputError` naming a face of another number of corners (``what`` names the mesh)."""
+    :class:`InputError` naming a face of another number of corners (``what`` names the mesh).
+    ``compact``: drop the vertices no face uses (False keeps every vertex, in order: a net's
+    joints that lie on no loop)."""
     V = np.asarray(V, float).reshape(-1, 3)
     F = np.asarray(F, np.int64)
     F = F.reshape(len(F), -1) if F.size else F.reshape(0, 3)
@@ -161,7 +163,8 @@ def mesh(V: np.ndarray, F: np.ndarray, what: str = "surface") -> Any:
         for f in F.tolist():
             add(*[i for i in f if i >= 0])
     m.Normals.ComputeNormals()
-    m.Compact()
+    if compact:
+        m.Compact()
     return m
 
 

@@ -326,7 +326,7 @@ def geodesic_net(rev: Revolution, *, n_lamellae: int | None = None, spacing: flo
                  crossing_angle: float = 90.0, at_parallel: float = 0.5,
                  offsets1: Sequence[float] | None = None,
                  offsets3: Sequence[float] | None = None,
-                 step: float | None = None) -> IntrinsicNet:
+                 step: float | None = None, made: int | None = None) -> IntrinsicNet:
     """A geodesic alignable net on a surface of revolution (paper 3.3, 4.1.2).
 
     One geodesic is traced through ``(s*, 0)`` at ``xi* = 90 - alpha/2`` degrees to the
@@ -354,6 +354,11 @@ def geodesic_net(rev: Revolution, *, n_lamellae: int | None = None, spacing: flo
         parallel, radians; override ``n_lamellae`` / ``spacing`` for that family.
     step : float, optional
         Sampling step along the curves, metres (default: profile length / 400).
+    made : int, optional
+        Instead of ``n_lamellae``: the number of curves made per family (all that reach the
+        domain, evenly spaced along the reference parallel from its first side meridian: the
+        densest spacing giving at most ``made`` curves in either family,
+        :func:`_spacing_for_count`). ``info["lamellae"]`` says what was asked and made.
 
     Returns
     -------
@@ -368,9 +373,14 @@ def geodesic_net(rev: Revolution, *, n_lamellae: int | None = None, spacing: flo
     c, xi = clairaut_constant_for_angle(rev, np.radians(crossing_angle), s_star)
     r_star = float(rev.r_of_s(s_star))
     step = (s_hi - s_lo) / 400.0 if step is None else float(step)
-    dstep = (_uniform_spacing(n_lamellae, spacing, Phi, r_star, step)
+    if made is not None and (n_lamellae is not None or spacing is not None):
+        raise InputError("give one of made, n_lamellae and spacing")
+    dstep = (_uniform_spacing(n_lamellae if made is None else made, spacing, Phi, r_star, step)
              if offsets1 is None or offsets3 is None else None)
     base, bs, bphi, bsig = _base_geodesic(rev, s_star, xi, (s_lo, s_hi), Phi, step)
+    if dstep is not None and made is not None:      # the number made per family
+        dstep = _spacing_for_count(int(made), base, bsig, bphi, (p_lo, p_hi), step,
+                                   step / r_star)
     o1 = (np.asarray(offsets1, float) if offsets1 is not None
           else _uniform_offsets(bphi, +1, p_lo, p_hi, dstep))
     o3 = (np.asarray(offsets3, float) if offsets3 is not None
@@ -384,7 +394,9 @@ def geodesic_net(rev: Revolution, *, n_lamellae: int | None = None, spacing: flo
         raise NoNetError("no curve of the net reaches the surface; check the offsets "
                          "(radians of the surface of revolution) or the spacing")
     turning = bool(np.any(np.diff(np.sign(np.diff(bs))) != 0))
-    info = {"base_phi_range": (float(bphi.min()), float(bphi.max())),
+    info = {"lamellae": {"asked": None if made is None else int(made),
+                         "made": [len(c1), len(c3)]},
+            "base_phi_range": (float(bphi.min()), float(bphi.max())),
             "base_length": float(bsig[-1] - bsig[0]), "turning_points": turning,
             "r_star": r_star, "step": step}
     return IntrinsicNet(curves1=c1, curves3=c3, sigma1=s1, sigma3=s3, offsets1=np.asarray(k1),
@@ -434,6 +446,52 @@ def _base_geodesic(rev: Revolution, s_star: float, xi: float, s_range: tuple[flo
     bs, bphi, bsig, bds, bdphi = (a[keep] for a in (bs, bphi, bsig, bds, bdphi))
     base = CubicHermiteSpline(bsig, np.stack([bs, bphi], 1), np.stack([bds, bdphi], 1))
     return base, bs, bphi, bsig
+
+
+def _spacing_for_count(n: int, base: Callable[..., np.ndarray], bsig: np.ndarray,
+                       bphi: np.ndarray, phi_range: tuple[float, float], step: float,
+                       d_min: float) -> float:
+    """The angle between evenly spaced curves (radians, at least ``d_min``) for which the
+    larger family has ``n`` curves reaching ``phi_range`` (or the nearest count there is).
+
+    First the paper's spacing ``Phi / (k - 1)`` (k curves across the reference parallel, the
+    domain's side meridians on a curve) for the k that makes ``n``; else the middle of the
+    spacings that make ``n`` (on 600 spacings from ``d_min`` up: the count of
+    :func:`_uniform_offsets`, and where it is within 2 of ``n`` the curves traced), so that
+    no curve only grazes the domain's corner; where no spacing makes ``n``, the nearest
+    count."""
+    p_lo, p_hi = phi_range
+    Phi = p_hi - p_lo
+
+    def offsets(d: float) -> int:
+        return max(len(_uniform_offsets(bphi, sg, p_lo, p_hi, d)) for sg in (+1, -1))
+
+    def traced(d: float) -> int:
+        return max(len(_family(base, bsig, bphi, sg, _uniform_offsets(bphi, sg, p_lo, p_hi, d),
+                               phi_range, step)[0]) for sg in (+1, -1))
+
+    for k in range(2, 4 * n + 2):
+        d = Phi / (k - 1)
+        if d < d_min:
+            break
+        c = offsets(d)
+        if c > n:
+            break
+        if c == n and traced(d) == n:
+            return d
+
+    width = Phi + float(np.ptp(bphi))
+    ds = np.geomspace(d_min, 2.0 * width + d_min, 600)   # the count falls from many to <= 2
+    cs = np.array([offsets(d) for d in ds])
+    near = np.flatnonzero(np.abs(cs - n) <= 2)            # traced where the count is close
+    for i in near:
+        cs[i] = traced(ds[i])
+    if not np.any(cs == n):                   # n is skipped here: the nearest count there is
+        near = int(np.argmin(np.abs(cs - n) + 0.5 * (cs > n)))
+        n = int(cs[near])
+    idx = np.flatnonzero(cs == n)
+    mid = idx[len(idx) // 2]
+    return float(ds[mid])
 
 
 def _uniform_offsets(bphi: np.ndarray, sign: int, p_lo: float, p_hi: float,

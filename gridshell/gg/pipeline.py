@@ -96,7 +96,12 @@ def check_offsets(offsets: Any) -> tuple[np.ndarray, np.ndarray]:
     return out[0], out[1]
 
 
-def gg_net_from_mesh(P: np.ndarray, *, n_lamellae: int | None = 10, spacing: float | None = None,
+#: with neither a count nor a spacing: the spacing that puts this many lamellae of each family
+#: across the reference parallel (more reach the surface beyond it; the summary says how many)
+DEFAULT_CROSSING = 10
+
+
+def gg_net_from_mesh(P: np.ndarray, *, n_lamellae: int | None = None, spacing: float | None = None,
                      crossing_angle: float = 90.0, at_parallel: float = 0.5,
                      offsets: tuple[Sequence[float], Sequence[float]] | None = None,
                      angle: float | None = None, step: float | None = None,
@@ -107,7 +112,11 @@ def gg_net_from_mesh(P: np.ndarray, *, n_lamellae: int | None = 10, spacing: flo
     ----------
     P : (R, C, 3) float
         GG mesh, metres (``P[:, j]`` meridians, ``P[i, :]`` parallels).
-    n_lamellae, spacing, crossing_angle, at_parallel
+    n_lamellae : int, optional
+        Lamellae made per family (``made`` of :func:`gridshell.gg.clairaut.geodesic_net`);
+        with neither it nor ``spacing``: the spacing that puts :data:`DEFAULT_CROSSING` of
+        each family across the reference parallel.
+    spacing, crossing_angle, at_parallel
         As in :func:`gridshell.gg.clairaut.geodesic_net` (``crossing_angle`` in degrees,
         ``spacing`` in metres along the reference parallel).
     offsets : (seq, seq), optional
@@ -142,7 +151,9 @@ def gg_net_from_mesh(P: np.ndarray, *, n_lamellae: int | None = 10, spacing: flo
         n_lamellae = spacing = None
     _say(progress, f"tracing geodesics (crossing angle {crossing_angle:g} deg)")
     try:
-        inet = geodesic_net(rev, n_lamellae=n_lamellae, spacing=spacing,
+        inet = geodesic_net(rev, made=n_lamellae, spacing=spacing,
+                            n_lamellae=(DEFAULT_CROSSING if n_lamellae is None and spacing is None
+                                        and o1 is None else None),
                             crossing_angle=crossing_angle, at_parallel=at_parallel,
                             offsets1=o1, offsets3=o3, step=step)
     except NoNetError:
@@ -156,10 +167,46 @@ def gg_net_from_mesh(P: np.ndarray, *, n_lamellae: int | None = 10, spacing: flo
             "of arc length: give positions in that range (metres)") from None
     _say(progress, f"mapping {len(inet.curves1)} + {len(inet.curves3)} curves onto the surface")
     net, extra = map_back(inet, P, rev)
+    if n_lamellae is not None:                  # the count asked is the count of the net
+        inet, net, extra = _net_of_count(int(n_lamellae), inet, net, extra, rev, P,
+                                         dict(crossing_angle=crossing_angle,
+                                              at_parallel=at_parallel, step=step))
     stage = {"rev": rev, "inet": inet, "net": net, "extra": extra}
     if revolution_net:
         stage["net_rev"] = map_to_revolution(inet, rev)[0]
     return stage
+
+
+def _family_count(net: Net) -> int:
+    return max(len(net.family(1)), len(net.family(3)))
+
+
+def _net_of_count(n: int, inet, net: Net, extra, rev, P: np.ndarray, options: dict) -> tuple:
+    """The net whose larger family has ``n`` lamellae: a curve the tracer counts may leave no
+    lamella on the mesh (too short to hold two joints), so the count asked of
+    :func:`geodesic_net` is raised (or lowered) until the mapped net has ``n``; where no
+    count gives ``n``, the nearest below. ``inet.info["lamellae"]`` records asked and made."""
+    best = (net, inet, extra)
+    have = _family_count(net)
+    if have != n:
+        step = 1 if have < n else -1
+        for m in range(n + step, n + 8 * step, step):
+            if m < 2:
+                break
+            try:
+                i2 = geodesic_net(rev, made=m, **options)
+            except (InputError, NoNetError):
+                break
+            n2, e2 = map_back(i2, P, rev)
+            c = _family_count(n2)
+            if c == n or (c < n and c > _family_count(best[0])) or \
+                    (_family_count(best[0]) > n and c < _family_count(best[0])):
+                best = (n2, i2, e2)
+            if c == n or (step > 0 and c > n) or (step < 0 and c < n):
+                break
+    net, inet, extra = best
+    inet.info["lamellae"] = {"asked": n, "made": [len(net.family(1)), len(net.family(3))]}
+    return inet, net, extra
 
 
 def _metres(values: Sequence[float]) -> str:
@@ -357,7 +404,7 @@ def _load_target(target: Any, units: Any = None, clean: bool = True, obj: str | 
 
 
 def design_gg(target: Any, *, meridians: str = "cols", grid: tuple[int, int] | None = None,
-              direction: float | None = None, n_lamellae: int | None = 10,
+              direction: float | None = None, n_lamellae: int | None = None,
               spacing: float | None = None, crossing_angle: float = 90.0,
               at_parallel: float = 0.5,
               offsets: tuple[Sequence[float], Sequence[float]] | None = None,
@@ -572,9 +619,18 @@ def _bundle_stage(s: dict[str, Any]) -> dict[str, Any]:
     and the report of the run."""
     rev, inet, design = s["rev"], s["inet"], s["surface"]
     rV, rF = rev.mesh()
+    metrics = dict(s["metrics"])
+    counted = inet.info.get("lamellae") or {}
+    if counted.get("asked") is not None:
+        made = max(counted["made"])
+        metrics["lamellae_count"] = {
+            "asked": counted["asked"], "made": made,
+            "why": "" if made == counted["asked"] else
+            f"{made} is the nearest count of evenly spaced geodesics that reach this surface "
+            "(the count jumps there); --spacing M sets the spacing itself"}
     bundle = DesignBundle(kind="GG", net=s["net"], aligned=s["aligned"],
                           surface_V=s["surface_V"], surface_F=s["surface_F"],
-                          metrics=s["metrics"], params=_gg_params(s), revolution_V=rV,
+                          metrics=metrics, params=_gg_params(s), revolution_V=rV,
                           revolution_F=rF, units=s["geo"].units)
     design_report = dict(design.report, converged=design.converged, history=design.history,
                          stop=design.stop, checkpoint=design.checkpoint, score=design.score,

@@ -63,13 +63,15 @@ def _phlw_failure(info: dict, mode: str, exc: Exception) -> ConvergenceError:
     if isinstance(e0, (int, float)) and isinstance(e1, (int, float)):
         energy = f", E_PHLW {e0:.4g} -> {e1:.4g}" + (
             ": the step diverged" if e1 > max(e0, 1e-12) * 10 else "")
-    return ConvergenceError(
+    err = ConvergenceError(
         f"the PHLW step (converged {info.get('phlw_converged')}{energy}, deviation "
         f"{info.get('phlw_deviation', float('nan')):.3g} % of the diagonal) left a surface "
         f"without the {mode} net: {exc}. The reference itself admits a start (distinct "
         f"principal curvatures{', K < 0 somewhere' if mode == 'aa' else ''}), so this is the "
         "optimizer's failure: raise --phlw-outer / --phlw-max-iter, or run 'gridshell phlw' on "
         "the reference and inspect its curvature diagram")
+    err.phlw_failure = True     # gridshell.analysis.admissible tells it from no patch at all
+    return err
 
 
 def _stopped(info: dict, traced: TracedNet, post: PostOptResult) -> list[str]:

@@ -99,7 +99,7 @@ def _net_outputs(bundle, out: Path, warnings: list[str]) -> Reply:
     from gridshell.design.bundle import finite_json
 
     net = bundle.net
-    mesh = rhino.to_mesh(net.joints, net.loops)
+    mesh = rhino.to_mesh(net.joints, net.loops, compact=False)   # every joint, in order
     axes = [rhino.to_polyline(lam.axis) for lam in net.lamellae]
     aligned = [rhino.to_polyline(bundle.aligned[np.asarray(lam.joints)])
                for lam in net.lamellae]

@@ -46,9 +46,10 @@ def mesh_arrays(m: Any) -> tuple[np.ndarray, np.ndarray]:
     return rh.mesh_arrays(m)[:2]
 
 
-def to_mesh(V: np.ndarray, F: np.ndarray) -> Any:
-    """A Rhino mesh of ``V (n,3)`` and faces ``F (m,3|4)`` (double-precision vertices)."""
-    return rh.mesh(V, F)
+def to_mesh(V: np.ndarray, F: np.ndarray, compact: bool = True) -> Any:
+    """A Rhino mesh of ``V (n,3)`` and faces ``F (m,3|4)`` (double-precision vertices;
+    ``compact=False`` keeps the vertices no face uses)."""
+    return rh.mesh(V, F, compact=compact)
 
 
 def to_polyline(P: np.ndarray) -> Any:

@@ -32,7 +32,8 @@ def design_parts(design: Any, report: dict | None = None) -> tuple[DesignBundle,
 
 
 def write_design(path: str | os.PathLike, design: Design | DesignBundle, report: dict | None = None,
-          *, render: bool = True, frames: int = 12, progress: Progress = None) -> Path:
+          *, render: bool = True, frames: int = 12, progress: Progress = None,
+          owner: str | None = None) -> Path:
     """Write a design to the bundle directory ``path`` atomically; returns ``path``.
 
     One call and one layout for every kind (GG, NCP, CNC, AA): design.json, net.obj,
@@ -52,6 +53,8 @@ def write_design(path: str | os.PathLike, design: Design | DesignBundle, report:
         alignment sequence is computed (``frames`` steps; 0: none).
     render : bool
         Also draw the pictures and the animation (the slowest part).
+    owner : str, optional
+        The command the bundle's manifest names (default ``gg`` / ``ncp`` by kind).
     """
     bundle, report = design_parts(design, report)
     if bundle.kind == "GG":
@@ -66,7 +69,7 @@ def write_design(path: str | os.PathLike, design: Design | DesignBundle, report:
         from gridshell.ncp.pipeline import ncp_files
 
         extra = ncp_files(bundle, report, render=render, progress=progress)
-    return write_bundle(path, bundle, extra=extra)
+    return write_bundle(path, bundle, extra=extra, owner=owner)
 
 
 def fabricate_checked(design: Any, out_dir: str | os.PathLike, params: Any = None, *,

@@ -128,7 +128,7 @@ def simulate(bundle: str | os.PathLike, out: str | os.PathLike | None = None, *,
     b = read_bundle(bundle_dir)
     target = Path(out) if out else bundle_dir / "equilibrium"
     if write:
-        check_output(target)
+        check_output(target, owner="simulate")
     if per_bay < 1 or max_iter < 1:
         raise InputError("--per-bay and --max-iter must be at least 1")
     strip, section, mat = strip_of(bundle_dir, material, width=width, thickness=thickness,

@@ -115,11 +115,11 @@ def _design(target: str, p: Mapping[str, Any], bundle: Path, units: str | None) 
     if kind == "gg":
         from gridshell.gg.pipeline import design_gg
 
-        design = design_gg(target, n_lamellae=count if count or p.get("spacing") else 10,
+        design = design_gg(target, n_lamellae=count,
                            spacing=p.get("spacing"), crossing_angle=p.get("angle", 90.0),
                            direction=p.get("direction"), units=units)
     else:
-        from gridshell.ncp.pipeline import design_ncp
+        from gridshell.analysis.admissible import design_ncp_explained as design_ncp
 
         design = design_ncp(target, mode=kind, curves=count, spacing=p.get("spacing"),
                             units=units)

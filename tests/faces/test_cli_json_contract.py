@@ -57,6 +57,7 @@ def _failures(b: dict, tmp: Path) -> dict[str, tuple[list[str], int, str]]:
                    "--no-states"], 4, "overstressed"),
         "serve": (["serve", "--port", "0"], 2, "--port"),
         "simulate": (["simulate", str(b["nowhere"])], 2, "nowhere"),
+        "build": (["build", str(b["points"]), "-o", str(tmp / "p")], 2, "no faces"),
         "sweep": (["sweep", str(b["nowhere"]), "-o", str(tmp / "s"), "--vary",
                    "lamellae=6,8"], 2, "nowhere"),
     }

@@ -73,7 +73,7 @@ def gg_solved(client):
     n = 12
     P = helicoid_grid(n, n, c=0.5)
     V, F = P.reshape(-1, 3), grid_quads(n, n)
-    body = request("/gg", Target=mesh_item(V, F), Lamellae=[item("System.Int32", "5")],
+    body = request("/gg", Target=mesh_item(V, F), Lamellae=[item("System.Int32", "8")],
                    Grid=[item("System.Int32", "12")])
     d, out = solve(client, body)
     return mesh_arrays(to_mesh(V, F)), d, out     # what the server reads (rhino3dm floats)
@@ -96,7 +96,7 @@ def test_gg_component_matches_the_api(gg_solved):
 
     (V, F), d, out = gg_solved
     assert not d.get("errors"), d
-    bundle, _ = design_gg((V, F), grid=(12, 12), n_lamellae=5, frames=0)
+    bundle, _ = design_gg((V, F), grid=(12, 12), n_lamellae=8, frames=0)
     net = decode(out["Net"][0])
     assert len(net.Vertices) == len(bundle.net.joints) and len(net.Faces) == len(bundle.net.loops)
     J = np.array([[net.Vertices[i].X, net.Vertices[i].Y, net.Vertices[i].Z]

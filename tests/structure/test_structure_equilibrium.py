@@ -19,11 +19,11 @@ PP = get_material("pp")
 
 @pytest.fixture(scope="module")
 def demo_gg():
-    """The demo's GG design (dome.obj, grid 16 x 16, 8 lamellae: 172 joints), in memory."""
+    """The demo's GG design (dome.obj, grid 16 x 16, 18 + 18 lamellae: 172 joints), in memory."""
     from gridshell import data
     from gridshell.gg.pipeline import design_gg
 
-    bundle, _ = design_gg(data.path("dome.obj"), grid=(16, 16), n_lamellae=8, frames=2)
+    bundle, _ = design_gg(data.path("dome.obj"), grid=(16, 16), n_lamellae=18, frames=2)
     return bundle
 
 

@@ -1,0 +1,102 @@
+"""gridshell build: one command from a model to a build pack (issue 30). The pack is checked
+against the tools it chains, run on their own: the figures recomputed from its files, the
+section against the check at that thickness and the next thinner stock one, the reuse of
+unchanged stages, and a user's file in the pack never lost."""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from gridshell.cli.main import main
+from gridshell.core.errors import OutputError
+from gridshell.data import __file__ as _data
+from gridshell.design.bundle import read_bundle
+from gridshell.design.verification import verify_bundle
+from gridshell.structure.materials import get_material
+from gridshell.workflow.build import BUILD_JSON, STAGES, build
+from gridshell.workflow.structure import check_structure
+
+DOME = str(Path(_data).parent / "dome.obj")
+
+
+@pytest.fixture(scope="module")
+def pack(tmp_path_factory):
+    out = tmp_path_factory.mktemp("pack") / "dome"
+    return out, build(DOME, out, lamellae=8, frames=4)
+
+
+def test_the_pack_holds_every_stage_and_its_figures_hold(pack):
+    out, res = pack
+    assert list(res.stages) == list(STAGES) and not res.reused
+    for f in ("design.json", "structure.json", "equilibrium/equilibrium.json",
+              "fabrication/manifest.json", "model.3dm", "report.html", "render.png",
+              "analysis/analysis.json", BUILD_JSON):
+        assert (out / f).is_file(), f
+    assert list((out / "fabrication").glob("*.dxf")) and list((out / "fabrication").glob("*.svg"))
+    assert verify_bundle(out)["ok"]                       # recomputed from the pack's files
+    b = read_bundle(out)                                   # the count asked is the count made
+    assert sorted(len(b.net.family(f)) for f in (1, 3)) == [8, 8]
+    rec = json.loads((out / BUILD_JSON).read_text())
+    assert res.kind == rec["kind"] == "gg" and res.stages["design"]["kind"] == "GG"
+    man = json.loads((out / "manifest.json").read_text())
+    assert man["command"] == "build" and BUILD_JSON in man["files"]
+    assert {"fabrication", "equilibrium", "analysis"} <= set(man["outputs"])
+
+
+def test_the_section_is_the_thinnest_stock_thickness_that_holds(pack):
+    out, res = pack
+    sec = res.section
+    mat = get_material(sec["material"])
+    chosen = check_structure(out, material=mat.name, thickness=sec["thickness_mm"],
+                             write=False, picture=False)
+    assert chosen.ok and chosen.result["max_utilisation"] == pytest.approx(
+        sec["utilisation"], rel=1e-6)
+    thinner = [t for t in mat.sheet_thicknesses_mm if t < sec["thickness_mm"]]
+    for t in thinner:                                      # each thinner one fails
+        assert not check_structure(out, material=mat.name, thickness=t, write=False,
+                                   picture=False).ok
+    s = json.loads((out / "structure.json").read_text())["section"]
+    assert s["thickness_mm"] == sec["thickness_mm"]
+
+
+def test_a_rerun_reuses_every_stage_and_a_new_material_reuses_the_design(pack):
+    out, first = pack
+    files = json.loads((out / "manifest.json").read_text())["files"]
+    again = build(DOME, out, lamellae=8, frames=4)
+    assert again.reused == list(STAGES) and again.seconds < 5.0
+    assert json.loads((out / "manifest.json").read_text())["files"]["design.json"] == \
+        files["design.json"]
+    other = build(DOME, out, lamellae=8, frames=4, material="petg")
+    assert other.reused == ["analyze", "design", "verify"]
+    assert json.loads((out / "structure.json").read_text())["material"]["name"] == "petg"
+    assert verify_bundle(out)["ok"]
+
+
+def test_a_users_file_in_the_pack_is_never_lost(tmp_path, pack):
+    out, _ = pack
+    import shutil
+
+    mine = tmp_path / "mine"
+    shutil.copytree(out, mine)
+    (mine / "notes.txt").write_text("my notes")
+    with pytest.raises(OutputError):
+        build(DOME, mine, lamellae=9, frames=4)           # a new design would replace the pack
+    assert (mine / "notes.txt").read_text() == "my notes"
+
+
+@pytest.mark.parametrize("argv,what", [
+    (["--lamellae", "1"], "--lamellae"), (["--scale", "1:0"], "--scale"),
+    (["--kind", "xx"], "--kind"), (["--material", "steel"], "--material"),
+    (["--width", "-2"], "--width"), (["--sheet", "600"], "--sheet"),
+    (["--frames", "-1"], "--frames"), (["--units", "km"], "--units"),
+])
+def test_bad_options_are_refused_before_any_work(tmp_path, capsys, argv, what):
+    out = tmp_path / "p"
+    try:
+        code = main(["build", DOME, "-o", str(out), *argv])
+    except SystemExit as e:
+        code = e.code
+    assert code == 2 and what in capsys.readouterr().err
+    assert not out.exists()
