@@ -247,6 +247,16 @@ def _structure_section(d: Path) -> str:
     return structure_section(d)
 
 
+def _figures_verdict(decided: list[str]) -> tuple[bool | None, str]:
+    """(all pass, the banner's text) of the thresholded checks' statuses."""
+    if not decided:
+        return None, "no thresholded metrics stored"
+    if all(s == "pass" for s in decided):
+        return True, f"all {len(decided)} within the paper's thresholds"
+    return False, (f"{decided.count('fail')} of {len(decided)} checks fail the paper's "
+                   "thresholds")
+
+
 def report_html(bundle_dir: str | os.PathLike) -> str:
     """The HTML text of the report of ``bundle_dir`` (see :func:`write_report`)."""
     from gridshell.core.version import __version__
@@ -261,13 +271,11 @@ def report_html(bundle_dir: str | os.PathLike) -> str:
     lams = design["lamellae"]
     checks = metric_checks(metrics)
     decided = [r["status"] for r in checks if r["status"] != "info"]
-    if not decided:
-        verdict = '<span class="verdict info">no thresholded metrics stored</span>'
-    elif all(s == "pass" for s in decided):
-        verdict = '<span class="verdict pass">&#10003; within the paper\'s thresholds</span>'
-    else:
-        verdict = (f'<span class="verdict fail">&#10007; {decided.count("fail")} of '
-                   f"{len(decided)} checks fail the paper's thresholds</span>")
+    from gridshell.render.verdicts import (banner_html, bill_of_materials,
+                                           equilibrium_section, verdicts)
+
+    verdict = banner_html(verdicts(d, *_figures_verdict(decided)))
+    bom = bill_of_materials(d)
     fam = {f: sum(1 for r in lams if int(r["family"]) == f) for f in (1, 3)}
     total = sum(float(r.get("length", 0.0)) for r in lams)
     title = f"{kind} alignable lamella gridshell &mdash; {html.escape(d.resolve().name)}"
@@ -304,7 +312,8 @@ def report_html(bundle_dir: str | os.PathLike) -> str:
         f"<title>{title}</title><style>{_CSS}{viewer_css()}</style></head><body>",
         f"<header><h1>{title}</h1><p>design report written by gridshell {__version__} "
         "&middot; self-contained: no external resources</p></header><main>",
-        f'<section id="overview"><h2>Overview</h2><p>{verdict}</p>{_kv_table(overview)}'
+        f'<section id="overview"><h2>Overview</h2>{verdict}{_kv_table(overview)}',
+        ("<h2>Bill of materials</h2>" + _kv_table(bom)) if bom else "",
         "</section>",
         viewer_section(d),
         f'<section id="metrics"><h2>Metrics (paper 5.1)</h2>{check_table}',
@@ -313,6 +322,7 @@ def report_html(bundle_dir: str | os.PathLike) -> str:
         f'<section id="pictures"><h2>Pictures</h2>{figs}</section>',
         _fabrication_section(d),
         _structure_section(d),
+        equilibrium_section(d, _kv_table, _figure),
         f'<section id="lamellae"><h2>Lamellae</h2>{_lamella_table(lams)}</section>',
         f'<section id="parameters"><h2>Parameters</h2>{_kv_table(_flatten(params))}',
         ("<h2>Timings [s]</h2>" + _kv_table(timings)) if timings else "",

@@ -14,8 +14,10 @@ route          inputs                                                   outputs
 ``/fabricate`` Bundle, Scale, Sheet, Width, Options, Force              Cut, Score,
                                                                         Engrave, Sheets,
                                                                         Report, Folder
-``/sweep``     Target (mesh, m), Vary (NAME=VALUES list), Workers,      Table, Best, Page,
-               Surface (m)                                              Folder
+``/sweep``     Target (mesh), Vary (NAME=VALUES list), Workers,         Table, Best, Page,
+               Surface, Units                                           Folder
+``/build``     Target (mesh), Kind, Material, Lamellae, Scale,          Summary, Build,
+               Surface, Units                                           Report, Pack
 =============  ======================================================  ==================
 
 A design component takes a mesh (Target / Reference) or a NURBS surface or single-face Brep
@@ -51,9 +53,9 @@ from gridshell.core.errors import InputError
 from gridshell.server import rhino
 
 #: the keywords ``Options`` may give, per component (the others are inputs of their own)
-GG_OPTIONS = ("meridians", "direction", "spacing", "crossing_angle", "at_parallel", "offsets",
+GG_OPTIONS = ("units", "meridians", "direction", "spacing", "crossing_angle", "at_parallel", "offsets",
               "weights", "angle", "rounds", "polish_iter", "allow_unconverged", "frames")
-NCP_OPTIONS = ("spacing", "n", "samples", "levelset_ctrl", "levelset_degree", "omega_f",
+NCP_OPTIONS = ("units", "spacing", "n", "samples", "levelset_ctrl", "levelset_degree", "omega_f",
                "trace_grid", "collapse_samples", "postopt_weights", "postopt_rounds",
                "frames", "sim_weights", "surface_samples", "phlw_options",
                "allow_unconverged")
@@ -133,7 +135,8 @@ def design_gg_component(new_dir: Callable[[str], Path], target: Any = None, lame
 
     kw = options(opts, GG_OPTIONS, "GG design")
     kw.setdefault("frames", 0)
-    geo = rhino.target_input(_one_target(target, surface, "Target"))
+    units = rhino.parse_units_input(kw.pop("units", None))
+    geo = rhino.target_input(_one_target(target, surface, "Target"), units=units)
     if int(grid) < 4 or int(lamellae) < 2:
         raise InputError(f"Grid {grid} and Lamellae {lamellae}: give Grid >= 4 and "
                          "Lamellae >= 2")
@@ -151,7 +154,9 @@ def design_ncp_component(new_dir: Callable[[str], Path], reference: Any = None,
     from gridshell.api import design_ncp, write
 
     kw = options(opts, NCP_OPTIONS, "NCP design")
-    geo = rhino.target_input(_one_target(reference, surface, "Reference"), what="the reference")
+    units = rhino.parse_units_input(kw.pop("units", None))
+    geo = rhino.target_input(_one_target(reference, surface, "Reference"), what="the reference",
+                             units=units)
     design = design_ncp(geo, mode=str(mode).strip().lower(), curves=int(curves), **kw)
     bundle = design.bundle
     out = write(new_dir(bundle.kind.lower()), design, render=False)
@@ -240,7 +245,7 @@ def fabricate_component(resolve: Callable[[Any], Path], bundle_dir: str,
 
 
 def sweep_component(new_dir: Callable[[str], Path], target: Any = None, vary: Any = None,
-                    workers: int = 2, surface: Any = None) -> Reply:
+                    workers: int = 2, surface: Any = None, units: str = "") -> Reply:
     """The ``/sweep`` component: every variant of ``vary`` (``NAME=V1,V2`` items, as
     ``gridshell sweep --vary``) on ``target`` (a Rhino mesh) or ``surface`` (NURBS), metres,
     run by :func:`gridshell.workflow.sweep.sweep` into ``new_dir("sweep")``; the table as
@@ -249,7 +254,6 @@ def sweep_component(new_dir: Callable[[str], Path], target: Any = None, vary: An
 
     from gridshell.api import sweep
     from gridshell.design.bundle import finite_json
-    from gridshell.geometry import rhino_adapter as rh
     from gridshell.workflow.study import Study, parse_vary
 
     items = [vary] if isinstance(vary, str) else list(vary or [])
@@ -264,15 +268,10 @@ def sweep_component(new_dir: Callable[[str], Path], target: Any = None, vary: An
     cores = os.cpu_count() or 1
     if not 1 <= int(workers) <= cores:
         raise InputError(f"Workers {workers}: give 1 to {cores} (the server's cores)")
-    obj = _one_target(target, surface, "Target")
-    rhino.target_input(obj)                                  # a bad target: its message now
+    u = rhino.parse_units_input(units)
     out = new_dir("sweep")
-    out.mkdir(parents=True)
-    model = rh.Model3dm("Meters", 1e-6).model
-    model.Objects.Add(obj)
-    if not rh.write_file(model, out / "target.3dm"):
-        raise InputError("could not store the target as a .3dm; connect a mesh or a surface")
-    res = sweep(Study(str(out / "target.3dm"), values), out / "study", workers=int(workers))
+    target_3dm = _stored_target(target, surface, u, out)
+    res = sweep(Study(str(target_3dm), values), out / "study", workers=int(workers))
     rows = finite_json(res.table.to_dict(orient="records"))
     ok = [r for r in rows if r.get("code") == 0 and r.get("max_utilisation") is not None]
     best = min(ok, key=lambda r: r["max_utilisation"]) if ok else None
@@ -281,6 +280,62 @@ def sweep_component(new_dir: Callable[[str], Path], target: Any = None, vary: An
     warnings = [] if ok else ["no variant was cut: see the Table's code and message"]
     return Reply(json.dumps(rows, default=_plain, allow_nan=False), best_text,
                  str(res.page or ""), str(out / "study"), warnings=warnings)
+
+
+def _stored_target(target: Any, surface: Any, units: str | None, out: Path) -> Path:
+    """The target (checked first: a bad one gives its message before anything is written)
+    stored as ``out/target.3dm`` in the unit it is drawn in, which the CLI reads as it is."""
+    from gridshell.geometry import rhino_adapter as rh
+
+    obj = _one_target(target, surface, "Target")
+    rhino.target_input(obj, units=units)
+    out.mkdir(parents=True)
+    model = rh.Model3dm(rhino.RHINO_UNITS[units or "m"], 1e-6).model
+    model.Objects.Add(obj)
+    if not rh.write_file(model, out / "target.3dm"):
+        raise InputError("could not store the target as a .3dm; connect a mesh or a surface")
+    return out / "target.3dm"
+
+
+def build_component(new_dir: Callable[[str], Path], target: Any = None, kind: str = "auto",
+                    material: str = "", lamellae: int = 0, scale: str = "",
+                    surface: Any = None, units: str = "") -> Reply:
+    """The ``/build`` component: ``gridshell build`` of ``target`` (a Rhino mesh) or
+    ``surface`` (NURBS) drawn in ``units`` (default metres), into ``new_dir("build")``: the
+    summary lines, build.json (JSON), report.html and the pack's folder."""
+    from gridshell.design.bundle import finite_json
+    from gridshell.design.section import parse_scale
+    from gridshell.structure.materials import get_material
+    from gridshell.workflow.build import BUILD_JSON, KINDS, build
+
+    kind = str(kind or "auto").strip().lower()
+    if kind not in KINDS:
+        raise InputError(f"Kind {kind!r}: give one of {', '.join(KINDS)}")
+    mat = str(material or "").strip() or None
+    if mat is not None:
+        get_material(mat)                                    # an unknown one: its message
+    if scale:
+        parse_scale(scale)
+    n = int(lamellae or 0)
+    if n == 1 or n < 0:
+        raise InputError(f"Lamellae {lamellae}: give 2 or more (0: the default)")
+    u = rhino.parse_units_input(units)
+    out = new_dir("build")
+    model = _stored_target(target, surface, u, out)
+    res = build(model, out / "pack", kind=kind, material=mat, lamellae=n or None,
+                scale=scale or None)
+    rec = json.loads((out / "pack" / BUILD_JSON).read_text(encoding="utf-8"))
+    sec, st = res.section, res.stages
+    lines = [f"kind: {res.kind} ({res.why})",
+             f"section: {sec['width_mm']:g} x {sec['thickness_mm']:g} mm {sec['material']} at "
+             f"{sec['scale']}",
+             f"structure: {st['check']['verdict']}, max utilisation "
+             f"{st['check']['max_utilisation']:.2f}",
+             f"sheets: {st['fabricate']['sheets']}, {st['fabricate']['strip_length_m']:.2f} m "
+             f"of strip, {st['fabricate']['mass_kg']:.3g} kg",
+             f"time: {res.seconds:.1f} s"]
+    return Reply(lines, json.dumps(finite_json(rec), default=_plain, allow_nan=False),
+                 str(out / "pack" / "report.html"), str(out / "pack"))
 
 
 def _sheet_curves(layout: Any, tolerance: float) -> tuple[list, list, list, list]:
@@ -407,6 +462,34 @@ def _fabricate_spec(hs) -> dict[str, Any]:
                  hs.HopsString("Folder", "D", "folder of the DXF / SVG files")])
 
 
+def _units_param(hs) -> Any:
+    """The optional Units input: the unit the Rhino document is drawn in."""
+    return hs.HopsString("Units", "U", "the unit the model is drawn in: m, cm, mm, in or ft "
+                         "(the Rhino document's; default m)", optional=True)
+
+
+def _build_spec(hs) -> dict[str, Any]:
+    """The Hops declaration of ``/build``."""
+    return dict(
+        rule="/build", name="Build pack", nickname="Build",
+        description="The whole chain in one component: analyse, design, verify, section, check, "
+                    "simulate, fabricate, .3dm and report (gridshell build)",
+        category="Gridshell", subcategory="Design",
+        inputs=[hs.HopsMesh("Target", "T", "target mesh", optional=True),
+                hs.HopsString("Kind", "K", "auto (default), gg, phlw, cnc or aa", optional=True),
+                hs.HopsString("Material", "Mat", "strip material preset (default pp)",
+                              optional=True),
+                hs.HopsInteger("Lamellae", "N", "lamellae per family (0: the default)",
+                               optional=True),
+                hs.HopsString("Scale", "S", "model scale, e.g. 1:10", optional=True),
+                _surface_param(hs), _units_param(hs)],
+        outputs=[hs.HopsString("Summary", "S", "what was chosen and the verdicts",
+                               access=hs.HopsParamAccess.LIST),
+                 hs.HopsString("Build", "B", "build.json (JSON)"),
+                 hs.HopsString("Report", "R", "report.html"),
+                 hs.HopsString("Pack", "P", "the pack's folder (cut files in fabrication/)")])
+
+
 def _sweep_spec(hs) -> dict[str, Any]:
     """The Hops declaration of ``/sweep``."""
     return dict(
@@ -418,7 +501,7 @@ def _sweep_spec(hs) -> dict[str, Any]:
                 hs.HopsString("Vary", "V", "NAME=V1,V2 per item, e.g. lamellae=6,8 and "
                               "kind=gg,cnc", access=hs.HopsParamAccess.LIST),
                 hs.HopsInteger("Workers", "W", "processes (default 2)", optional=True),
-                _surface_param(hs)],
+                _surface_param(hs), _units_param(hs)],
         outputs=[hs.HopsString("Table", "T", "one row per variant (JSON)"),
                  hs.HopsString("Best", "B", "the elastic cut variant of least utilisation"),
                  hs.HopsString("Page", "P", "sweep.html"),
@@ -426,7 +509,7 @@ def _sweep_spec(hs) -> dict[str, Any]:
 
 
 def register(hops, workdir: Path, resolve: Callable[[Any], Path]) -> None:
-    """Register the six components on ``hops`` (a ghhops_server Hops middleware); designs
+    """Register the seven components on ``hops`` (a ghhops_server Hops middleware); designs
     go into new folders of ``workdir``, bundles are taken where ``resolve`` accepts them.
     Each handler's parameters are its inputs in order (Hops passes them so, a missing
     optional input as its default)."""
@@ -456,8 +539,13 @@ def register(hops, workdir: Path, resolve: Callable[[Any], Path]) -> None:
         return fabricate_component(resolve, bundle_dir, scale, sheet, width, opts, force)
 
     @hops.component(**_sweep_spec(hs))
-    def study(target=None, vary=None, workers=2, surface=None):
-        return sweep_component(new_dir, target, vary, workers, surface)
+    def study(target=None, vary=None, workers=2, surface=None, units=""):
+        return sweep_component(new_dir, target, vary, workers, surface, units)
+
+    @hops.component(**_build_spec(hs))
+    def pack(target=None, kind="auto", material="", lamellae=0, scale="", surface=None,
+             units=""):
+        return build_component(new_dir, target, kind, material, lamellae, scale, surface, units)
 
 
 def make_app(workdir: str | Path | None = None, *, allow: tuple = (), host: str = "127.0.0.1",

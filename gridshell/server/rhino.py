@@ -28,7 +28,24 @@ def decode(item: dict) -> Any:
     return obj
 
 
-def target_input(obj: Any, what: str = "the target") -> Any:
+#: Rhino's unit system of each unit a Units input may give
+RHINO_UNITS = {"m": "Meters", "cm": "Centimeters", "mm": "Millimeters", "in": "Inches",
+               "ft": "Feet"}
+
+
+def parse_units_input(text: Any) -> str | None:
+    """The unit of a Hops Units input (``m``, ``cm``, ``mm``, ``in``, ``ft``; empty: metres or
+    the size's own, as the CLI reads a file that does not say); InputError otherwise."""
+    t = str(text or "").strip().lower()
+    if not t:
+        return None
+    if t not in RHINO_UNITS:
+        raise InputError(f"Units {text!r}: give one of {', '.join(RHINO_UNITS)} (the Rhino "
+                         "document's unit, e.g. mm)")
+    return t
+
+
+def target_input(obj: Any, what: str = "the target", units: str | None = None) -> Any:
     """The :class:`~gridshell.io.read.InputGeometry` (metres) of a target or reference: a mesh
     (welded, checked: :func:`gridshell.io.read.read_input`), or a NURBS surface or single-face
     Brep as its B-spline (``surface``; ``V, F`` its sampling) - what the CLI reads from a .3dm
@@ -36,7 +53,7 @@ def target_input(obj: Any, what: str = "the target") -> Any:
     from gridshell.io.read import read_input
     from gridshell.io.rhino import object_input
 
-    return read_input(object_input(obj, what), what=what)
+    return read_input(object_input(obj, what), what=what, units=units)
 
 
 def mesh_arrays(m: Any) -> tuple[np.ndarray, np.ndarray]:

@@ -100,3 +100,34 @@ def test_bad_options_are_refused_before_any_work(tmp_path, capsys, argv, what):
         code = e.code
     assert code == 2 and what in capsys.readouterr().err
     assert not out.exists()
+
+
+def test_the_report_states_every_verdict_and_the_bill_of_materials(pack, tmp_path):
+    import shutil
+
+    from gridshell.render.report import report_html
+    from gridshell.render.verdicts import bill_of_materials, verdicts
+
+    out, res = pack
+    page = (out / "report.html").read_text()
+    assert 'id="equilibrium"' in page and "Bill of materials" in page
+    v = {t: (st, text) for t, st, text in verdicts(out, True, "")}
+    assert set(v) == {"figures", "structure", "equilibrium", "sheets"}
+    assert all(st == "pass" for st, _ in v.values())
+    fab = json.loads((out / "fabrication" / "fabrication.json").read_text())
+    rows = dict(bill_of_materials(out))
+    length = sum(q["flat_length_mm"] for q in fab["pieces"]) / 1000
+    assert rows["total strip length"] == f"{length:.2f} m"
+    p = fab["params"]
+    kg = length * p["width"] * 1e-3 * p["thickness"] * 1e-3 * get_material(
+        json.loads((out / "structure.json").read_text())["material"]["name"]).density
+    assert rows["mass of the strips"].startswith(f"{kg:.3g} kg")
+    # an overstressed check is said first, as a failure, above the figures that pass
+    bad = tmp_path / "bad"
+    shutil.copytree(out, bad)
+    s = json.loads((bad / "structure.json").read_text())
+    s.update(verdict="overstressed", max_utilisation=11.47, governing_state="frame_005")
+    (bad / "structure.json").write_text(json.dumps(s))
+    html = report_html(bad)
+    i_fail, i_pass = html.find("verdict fail"), html.find("verdict pass")
+    assert 0 < i_fail < i_pass and "overstressed, max utilisation 11.47 (frame_005)" in html
