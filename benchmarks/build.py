@@ -37,19 +37,20 @@ def _quads(n: int, m: int) -> np.ndarray:
     return np.stack([idx[:-1, :-1], idx[1:, :-1], idx[1:, 1:], idx[:-1, 1:]], -1).reshape(-1, 4)
 
 
-def _rotated_hill_quads(path: Path) -> Path:
+def _rotated_hill_quads(folder: Path) -> Path:
     n, m = 25, 17
     V, _ = hill(n, m)
     a = np.radians(35.0)
     R = np.array([[np.cos(a), -np.sin(a), 0], [np.sin(a), np.cos(a), 0], [0, 0, 1]])
-    return write_obj_text(path, V @ R.T + [3.0, -2.0, 0.5], _quads(n, m))
+    return write_obj_text(folder / "hill_quads_rotated.obj", V @ R.T + [3.0, -2.0, 0.5],
+                          _quads(n, m))
 
 
-def _hypar(path: Path, side: float = 6.0, n: int = 21) -> Path:
+def _hypar(folder: Path, side: float = 6.0, n: int = 21) -> Path:
     t = np.linspace(-side / 2, side / 2, n)
     X, Y = np.meshgrid(t, t, indexing="ij")
     V = np.stack([X.ravel(), Y.ravel(), (X * Y / side).ravel()], 1)
-    return write_obj_text(path, V, _quads(n, n))
+    return write_obj_text(folder / "hypar.obj", V, _quads(n, n))
 
 
 #: name -> (maker of the file in a folder, extra arguments the file needs)

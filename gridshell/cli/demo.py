@@ -75,7 +75,30 @@ def _checks(kind: str, metrics: dict) -> str:
     return ("pass (" if passed(gates) else "FAIL (") + gate_summary(gates) + ")"
 
 
-def _finish(d: Path, label: str, name: str, fab_params: dict, progress) -> dict[str, Any]:
+#: the GG demo built at full size: a 3 m pavilion of spruce C24 strips under snow (issue 28)
+FULL_SCALE = {"material": "spruce", "width": 60.0, "thickness": 10.0, "scale": "1:1",
+              "snow": 1.0}
+
+
+def _full_scale(d: Path, label: str, progress) -> dict[str, Any]:
+    """``gridshell simulate`` of the design built at 1:1 in spruce under self-weight and
+    :data:`FULL_SCALE` snow (kN/m2): deflection, span / deflection, the bolts' shear
+    (``d/equilibrium``)."""
+    from gridshell.api import simulate
+
+    fs = FULL_SCALE
+    progress(f"{label}: at full scale in {fs['material']} {fs['width']:g} x "
+             f"{fs['thickness']:g} mm under self-weight + {fs['snow']:g} kN/m2 snow "
+             "(equilibrium/)")
+    f = simulate(d, material=fs["material"], width=fs["width"], thickness=fs["thickness"],
+                 scale=fs["scale"], snow=fs["snow"]).figures
+    return {k: f[k] for k in ("gravity", "section", "deflection_max_mm", "span_m",
+                              "span_over_deflection", "bolt_shear_max_N", "bolt_shear_mean_N",
+                              "utilisation_peak", "snow_total_kN", "weight_N", "converged")}
+
+
+def _finish(d: Path, label: str, name: str, fab_params: dict, progress,
+            full_scale: bool = False) -> dict[str, Any]:
     """Cut, check, render, export and report a written bundle ``d``; returns the fabrication
     report. The pictures, the report and the .3dm come from one call
     (:func:`gridshell.workflow.outputs.write_outputs`: the .3dm built beside the pictures)."""
@@ -87,6 +110,8 @@ def _finish(d: Path, label: str, name: str, fab_params: dict, progress) -> dict[
              "polypropylene)")
     fab = fabricate(d, d / "fabrication", fab_params, progress=progress.detail)
     fab = dict(fab, structure=_structure(d, label, fab_params, progress))
+    if full_scale:
+        fab["full_scale"] = _full_scale(d, label, progress)
     write_outputs(d, report=True, rhino=d / f"{name}.3dm", rhino_options={"params": fab_params},
                   progress=lambda msg: progress(f"{label}: {msg}"))
     return fab
@@ -102,6 +127,13 @@ def _structure(d: Path, label: str, fab_params: dict, progress) -> dict[str, Any
                           thickness=fab_params["thickness"], scale=fab_params["scale"]).result
     return {k: res[k] for k in ("verdict", "max_utilisation", "max_utilisation_deployed",
                                 "governing_state", "max_elastic_thickness_mm")}
+
+
+def _snow_line(f: dict) -> str:
+    return (f"{f['section']}, spruce, {f['gravity']}: deflection {f['deflection_max_mm']:.3g} mm "
+            f"(span {f['span_m']:.2f} m / {f['span_over_deflection']:.0f}), largest bolt shear "
+            f"{f['bolt_shear_max_N']:.3g} N, peak utilisation {f['utilisation_peak']:.2f} "
+            "(equilibrium/)")
 
 
 def _strength(fab: dict) -> str:
@@ -128,7 +160,7 @@ def _gg(root: Path, sizes: dict, progress) -> dict[str, Any]:
     write(d, design, progress=progress.detail)
     progress("GG: verifying the bundle from its files")
     v = verify_bundle(d)
-    fab = _finish(d, "GG", "gg", FABRICATION, progress)
+    fab = _finish(d, "GG", "gg", FABRICATION, progress, full_scale=True)
     m = bundle.metrics
     return {
         "dir": d, "kind": "GG", "target": target.name,
@@ -229,6 +261,7 @@ def _summary(out: Path, gg: dict | None, ncp: dict | None, total: float) -> dict
         s["GG paper thresholds"] = gg["checks"]
         s["GG cut files"] = _sheets(gg["fabrication"])
         s["GG strips 1 mm pp"] = _strength(gg["fabrication"])
+        s["GG at 1:1 under snow"] = _snow_line(gg["fabrication"]["full_scale"])
     if ncp is not None:
         s["CNC pavilion"] = (f"{out / 'ncp'}/ (report.html, render.png, alignment.gif, "
                              "ncp.3dm, fabrication/)")
@@ -265,6 +298,8 @@ def _nested(summary: dict, gg: dict | None, ncp: dict | None) -> dict[str, Any]:
         keep["fabrication"] = {k: f[k] for k in ("n_strips", "n_pieces", "n_sheets", "shape",
                                                   "utilisation", "material_used",
                                                   "material_used_per_sheet", "structure")}
+        if "full_scale" in f:
+            keep["full_scale"] = f["full_scale"]
         return keep
 
     return {"summary": summary, "gg": part(gg), "ncp": part(ncp)}

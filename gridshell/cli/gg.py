@@ -86,6 +86,7 @@ def _offsets(args: Any) -> tuple[list[float], list[float]] | None:
 
 def run(args: Any) -> int:
     from gridshell.core.atomic import check_output
+    from gridshell.workflow.cut import require_no_made_from
     from gridshell.api import design_gg, write
 
     from gridshell.cli.common import (Progress, input_line, input_options, print_summary,
@@ -97,6 +98,7 @@ def run(args: Any) -> int:
         raise InputError(f"--frames must be in 0 .. 1000 (each state is an optimization), got "
                          f"{args.frames}; e.g. 12")
     check_output(args.output, marker="design.json")
+    require_no_made_from(args.output)
     progress = Progress(args)
     n = args.lamellae
     design = design_gg(args.target, meridians=args.meridians,

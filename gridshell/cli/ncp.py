@@ -88,10 +88,12 @@ def _unconverged(bundle: Any, report: dict) -> list[str]:
 
 def run(args: Any) -> int:
     from gridshell.core.atomic import check_output
+    from gridshell.workflow.cut import require_no_made_from
     from gridshell.api import design_ncp, write
     from gridshell.cli.common import Progress, input_line, input_options, print_gates
 
     check_output(args.output, marker="design.json")
+    require_no_made_from(args.output)
     progress = Progress(args)
     progress(f"reading {args.reference}")
     phlw = {"ctrl": tuple(args.phlw_ctrl), "samples": tuple(args.phlw_samples),

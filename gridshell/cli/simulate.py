@@ -5,7 +5,7 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-from gridshell.cli.values import checked, count, positive
+from gridshell.cli.values import checked, count, nonnegative, positive
 
 HELP = ("elastic equilibrium of the deployed gridshell: every lamella a discrete elastic rod of "
         "the real strip, joints that turn about their axis only, supports held at the design; "
@@ -36,6 +36,10 @@ def add_args(p: argparse.ArgumentParser) -> None:
                    help="joints held at their design positions: 'boundary' (default: the joints "
                         "on the net's boundary) or joint indices such as 0,5,17")
     g.add_argument("--gravity", action="store_true", help="add the strips' self-weight (-z)")
+    g.add_argument("--snow", type=nonnegative, default=None, metavar="KN_M2",
+                   help="a uniform snow load, kN per m2 of plan area, on the simulated "
+                        "structure (with self-weight; at --scale 1:1 the pavilion itself): "
+                        "adds the deflection (mm), span / deflection and the bolts' shear (N)")
     g.add_argument("--per-bay", type=count(1), default=3,
                    help="rod elements between neighbouring joints (default 3)")
     g.add_argument("--max-iter", type=count(1), default=100,
@@ -67,7 +71,8 @@ def run(args: Any) -> int:
     sim = simulate(args.bundle, args.out, material=args.material, width=args.width,
                    thickness=args.thickness, scale=args.scale,
                    supports=parse_supports(args.supports), gravity=args.gravity,
-                   per_bay=args.per_bay, max_iter=args.max_iter, progress=progress)
+                   snow=args.snow, per_bay=args.per_bay, max_iter=args.max_iter,
+                   progress=progress)
     print_summary(args, "Simulate", summary(args, sim))
     return 0
 
@@ -96,6 +101,21 @@ def summary(args: Any, sim: Any) -> dict[str, Any]:
         "time": f"{fig['wall_s']:.1f} s wall, {fig['cpu_s']:.1f} s CPU",
         "output": str(sim.out),
     }
+    if "snow_kN_m2" in fig:
+        summary["reactions"] = (f"largest {fig['reaction_max_N']:.3g} N; vertical sum "
+                                f"{fig['reaction_sum_N'][2]:.4g} N = self-weight "
+                                f"{fig['weight_N']:.4g} N + snow "
+                                f"{1e3 * fig['snow_total_kN']:.4g} N")
+        summary["deflection"] = (f"{fig['deflection_max_mm']:.3g} mm (vertical "
+                                 f"{fig['deflection_vertical_max_mm']:.3g} mm), span "
+                                 f"{fig['span_m']:.3g} m / deflection = "
+                                 f"{fig['span_over_deflection']:.0f}")
+        summary["bolts"] = (f"largest shear {fig['bolt_shear_max_N']:.3g} N (joint "
+                            f"{fig['bolt_shear_max_joint']}), mean "
+                            f"{fig['bolt_shear_mean_N']:.3g} N")
+    u = fig["utilisation_peak"]
+    summary["verdict"] = (f"{'elastic' if u <= 1 else 'OVERSTRESSED'}: peak utilisation "
+                          f"{u:.2f} under {fig['gravity']}")
     if getattr(args, "json", False):
         summary = {**summary, "figures": fig}
     return summary

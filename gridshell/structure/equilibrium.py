@@ -111,18 +111,33 @@ def _stress_summary(model: DeployedModel, q: np.ndarray) -> dict[str, Any]:
 
 
 def simulate(bundle, material, section, *, supports: str | np.ndarray = "boundary",
-             gravity: bool = False, per_bay: int = 3, stiffness: Stiffness | None = None,
+             gravity: bool = False, snow: float | None = None, per_bay: int = 3,
+             stiffness: Stiffness | None = None,
              rtol: float = 1e-9, max_iter: int = 200, time_limit: float | None = None,
              progress: Callable[[str], None] | None = None, require: bool = True
              ) -> Equilibrium:
     """The static equilibrium of a design bundle (:class:`~gridshell.design.bundle.DesignBundle`)
-    built in ``section`` of ``material`` (see :mod:`gridshell.structure.deployed`).
+    built in ``section`` of ``material`` (see :mod:`gridshell.structure.deployed`); ``snow``:
+    a uniform snow load, kN per m2 of plan area on the simulated structure (with self-weight;
+    :func:`gridshell.structure.loads.snow_forces`), which adds the deflection, span /
+    deflection and the bolts' shear to the figures.
 
-    Raises :class:`ConvergenceError` if Newton does not converge (``require``)."""
+    Raises :class:`ConvergenceError` if Newton does not converge (``require``). Long because
+    the figures are one flat record, each line one figure of equilibrium.json.
+    """
+    from gridshell.structure import loads
+
     t0, c0 = time.perf_counter(), time.process_time()
+    gravity = gravity or bool(snow)
     model = build_model(bundle, material, section, supports=supports, gravity=gravity,
                         per_bay=per_bay, stiffness=stiffness)
     net = model.network
+    snow_total = 0.0
+    if snow:
+        Fs = loads.snow_forces(bundle.net.joints * model.scale, bundle.net.loops, snow)
+        on = model.joint_node >= 0
+        np.add.at(net.forces, model.joint_node[on], Fs[on])
+        snow_total = float(-Fs[on, 2].sum())
     if progress:
         progress(f"rod model: {len(net.rods)} lamellae, {len(net.X)} nodes, {net.n_edges} "
                  f"elements, {len(net.joints)} joints, {len(model.supports)} supports")
@@ -148,7 +163,7 @@ def simulate(bundle, material, section, *, supports: str | np.ndarray = "boundar
     energy = {k: float(v) for k, v in parts.items() if k != "loads"}
     energy["elastic"] = float(sum(energy.values()))
     stresses = _stress_summary(model, q)
-    weight = float(-net.forces[:, 2].sum())
+    weight = float(-net.forces[:, 2].sum()) - snow_total
     ang = joint_mismatch(net, q)
     figures = {
         "kind": model.kind,
@@ -156,7 +171,8 @@ def simulate(bundle, material, section, *, supports: str | np.ndarray = "boundar
         "section": f"{model.section.width_mm:g} x {model.section.thickness_mm:g} mm "
                    f"(edge ratio {model.section.edge_ratio:.3g}:1), scale {sc:g}",
         "rest state": model.rest,
-        "gravity": "self-weight" if gravity else "off",
+        "gravity": (f"self-weight + snow {snow:g} kN/m2" if snow else
+                    "self-weight" if gravity else "off"),
         "rod model": f"{len(net.rods)} lamellae, {len(net.X)} nodes, {net.n_edges} elements, "
                      f"{len(net.joints)} joints",
         "supports": int(len(model.supports)),
@@ -176,6 +192,7 @@ def simulate(bundle, material, section, *, supports: str | np.ndarray = "boundar
         "sigma_peak_MPa": stresses["peak_sigma_MPa"],
         "tau_peak_MPa": stresses["peak_tau_MPa"],
         "joint_axis_mismatch_deg": float(ang),
+        **(_under_load(model, res.q, J0, Jeq, used, snow, snow_total) if snow else {}),
         "wall_s": time.perf_counter() - t0,
         "cpu_s": time.process_time() - c0,
     }
@@ -183,6 +200,23 @@ def simulate(bundle, material, section, *, supports: str | np.ndarray = "boundar
     axes0 = [net.X[n] / sc for n in model.lamella_nodes]
     return Equilibrium(model, res, Jeq, axes, axes0, dev, R, model.supports, energy, stresses,
                        figures)
+
+
+def _under_load(model: DeployedModel, q: np.ndarray, J0: np.ndarray, Jeq: np.ndarray,
+                used: np.ndarray, snow: float, snow_total: float) -> dict[str, Any]:
+    """The figures of a loaded equilibrium: snow (kN/m2, total kN), deflection (mm of the
+    simulated structure), span / deflection, the largest bolt shear (N) and its joint."""
+    from gridshell.structure import loads
+
+    sc = model.scale
+    nodes = model.joint_node[used]
+    bolts = loads.bolt_forces(model.network, q, nodes)
+    k = int(np.argmax(bolts)) if len(bolts) else 0
+    fig = loads.deflection_figures(J0[used] * sc, Jeq[used] * sc, J0[model.supports] * sc)
+    return {"snow_kN_m2": float(snow), "snow_total_kN": snow_total / 1e3, **fig,
+            "bolt_shear_max_N": float(bolts[k]) if len(bolts) else 0.0,
+            "bolt_shear_max_joint": int(np.flatnonzero(used)[k]) if len(bolts) else -1,
+            "bolt_shear_mean_N": float(bolts[bolts > 0].mean()) if np.any(bolts > 0) else 0.0}
 
 
 def joint_mismatch(net: RodNetwork, q: np.ndarray) -> float:

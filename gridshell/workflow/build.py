@@ -13,14 +13,13 @@ directory ``out`` (the pack: a design bundle with everything made from it)::
     build.json         what was chosen and why, each stage's key, time and verdict
     manifest.json      every file of the pack
 
-Stages: ``analyze`` -> ``design`` -> ``verify`` -> ``section`` (the thinnest stock thickness
-of the material that stays elastic at the strip width and scale,
-:func:`gridshell.structure.sizing.stock_sections`) -> ``check`` -> ``simulate`` ->
+Stages: ``analyze`` -> ``design`` -> ``verify`` -> ``check`` (the section: the thinnest stock
+thickness of the material, which holds if any does, and its stresses) -> ``simulate`` ->
 ``fabricate`` -> ``outputs`` (render, report, .3dm). Each stage has a key, the SHA-256 of
 what it depends on (the model's bytes, the options that reach it, the tool's version and the
 keys of the stages before); a re-run with the same arguments reuses every stage whose key is
 unchanged and whose files are still the ones the pack's manifest lists, so a change of
-material re-runs only the stages from ``section`` on. A stage that fails ends the build with
+material re-runs only the stages from ``check`` on. A stage that fails ends the build with
 its exit code (3 no net of the kind, 4 figures or stresses fail); nothing the tool did not
 write is touched (the pack is refused, exit 5, if it holds foreign files).
 """
@@ -41,7 +40,7 @@ __all__ = ["BUILD_JSON", "KINDS", "STAGES", "BuildResult", "build", "build_key"]
 BUILD_JSON = "build.json"
 RHINO = "model.3dm"
 #: the stages in order (build.json's "stages")
-STAGES = ("analyze", "design", "verify", "section", "check", "simulate", "fabricate", "outputs")
+STAGES = ("analyze", "design", "verify", "check", "simulate", "fabricate", "outputs")
 #: --kind: auto (the analysis chooses), GG or an NCP mode
 KINDS = ("auto", "gg", "phlw", "cnc", "aa")
 
@@ -145,12 +144,12 @@ def build(model: str | os.PathLike, out: str | os.PathLike, *, kind: str = "auto
         stage("design", k_design, lambda: _design(model, out, opts, res.kind, lamellae, frames,
                                                   a), ("design.json",))
         stage("verify", build_key(k_design, "verify"), lambda: _verify(out), ())
-        k_sec = build_key(k_design, "section", material, str(scale), width)
-        sec = stage("section", k_sec, lambda: _section(out, material, scale, width), ())
+        k_sec = build_key(k_design, "check", material, str(scale), width)
+        sec = stage("check", k_sec, lambda: _check(out, material, scale, width),
+                    ("structure.json",))
         res.section = sec["section"]
         pick = {"material": sec["section"]["material"], "scale": sec["section"]["scale"],
                 "width": sec["section"]["width_mm"], "thickness": sec["section"]["thickness_mm"]}
-        stage("check", build_key(k_sec, "check"), lambda: _check(out, pick), ("structure.json",))
         stage("simulate", build_key(k_sec, "simulate"), lambda: _simulate(out, pick),
               ("equilibrium",))
         k_fab = build_key(k_sec, "fabricate", sheet)
@@ -243,58 +242,42 @@ def _verify(out: Path) -> dict[str, Any]:
     return {"ok": True, "checks": list(v.report["checks"])}
 
 
-def _section(out: Path, material: str | None, scale: Any, width: float | None
-             ) -> dict[str, Any]:
-    """The thinnest stock thickness of ``material`` at which a strip ``width`` mm wide at
-    ``scale`` stays elastic in every judged state (the deployed design, the collapsed state
-    and the alignment sequence); :class:`Overstressed` naming the best there is when none
-    does."""
-    from gridshell.design.bundle import read_bundle
-    from gridshell.design.section import scale_text
-    from gridshell.structure.check import deployed_curvatures
-    from gridshell.structure.section import Section
-    from gridshell.structure.sizing import demand_from, max_utilisation, smallest_scale
+def _check(out: Path, material: str | None, scale: Any, width: float | None
+           ) -> dict[str, Any]:
+    """The section and its stresses (gridshell check, structure.json): the thinnest stock
+    thickness of ``material`` for a strip ``width`` mm wide at ``scale``. The utilisation
+    cannot fall as the strip thickens (weak-axis bending and twist stresses grow with the
+    thickness, strong-axis bending does not depend on it), so the thinnest stock thickness
+    holds if any does; when it does not, :class:`Overstressed` names the best there is and
+    the smallest scale that would hold."""
+    from gridshell.design.section import resolve_section, scale_text
+    from gridshell.structure.materials import get_material
+    from gridshell.structure.sizing import smallest_scale
     from gridshell.structure.verdict import Overstressed
     from gridshell.workflow.structure import check_structure
 
-    first = check_structure(out, material=material, width=width, scale=scale, write=False,
-                            picture=False)
-    strip, mat, res = first.section, first.material, first.result
-    b = read_bundle(out)
-    base = Section(strip.width_mm, strip.thickness_mm, strip.scale)
-    _, ks, _ = deployed_curvatures(b, base)
-    demand = demand_from(ks, [lam.id for lam in b.net.lamellae], base.scale, res["states"])
-    stock = sorted(mat.sheet_thicknesses_mm) or [float(strip.thickness_mm)]
-    tried = []
-    for t in stock:
-        u = max_utilisation(demand, mat, Section(strip.width_mm, t, strip.scale))
-        tried.append((t, u))
-        if u <= 1.0:
-            return {"section": {"material": mat.name, "scale": scale_text(strip.scale),
-                                "width_mm": float(strip.width_mm), "thickness_mm": float(t),
-                                "utilisation": float(u)},
-                    "tried": [{"thickness_mm": a, "utilisation": c} for a, c in tried],
-                    "why": f"the thinnest {mat.name} stock thickness that stays elastic at "
-                           f"{strip.width_mm:g} mm wide, {scale_text(strip.scale)}"}
-    t, u = min(tried, key=lambda r: r[1])
-    raise Overstressed(
-        f"no stock thickness of {mat.name} holds a {strip.width_mm:g} mm strip at "
-        f"{scale_text(strip.scale)}: the best, {t:g} mm, reaches utilisation {u:.2f} "
-        f"({res['governing_state']}); build at {scale_text(smallest_scale(strip.scale, u))} "
-        "or larger (--scale), a narrower strip (--width) or a stronger --material "
-        "('gridshell check --suggest' lists the sections)")
-
-
-def _check(out: Path, pick: dict[str, Any]) -> dict[str, Any]:
-    from gridshell.structure.verdict import Overstressed
-    from gridshell.workflow.structure import check_structure
-
-    c = check_structure(out, **pick)
+    strip = resolve_section(out, material=material, width=width, scale=scale)
+    mat = get_material(strip.material)
+    t = min(mat.sheet_thicknesses_mm) if mat.sheet_thicknesses_mm else strip.thickness_mm
+    c = check_structure(out, material=mat.name, width=strip.width_mm, thickness=t,
+                        scale=strip.scale)
     r = c.result
+    u = float(r["max_utilisation"])
+    sc = scale_text(strip.scale)
     if not c.ok:
-        raise Overstressed(f"the strips are overstressed in {r['governing_state']} "
-                           f"(utilisation {r['max_utilisation']:.2f})")
-    return {"verdict": r["verdict"], "max_utilisation": r["max_utilisation"],
+        small = smallest_scale(strip.scale, u)
+        larger = (f"build at {scale_text(small)} or larger (--scale), " if small <= 1.0 else
+                  "not even at full size (1:1) would it hold; ")
+        raise Overstressed(
+            f"no stock thickness of {mat.name} holds a {strip.width_mm:g} mm strip at {sc}: "
+            f"the thinnest, {t:g} mm, reaches utilisation {u:.2f} ({r['governing_state']}); "
+            f"{larger}a narrower strip (--width) or a stronger --material ('gridshell check "
+            "--suggest' lists the sections)")
+    return {"section": {"material": mat.name, "scale": sc, "width_mm": float(strip.width_mm),
+                        "thickness_mm": float(t), "utilisation": u},
+            "why": f"the thinnest {mat.name} stock thickness ({t:g} mm) holds at "
+                   f"{strip.width_mm:g} mm wide, {sc}",
+            "verdict": r["verdict"], "max_utilisation": u,
             "max_utilisation_deployed": r["max_utilisation_deployed"],
             "governing_state": r["governing_state"], "min_radius_m": r["min_radius_m"]}
 

@@ -15,7 +15,37 @@ from gridshell.core.errors import InputError
 from gridshell.design.bundle import Design, DesignBundle, write_bundle
 from gridshell.design.verification import require_design
 
-__all__ = ["design_parts", "fabricate_checked", "write_design"]
+__all__ = ["design_parts", "fabricate_checked", "made_from", "require_no_made_from",
+           "write_design"]
+
+#: files other commands add to a bundle from its design (render, export, check)
+MADE_FROM = ("render.png", "report.html", "structure.json", "structure.png", "build.json")
+
+
+def made_from(path: str | os.PathLike) -> list[str]:
+    """What other commands made from the design in the bundle directory ``path`` (cut files,
+    equilibrium, the .3dm, render.png, report.html, structure.json: the nested outputs and
+    files its manifest lists), which a new design there would leave stale."""
+    from gridshell.core import manifest
+
+    m = manifest.read(path) if Path(path).is_dir() else None
+    if not m:
+        return []
+    files = [f for f in m.get("files", {}) if f in MADE_FROM or f.endswith(".3dm")]
+    return sorted(set(m.get("outputs", [])) | set(files))
+
+
+def require_no_made_from(path: str | os.PathLike) -> None:
+    """:class:`OutputError` before any work when a new design at ``path`` would delete what
+    other commands made from the old one (:func:`made_from`)."""
+    from gridshell.core.errors import OutputError
+
+    found = made_from(path)
+    if found:
+        raise OutputError(
+            f"{path} holds what was made from its design ({', '.join(found[:6])}"
+            f"{', ...' if len(found) > 6 else ''}); a new design would delete it: write to "
+            "another -o, or remove them (or the directory) first (nothing was changed)")
 
 Progress = Callable[[str], None] | None
 
@@ -57,6 +87,8 @@ def write_design(path: str | os.PathLike, design: Design | DesignBundle, report:
         The command the bundle's manifest names (default ``gg`` / ``ncp`` by kind).
     """
     bundle, report = design_parts(design, report)
+    if owner != "build":                # a build re-makes what it made from the design
+        require_no_made_from(path)
     if bundle.kind == "GG":
         from gridshell.gg.pipeline import gg_files
 

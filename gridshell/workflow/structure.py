@@ -111,12 +111,14 @@ class Simulation:
 def simulate(bundle: str | os.PathLike, out: str | os.PathLike | None = None, *,
              material: Any = None, width: float | None = None, thickness: float | None = None,
              scale: Any = None, supports: Any = "boundary", gravity: bool = False,
-             per_bay: int = 3, max_iter: int = 100, write: bool = True,
-             progress: Progress = None) -> Simulation:
+             snow: float | None = None, per_bay: int = 3, max_iter: int = 100,
+             write: bool = True, progress: Progress = None) -> Simulation:
     """The elastic equilibrium of the deployed gridshell of the bundle directory ``bundle``:
     every lamella a discrete elastic rod of the real strip (``width`` x ``thickness`` mm at
     ``scale``, ``material``), joints turning about their axis only, ``supports`` (``"boundary"``
-    or joint indices) held at the design, optionally under ``gravity``; ``per_bay`` rod elements
+    or joint indices) held at the design, optionally under ``gravity`` and a ``snow`` load
+    (kN/m2 of plan area, with self-weight: deflection, span / deflection and bolt shear in the
+    figures); ``per_bay`` rod elements
     between joints, at most ``max_iter`` Newton iterations. With ``write`` the result goes to
     ``out`` (default ``DIR/equilibrium``), replaced atomically."""
     from gridshell.core.atomic import check_output
@@ -136,7 +138,8 @@ def simulate(bundle: str | os.PathLike, out: str | os.PathLike | None = None, *,
     if progress:
         progress(f"equilibrium of {b.kind} {bundle_dir} in {strip.width_mm:g} x "
                  f"{strip.thickness_mm:g} mm {mat.label} at {_scale(strip)}")
-    eq = equilibrium(b, mat, section, supports=supports, gravity=gravity, per_bay=per_bay,
+    eq = equilibrium(b, mat, section, supports=supports, gravity=gravity, snow=snow,
+                     per_bay=per_bay,
                      max_iter=max_iter, progress=progress)
     record = _record(eq, mat, section)
     if write:

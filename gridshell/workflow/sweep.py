@@ -189,7 +189,8 @@ def _compute(todo: list, study: Study, variants: Path, workers: int | None,
     try:
         target = str(Path(study.target).resolve())
         futures = [client.submit(run_variant, target, p, k, str(variants.resolve()),
-                                 study.units, key=f"variant-{k}", pure=False, retries=1)
+                                 study.units, key=f"variant-{k}", pure=False, retries=1,
+                                 priority=_expected_cost(p))
                    for k, p in todo]
         if bar:
             distributed.progress(futures, notebook=False)
@@ -212,6 +213,15 @@ def _compute(todo: list, study: Study, variants: Path, workers: int | None,
             cluster.close()
         _sweep_temporary(variants, [k for k, _ in todo])
     return rows
+
+
+def _expected_cost(p: dict[str, Any]) -> int:
+    """A rank of a variant's expected run time (Dask runs higher priorities first, so the long
+    tasks start early and the short ones fill the end: the workers finish together). NCP kinds
+    (a PHLW step, tracing, post-optimization) take several times a GG design; more lamellae
+    take longer."""
+    kind = str(p.get("kind", "gg"))
+    return (0 if kind == "gg" else 1000) + int(p.get("lamellae") or 10)
 
 
 def _sweep_temporary(variants: Path, keys: list[str]) -> None:

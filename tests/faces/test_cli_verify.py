@@ -44,9 +44,14 @@ def test_gg_bundle_passes_its_own_tools(tmp_path, capsys, name):
     assert main(["render", str(b), "--no-sequence", "--size", "100", "100", "-q"]) == 0
     m = manifest.read(b)
     assert "render.png" in m["files"] and m["outputs"] == ["fabrication"]
-    assert main(["gg", str(target), "-o", str(b), *GG]) == 0  # its own output, replaced
-    assert not (b / "fabrication").exists() and not (b / "render.png").exists()
     capsys.readouterr()
+    # a new design would delete what was made from this one: refused before any work
+    before = (b / "design.json").read_bytes()
+    assert main(["gg", str(target), "-o", str(b), *GG]) == 5
+    err = capsys.readouterr().err
+    assert "fabrication" in err and "render.png" in err and "another -o" in err
+    assert (b / "fabrication" / "cutlist.csv").is_file() and (b / "render.png").is_file()
+    assert (b / "design.json").read_bytes() == before
     # a joint moved by 5 % of the span: the recomputed figures fail or disagree
     text = (b / "net.obj").read_text().splitlines()
     V = read_configuration(b / "net.obj")[0]
