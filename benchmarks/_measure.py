@@ -126,3 +126,15 @@ def compile_tree(root: Path) -> None:
         if (Path(root) / pkg).is_dir():
             compileall.compile_dir(str(Path(root) / pkg), quiet=1)
 
+
+def gridshell_env() -> dict[str, str]:
+    """The environment of a ``python -m gridshell`` child process of a benchmark: this
+    checkout first on ``PYTHONPATH``, matplotlib without a display."""
+    import os
+
+    root = str(Path(__file__).resolve().parent.parent)
+    env = dict(os.environ, MPLBACKEND="Agg")
+    env["PYTHONPATH"] = os.pathsep.join([root] + [p for p in
+                                                  env.get("PYTHONPATH", "").split(os.pathsep)
+                                                  if p])
+    return env

@@ -28,6 +28,8 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
+from _measure import gridshell_env as _env  # noqa: E402
+
 from tests.helpers.io_cases import (hill, hill_ctrl, rhino_mesh, rhino_nurbs,  # noqa: E402
                                     soup, write_3dm, write_obj_text, write_ply_soup)
 
@@ -68,7 +70,7 @@ MODELS: dict[str, tuple[Callable[[Path], Path], list[str]]] = {
 
 
 def _build(model: Path, out: Path, extra: list[str]) -> dict[str, Any]:
-    env = dict(os.environ, MPLBACKEND="Agg", PYTHONPATH=str(ROOT))
+    env = _env()
     t0 = time.perf_counter()
     p = subprocess.run([sys.executable, "-m", "gridshell", "build", str(model), "-o", str(out),
                         "--json", *extra], env=env, capture_output=True, text=True)

@@ -51,6 +51,8 @@ from typing import Any
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
+from _measure import gridshell_env as _env  # noqa: E402
+
 from gridshell.corpus import MODES, Reference, select  # noqa: E402
 from gridshell.corpus.files import target_name  # noqa: E402
 from gridshell.measure.quality import design_gates, gate_summary, passed  # noqa: E402
@@ -65,14 +67,6 @@ KIND = {"gg": "GG", "ncp-phlw": "NCP", "ncp-cnc": "CNC", "ncp-aa": "AA"}
 
 
 # ----------------------------------------------------------------------------- running
-
-
-def _env() -> dict[str, str]:
-    env = dict(os.environ, MPLBACKEND="Agg")
-    env["PYTHONPATH"] = os.pathsep.join([str(ROOT)] + [p for p in
-                                                       env.get("PYTHONPATH", "").split(os.pathsep)
-                                                       if p])
-    return env
 
 
 def _call(argv: list[str], timeout: float) -> dict[str, Any]:

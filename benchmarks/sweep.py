@@ -36,15 +36,9 @@ from typing import Any
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
+from _measure import gridshell_env as _env  # noqa: E402
+
 DOME = ROOT / "gridshell" / "data" / "dome.obj"
-
-
-def _env() -> dict[str, str]:
-    env = dict(os.environ, MPLBACKEND="Agg")
-    env["PYTHONPATH"] = os.pathsep.join([str(ROOT)] + [p for p in
-                                                       env.get("PYTHONPATH", "").split(os.pathsep)
-                                                       if p])
-    return env
 
 
 def _gridshell(*argv: str) -> tuple[int, float]:

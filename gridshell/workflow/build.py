@@ -14,8 +14,9 @@ directory ``out`` (the pack: a design bundle with everything made from it)::
     manifest.json      every file of the pack
 
 Stages: ``analyze`` -> ``design`` -> ``verify`` -> ``check`` (the section: the thinnest stock
-thickness of the material, which holds if any does, and its stresses) -> ``simulate`` ->
-``fabricate`` -> ``outputs`` (render, report, .3dm). Each stage has a key, the SHA-256 of
+thickness of the material, which holds if any does, and its stresses) -> ``fabricate`` and
+``simulate`` (the equilibrium computed in a forked process while the cut files are made,
+:mod:`gridshell.core.aside`) -> ``outputs`` (render, report, .3dm). Each stage has a key, the SHA-256 of
 what it depends on (the model's bytes, the options that reach it, the tool's version and the
 keys of the stages before); a re-run with the same arguments reuses every stage whose key is
 unchanged and whose files are still the ones the pack's manifest lists, so a change of
@@ -29,10 +30,12 @@ import hashlib
 import json
 import os
 import time
+from contextlib import ExitStack
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable
 
+from gridshell.core.aside import Aside
 from gridshell.core.errors import GridshellError, InputError
 
 __all__ = ["BUILD_JSON", "KINDS", "STAGES", "BuildResult", "build", "build_key"]
@@ -40,7 +43,7 @@ __all__ = ["BUILD_JSON", "KINDS", "STAGES", "BuildResult", "build", "build_key"]
 BUILD_JSON = "build.json"
 RHINO = "model.3dm"
 #: the stages in order (build.json's "stages")
-STAGES = ("analyze", "design", "verify", "check", "simulate", "fabricate", "outputs")
+STAGES = ("analyze", "design", "verify", "check", "fabricate", "simulate", "outputs")
 #: --kind: auto (the analysis chooses), GG or an NCP mode
 KINDS = ("auto", "gg", "phlw", "cnc", "aa")
 
@@ -122,10 +125,14 @@ def build(model: str | os.PathLike, out: str | os.PathLike, *, kind: str = "auto
     k_in = build_key("input", file_sha256(model), opts, _version())
     res = BuildResult(out, kind, "", {})
 
+    def reusable(name: str, key: str, files: tuple[str, ...]) -> bool:
+        old = before.get(name)
+        return bool(old) and old.get("key") == key and all((out / f).exists() for f in files)
+
     def stage(name: str, key: str, run: Callable[[], dict[str, Any]],
               files: tuple[str, ...] = ()) -> dict[str, Any]:
         old = before.get(name)
-        if old and old.get("key") == key and all((out / f).exists() for f in files):
+        if reusable(name, key, files):
             res.stages[name] = {**old, "reused": True}
             say(f"{name}: unchanged, reused")
             return res.stages[name]
@@ -150,10 +157,14 @@ def build(model: str | os.PathLike, out: str | os.PathLike, *, kind: str = "auto
         res.section = sec["section"]
         pick = {"material": sec["section"]["material"], "scale": sec["section"]["scale"],
                 "width": sec["section"]["width_mm"], "thickness": sec["section"]["thickness_mm"]}
-        stage("simulate", build_key(k_sec, "simulate"), lambda: _simulate(out, pick),
-              ("equilibrium",))
-        k_fab = build_key(k_sec, "fabricate", sheet)
-        stage("fabricate", k_fab, lambda: _fabricate(out, pick, sheet), ("fabrication",))
+        k_sim, k_fab = build_key(k_sec, "simulate"), build_key(k_sec, "fabricate", sheet)
+        with ExitStack() as stack:      # the equilibrium computed beside the cut files
+            job = None
+            if not reusable("simulate", k_sim, ("equilibrium",)) and \
+                    not reusable("fabricate", k_fab, ("fabrication",)):
+                job = stack.enter_context(Aside(_equilibrium, out, pick))
+            stage("fabricate", k_fab, lambda: _fabricate(out, pick, sheet), ("fabrication",))
+            stage("simulate", k_sim, lambda: _simulate(out, pick, job), ("equilibrium",))
         stage("outputs", build_key(k_fab, "outputs"), lambda: _outputs(out, pick, sheet),
               (RHINO, "report.html"))
     finally:
@@ -282,10 +293,21 @@ def _check(out: Path, material: str | None, scale: Any, width: float | None
             "governing_state": r["governing_state"], "min_radius_m": r["min_radius_m"]}
 
 
-def _simulate(out: Path, pick: dict[str, Any]) -> dict[str, Any]:
+def _equilibrium(out: Path, pick: dict[str, Any]) -> Any:
+    """The equilibrium under self-weight, computed and not written (a pure function: it may
+    run in a forked process, :mod:`gridshell.core.aside`)."""
     from gridshell.workflow.structure import simulate
 
-    f = simulate(out, gravity=True, **pick).figures
+    return simulate(out, gravity=True, write=False, **pick)
+
+
+def _simulate(out: Path, pick: dict[str, Any], job: Any = None) -> dict[str, Any]:
+    """equilibrium/ (gridshell simulate --gravity): from ``job`` (an Aside computing
+    :func:`_equilibrium`) when given, else computed here."""
+    from gridshell.workflow.structure import write_simulation
+
+    sim = job.result() if job is not None else _equilibrium(out, pick)
+    f = write_simulation(out, sim).figures
     keep = ("converged", "deviation_mean_pct", "deviation_max_pct", "utilisation_peak",
             "reaction_max_N", "weight_N", "newton")
     return {k: f[k] for k in keep if k in f}
@@ -298,7 +320,10 @@ def _fabricate(out: Path, pick: dict[str, Any], sheet: str | None) -> dict[str, 
     params = {"width": pick["width"], "thickness": pick["thickness"], "scale": pick["scale"]}
     if sheet:
         params["sheet"] = sheet
-    rep = fabricate_checked(out, out / "fabrication", params, material=pick["material"])
+    checked = json.loads((out / "structure.json").read_text(encoding="utf-8"))
+    # the verify and check stages of this pack gated these very files (their keys match)
+    rep = fabricate_checked(out, out / "fabrication", params, material=pick["material"],
+                            verified=True, structure=checked)
     length_m = sum(float(q.get("flat_length_mm", 0.0)) for q in rep["pieces"]) / 1000.0
     rho = get_material(pick["material"]).density
     return {"sheets": int(rep["n_sheets"]), "material_used_pct": 100.0 * rep["material_used"],

@@ -106,14 +106,19 @@ def write_design(path: str | os.PathLike, design: Design | DesignBundle, report:
 
 def fabricate_checked(design: Any, out_dir: str | os.PathLike, params: Any = None, *,
               force: bool = False, plan: bool = True, progress: Progress = None,
-              material: str | None = None) -> dict[str, Any]:
+              material: str | None = None, verified: bool = False,
+              structure: dict[str, Any] | None = None) -> dict[str, Any]:
     """Cut files (DXF, SVG, PNG per sheet), cut list and plan of a design into ``out_dir``
     (:func:`gridshell.fabrication.pipeline.fabricate`; ``params``: a FabParams or a dict of its fields,
     mm of the model). A design that fails its figures (recomputed from the files of a bundle
     directory) is refused with :class:`~gridshell.core.errors.InputError`, one whose strips of
     ``material`` (a preset name; default the strips' default material) would be overstressed
     with :class:`~gridshell.structure.verdict.Overstressed`, unless ``force``; the structural
-    verdict is the report's ``"structure"``."""
+    verdict is the report's ``"structure"``. A caller that has just verified these very files
+    says so (``verified``), and one that has their check for this material and section gives
+    it (``structure``: :func:`gridshell.structure.check.check_bundle`'s result, e.g.
+    structure.json): neither is computed again (the given check still refuses an
+    overstressed design unless ``force``)."""
     from gridshell.fabrication.params import FabParams
     from gridshell.fabrication.pipeline import fabricate as _fabricate
     from gridshell.structure import Section, get_material
@@ -122,11 +127,18 @@ def fabricate_checked(design: Any, out_dir: str | os.PathLike, params: Any = Non
 
     bundle = design if isinstance(design, (str, os.PathLike)) else design_parts(design)[0]
     where = Path(bundle) if isinstance(bundle, (str, os.PathLike)) else bundle
-    require_design(where, force, "fabricate(..., force=True) cuts it anyway")
+    retry = "fabricate(..., force=True) cuts it anyway"
+    if not verified:
+        require_design(where, force, retry)
     fp = params if isinstance(params, FabParams) else FabParams(**(params or {}))
-    res = require_elastic(where, get_material(material or DEFAULTS["material"]),
-                          Section.from_params(fp), force,
-                          "fabricate(..., force=True) cuts it anyway")
+    if structure is not None:
+        from gridshell.structure.verdict import refuse_overstressed
+
+        refuse_overstressed(structure, force, retry)
+        res = structure
+    else:
+        res = require_elastic(where, get_material(material or DEFAULTS["material"]),
+                              Section.from_params(fp), force, retry)
     return _fabricate(bundle, out_dir, fp, progress=progress, plan=plan,
                       structure=verdict_record(res, force))
 

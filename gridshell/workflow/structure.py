@@ -149,6 +149,20 @@ def simulate(bundle: str | os.PathLike, out: str | os.PathLike | None = None, *,
     return Simulation(eq, b, strip, mat, record, target if write else None)
 
 
+def write_simulation(bundle: str | os.PathLike, sim: Simulation,
+                     out: str | os.PathLike | None = None) -> Simulation:
+    """Write a :class:`Simulation` computed with ``write=False`` (perhaps in another process)
+    to ``out`` (default ``bundle/equilibrium``), atomically; the simulation with its output."""
+    from dataclasses import replace
+
+    from gridshell.core.atomic import check_output
+
+    target = Path(out) if out else Path(bundle) / "equilibrium"
+    check_output(target, owner="simulate")
+    _write(target, sim.bundle, sim.equilibrium, sim.record, sim.section, sim.material)
+    return replace(sim, out=target)
+
+
 def _scale(strip: StripSection) -> str:
     from gridshell.design.section import scale_text
 
