@@ -41,18 +41,23 @@ def add_args(p: argparse.ArgumentParser) -> None:
                    help="strip width as cut, mm (default 20)")
     p.add_argument("--sheet", type=checked(parse_sheet, "sheet"), metavar="WxH",
                    help="sheet size, mm (default 600x400)")
+    p.add_argument("--max-deviation", type=number(0.0), metavar="PCT",
+                   help="refuse (exit 4) a net whose joints lie farther from the model than "
+                        "this on average, %% of its diagonal (default: no gate)")
     p.add_argument("--frames", type=count(0, "0: no alignment sequence"), default=12,
                    metavar="N", help="states of the alignment sequence (default 12; 0: none)")
 
 
 def run(args: Any) -> int:
     from gridshell.cli.common import Progress, print_summary
+    from gridshell.measure.fidelity import fidelity_line
     from gridshell.workflow.build import build
 
     progress = Progress(args)
     res = build(args.model, args.output, kind=args.kind, material=args.material,
                 lamellae=args.lamellae, scale=args.scale, width=args.width, sheet=args.sheet,
                 units=args.units, obj=args.object, frames=args.frames,
+                max_deviation=args.max_deviation,
                 progress=progress.callback)
     st, sec = res.stages, res.section
     d, c, e, f = st["design"], st["check"], st["simulate"], st["fabricate"]
@@ -63,6 +68,7 @@ def run(args: Any) -> int:
         "net": f"{' + '.join(str(v) for v in n.values()) or '?'} lamellae, "
                f"{d.get('n_joints')} joints",
         "figures": "verified (every figure within the paper's thresholds)",
+        "fidelity": fidelity_line(d.get("fidelity")),
         "section": f"{sec['width_mm']:g} x {sec['thickness_mm']:g} mm {sec['material']} at "
                    f"{sec['scale']} (thinnest stock thickness that holds)",
         "structure": f"{c['verdict']}, max utilisation {c['max_utilisation']:.2f} "

@@ -5,7 +5,7 @@ import argparse
 import math
 from typing import Any
 
-from gridshell.cli.values import angle_between, count, fraction, number, positive
+from gridshell.cli.values import angle_between, count, fraction, nonnegative, number, positive
 
 HELP = "design a geodesic (GG) alignable gridshell on a target surface and write a design bundle"
 
@@ -51,6 +51,9 @@ def add_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--polish", type=count(0, "0: no final projection"), default=20, metavar="N",
                    help="most iterations of the final projection onto the constraints; it "
                         "stops once the figures hold and stagnate (default 20)")
+    p.add_argument("--max-deviation", type=nonnegative, metavar="PCT",
+                   help="refuse (exit 4, nothing written) a net whose joints lie farther from "
+                        "the target than this on average, %% of its diagonal (default: no gate)")
     p.add_argument("--allow-unconverged", action="store_true",
                    help="write the design even if it misses the paper's figures (Delta_a mean "
                         "< 1 %%, max < 3 %%; default: exit code 4, nothing written); the bundle "
@@ -109,10 +112,14 @@ def run(args: Any) -> int:
                        allow_unconverged=args.allow_unconverged,
                        frames=args.frames, **input_options(args),
                        progress=progress.callback)
+    from gridshell.measure.fidelity import require_fidelity
+
+    require_fidelity(design.bundle.metrics, args.max_deviation)
     progress(f"writing {args.output}")
     out = write(args.output, design, render=not args.no_preview, progress=progress.callback)
     bundle, report = design
     m = bundle.metrics
+    from gridshell.measure.fidelity import fidelity_line
     seq = report["sequence"]
     quality = bundle.params["quality"]
 
@@ -129,6 +136,7 @@ def run(args: Any) -> int:
         "Delta_a straight [%]": m["alignability"],
         "Delta_a arc [%]": m["alignability_arc"],
         "geodesic turning [%]": m["geodesic_turning"],
+        "fidelity to the target": fidelity_line(m.get("fidelity")),
         "deviation [% diag]": m.get("deviation", {}),
         "deviation target->surface [% diag]": m.get("deviation_target", {}),
         "coverage [% of target area]": m.get("coverage", float("nan")),

@@ -68,6 +68,9 @@ def add_args(p: argparse.ArgumentParser) -> None:
                    help="mesh input: turn the reference's parametrization onto its mean principal "
                         "directions (as far as coverage allows) before the PHLW step (default: "
                         "keep it)")
+    p.add_argument("--max-deviation", type=nonnegative, metavar="PCT",
+                   help="refuse (exit 4, nothing written) a net whose joints lie farther from "
+                        "the target than this on average, %% of its diagonal (default: no gate)")
     p.add_argument("--allow-unconverged", action="store_true",
                    help="write a design whose figures (Delta_a mean / max after the "
                         "post-optimization, Delta_l max, Delta_n max, the collapse error) miss "
@@ -117,9 +120,13 @@ def run(args: Any) -> int:
     if not quality["ok"]:
         progress(f"warning: the design misses the paper's figures ({quality['summary']}); "
                  "written because of --allow-unconverged, marked as failing")
+    from gridshell.measure.fidelity import require_fidelity
+
+    require_fidelity(design.bundle.metrics, args.max_deviation)
     progress(f"writing {args.output}")
     out = write(args.output, design, render=not args.no_render, progress=progress.callback)
     m = bundle.metrics
+    from gridshell.measure.fidelity import fidelity_line
     summary = {
         "bundle": str(out),
         "kind": bundle.kind,
@@ -132,6 +139,7 @@ def run(args: Any) -> int:
         "Delta_a after [%]": m["delta_a_after"],
         "Delta_l [%]": m["delta_l"],
         "Delta_n [%]": m["delta_n"],
+        "fidelity to the target": fidelity_line(m.get("fidelity")),
         "deviation [% diag]": m["deviation"],
         "crossing kn difference [%]": {"mean": m["crossing_kn"]["mean"],
                                        "max": m["crossing_kn"]["max"]},

@@ -308,6 +308,10 @@ def gg_metrics(net: Net, V: np.ndarray, F: np.ndarray, *, net_rev: Net | None = 
         dt = target_deviation(V, F, sV, sF)
         out["deviation_target"] = {"mean": dt["mean"], "max": dt["max"]}
         out["coverage"] = coverage(V, F, sV, sF)
+        from gridshell.measure.fidelity import net_fidelity
+
+        out["fidelity"] = {**net_fidelity(net.joints, net.loops, tV, tF),
+                           "target": "the target mesh"}
     out["n_joints"] = int(len(net.joints))
     out["n_loops"] = int(len(net.loops))
     out["n_lamellae"] = {"C1": len(net.family(1)), "C3": len(net.family(3))}

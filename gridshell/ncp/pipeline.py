@@ -176,13 +176,14 @@ def _guarded(state: dict[str, Any], run: Callable[[], Any]) -> Any:
 
 
 @stage("surface", needs=("source", "opts", "n"),
-       gives=("surface", "n_src", "info", "input_units", "from_phlw"))
+       gives=("surface", "n_src", "info", "input_units", "from_phlw", "reference"))
 def _surface_stage(state: dict[str, Any]) -> dict[str, Any]:
     """The B-spline surface: read as it is, or the PHLW step on a reference (load_surface)."""
     o: NCPOptions = state["opts"]
     surf, n_src, info = load_surface(state["source"], mode=o.mode, phlw_options=o.phlw_options,
                                      progress=o.progress, units=o.units, clean=o.clean, obj=o.obj)
     input_units = info.pop("units")
+    reference = info.pop("reference", None)      # the user's mesh: the net's fidelity to it
     if o.strict and info.get("phlw_converged") is False:
         raise ConvergenceError(
             "the PHLW step did not converge within its iteration limits (phlw_options outer x "
@@ -191,7 +192,8 @@ def _surface_stage(state: dict[str, Any]) -> dict[str, Any]:
     # a no-net answer on the PHLW step's surface is the step's failure, unless the user's n
     # is the reason
     return {"surface": surf, "n_src": n_src, "info": info, "input_units": input_units,
-            "from_phlw": "phlw_converged" in info and state["n"] is None}
+            "from_phlw": "phlw_converged" in info and state["n"] is None,
+            "reference": reference}
 
 
 @stage("directions", needs=("surface", "opts", "n", "n_src", "info", "from_phlw", "notes"),
@@ -333,7 +335,7 @@ def _mode_figures(mode: str, n: float | None, col: CollapseResult,
 
 
 @stage("metrics", needs=("surface", "traced", "collapse", "post", "sequence",
-                         "collapse_direction", "n", "opts"),
+                         "collapse_direction", "n", "opts", "reference"),
        gives=("metrics", "gates", "mesh", "aligned_2d", "out_net"))
 def _metrics_stage(state: dict[str, Any]) -> dict[str, Any]:
     """The design's figures and the paper's gates on them (``metrics["quality"]``)."""
@@ -351,6 +353,13 @@ def _metrics_stage(state: dict[str, Any]) -> dict[str, Any]:
     metrics["fairness"] = net_fairness(out_net, mesh.V, mesh.F,
                                        tangent=False, width=design_width_m(mesh.V), states=seq.V,
                                        gate_folds=False)
+    from gridshell.measure.fidelity import net_fidelity
+
+    ref = state.get("reference")          # the user's mesh; else the B-spline is the target
+    tV, tF = ref if ref is not None else (mesh.V, mesh.F)
+    metrics["fidelity"] = {**net_fidelity(out_net.joints, out_net.loops, tV, tF),
+                           "target": "the reference mesh" if ref is not None
+                           else "the B-spline surface"}
     gates = design_gates(KIND[o.mode], metrics)
     metrics["quality"] = {"ok": passed(gates), "summary": gate_summary(gates),
                           "gates": [{**g.as_dict(), "line": g.line()} for g in gates]}

@@ -130,7 +130,8 @@ def _phlw_info(res: Any, init: Any, geo: Any) -> dict[str, Any]:
             "phlw_energy": [e0, e1],
             "phlw_figures": {k: f["value"] for k, f in (res.figures or {}).items()},
             "phlw_aligned_deg": float(init.rotated_deg),
-            "units": geo.units, "input": geo.info()}
+            "units": geo.units, "input": geo.info(),
+            "reference": (geo.V, geo.F)}   # taken out by the pipeline (fidelity), not stored
 
 
 def _phlw_units(path: Path) -> Any:

@@ -100,13 +100,16 @@ def _previous(out: Path) -> dict[str, Any]:
 def build(model: str | os.PathLike, out: str | os.PathLike, *, kind: str = "auto",
           material: str | None = None, lamellae: int | None = None, scale: Any = None,
           width: float | None = None, sheet: str | None = None, units: Any = None,
-          obj: str | None = None, frames: int = 12, progress: Progress = None) -> BuildResult:
+          obj: str | None = None, frames: int = 12, max_deviation: float | None = None,
+          progress: Progress = None) -> BuildResult:
     """Build the pack of ``model`` (a mesh or .3dm path; ``units`` when the file does not say,
     ``obj`` the .3dm object) in ``out``.
 
     ``kind``: "auto" (the analysis recommends) or gg / phlw / cnc / aa; ``material``: a
     preset (default pp); ``lamellae``: per family; ``scale`` (e.g. "1:10"), ``width`` (mm as
-    cut), ``sheet`` ("600x400" mm); ``frames``: states of the alignment sequence."""
+    cut), ``sheet`` ("600x400" mm); ``frames``: states of the alignment sequence;
+    ``max_deviation``: refuse a net farther from the target than this on average (% of the
+    diagonal, :func:`gridshell.measure.fidelity.require_fidelity`)."""
     from gridshell.core.atomic import check_output
     from gridshell.workflow.study import file_sha256
 
@@ -147,9 +150,9 @@ def build(model: str | os.PathLike, out: str | os.PathLike, *, kind: str = "auto
         a = stage("analyze", build_key(k_in, "analyze"),
                   lambda: _analyze(model, opts, kind), ())
         res.kind, res.why = a["kind"], a["why"]
-        k_design = build_key(k_in, "design", res.kind, lamellae, frames)
+        k_design = build_key(k_in, "design", res.kind, lamellae, frames, max_deviation)
         stage("design", k_design, lambda: _design(model, out, opts, res.kind, lamellae, frames,
-                                                  a), ("design.json",))
+                                                  max_deviation), ("design.json",))
         stage("verify", build_key(k_design, "verify"), lambda: _verify(out), ())
         k_sec = build_key(k_design, "check", material, str(scale), width)
         sec = stage("check", k_sec, lambda: _check(out, material, scale, width),
@@ -213,7 +216,11 @@ _ANALYSES: dict[str, Any] = {}
 
 
 def _design(model: Path, out: Path, opts: dict, kind: str, lamellae: int | None, frames: int,
-            analysis: dict[str, Any]) -> dict[str, Any]:
+            max_deviation: float | None) -> dict[str, Any]:
+    """The design of the chosen kind, gated on its fidelity to the target, written as the
+    pack's bundle with the analysis beside it."""
+    from gridshell.measure.fidelity import require_fidelity
+
     from gridshell.core import manifest
     from gridshell.workflow.cut import write_design
 
@@ -227,6 +234,7 @@ def _design(model: Path, out: Path, opts: dict, kind: str, lamellae: int | None,
 
         design = design_ncp(str(model), mode=kind, curves=lamellae, frames=frames,
                             units=opts["units"], obj=opts["object"])
+    require_fidelity(design.bundle.metrics, max_deviation)
     write_design(out, design, render=False, frames=frames, owner="build")
     a = _ANALYSES.pop(str(model), None)
     if a is not None:
@@ -237,7 +245,7 @@ def _design(model: Path, out: Path, opts: dict, kind: str, lamellae: int | None,
     b = design.bundle
     counts = b.metrics.get("n_lamellae") or {}
     return {"kind": b.kind, "n_lamellae": counts, "n_joints": int(len(b.net.joints)),
-            "lamellae_asked": lamellae}
+            "lamellae_asked": lamellae, "fidelity": b.metrics.get("fidelity")}
 
 
 def _verify(out: Path) -> dict[str, Any]:
