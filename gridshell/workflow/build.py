@@ -127,6 +127,7 @@ def build(model: str | os.PathLike, out: str | os.PathLike, *, kind: str = "auto
     opts = {"units": None if units is None else str(units), "object": obj}
     k_in = build_key("input", file_sha256(model), opts, _version())
     res = BuildResult(out, kind, "", {})
+    held: dict[str, Any] = {}           # what one stage hands the next within this run
 
     def reusable(name: str, key: str, files: tuple[str, ...]) -> bool:
         old = before.get(name)
@@ -148,11 +149,11 @@ def build(model: str | os.PathLike, out: str | os.PathLike, *, kind: str = "auto
 
     try:
         a = stage("analyze", build_key(k_in, "analyze"),
-                  lambda: _analyze(model, opts, kind), ())
+                  lambda: _analyze(model, opts, kind, held), ())
         res.kind, res.why = a["kind"], a["why"]
         k_design = build_key(k_in, "design", res.kind, lamellae, frames, max_deviation)
         stage("design", k_design, lambda: _design(model, out, opts, res.kind, lamellae, frames,
-                                                  max_deviation), ("design.json",))
+                                                  max_deviation, held), ("design.json",))
         stage("verify", build_key(k_design, "verify"), lambda: _verify(out), ())
         k_sec = build_key(k_design, "check", material, str(scale), width)
         sec = stage("check", k_sec, lambda: _check(out, material, scale, width),
@@ -192,7 +193,7 @@ def _record(out: Path, res: BuildResult, seconds: float) -> None:
 # ----------------------------------------------------------------------------- the stages
 
 
-def _analyze(model: Path, opts: dict, kind: str) -> dict[str, Any]:
+def _analyze(model: Path, opts: dict, kind: str, held: dict[str, Any]) -> dict[str, Any]:
     """The analysis (kept in memory until the design has made the pack) and the choice."""
     from gridshell.analysis.analyze import analyze_target
 
@@ -206,19 +207,16 @@ def _analyze(model: Path, opts: dict, kind: str) -> dict[str, Any]:
         chosen = kind
         why = f"--kind {kind} (the analysis would choose {rec.pipeline}"\
               f"{'' if rec.mode is None else ' ' + rec.mode}: {rec.why})"
-    _ANALYSES[str(model)] = a
+    held["analysis"] = a                # written into the pack once the design has made it
     return {"kind": chosen, "why": why, "recommended": rec.as_dict(),
             "coverage_percent": a.coverage}
 
 
-#: analyses of this process by model path, written into the pack once it exists
-_ANALYSES: dict[str, Any] = {}
-
-
 def _design(model: Path, out: Path, opts: dict, kind: str, lamellae: int | None, frames: int,
-            max_deviation: float | None) -> dict[str, Any]:
+            max_deviation: float | None, held: dict[str, Any]) -> dict[str, Any]:
     """The design of the chosen kind, gated on its fidelity to the target, written as the
-    pack's bundle with the analysis beside it."""
+    pack's bundle with the analysis beside it (this run's, ``held["analysis"]``, or made again
+    when the analysis stage was reused: the new bundle replaces the pack's directory)."""
     from gridshell.measure.fidelity import require_fidelity
 
     from gridshell.core import manifest
@@ -236,12 +234,12 @@ def _design(model: Path, out: Path, opts: dict, kind: str, lamellae: int | None,
                             units=opts["units"], obj=opts["object"])
     require_fidelity(design.bundle.metrics, max_deviation)
     write_design(out, design, render=False, frames=frames, owner="build")
-    a = _ANALYSES.pop(str(model), None)
-    if a is not None:
-        from gridshell.analysis.analyze import write_analysis
+    from gridshell.analysis.analyze import analyze_target, write_analysis
 
-        write_analysis(a, out / "analysis")
-        manifest.register(out / "analysis", output=True)
+    a = held.get("analysis") or analyze_target(str(model), units=opts["units"],
+                                               obj=opts["object"], trial=False)
+    write_analysis(a, out / "analysis")
+    manifest.register(out / "analysis", output=True)
     b = design.bundle
     counts = b.metrics.get("n_lamellae") or {}
     return {"kind": b.kind, "n_lamellae": counts, "n_joints": int(len(b.net.joints)),

@@ -140,3 +140,12 @@ def test_the_report_states_every_verdict_and_the_bill_of_materials(pack, tmp_pat
     html = report_html(bad)
     i_fail, i_pass = html.find("verdict fail"), html.find("verdict pass")
     assert 0 < i_fail < i_pass and "overstressed, max utilisation 11.47 (frame_005)" in html
+
+
+def test_a_new_design_with_the_analysis_reused_keeps_the_analysis_in_the_pack(tmp_path):
+    out = tmp_path / "p"
+    build(DOME, out, lamellae=6, frames=0)
+    again = build(DOME, out, lamellae=8, frames=0)         # the design changes, not the model
+    assert "analyze" in again.reused and "design" not in again.reused
+    assert (out / "analysis" / "analysis.json").is_file()
+    assert verify_bundle(out)["ok"]
