@@ -15,6 +15,7 @@ directions) and counter-clockwise in ``(phi, s)`` overall, like the mesh's faces
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
@@ -25,7 +26,7 @@ from gridshell.geometry.net import Lamella, Net, polyline_arclength
 from gridshell.gg.clairaut import IntrinsicNet
 from gridshell.gg.revolution import Revolution
 
-__all__ = ["SurfaceMap", "map_net", "map_to_revolution", "net_loops", "orient_loops",
+__all__ = ["NetParameters", "SurfaceMap", "map_net", "net_parameters", "map_to_revolution", "net_loops", "orient_loops",
            "segment_intersections"]
 
 
@@ -62,6 +63,17 @@ class SurfaceMap:
         s = np.clip(np.asarray(s, float).ravel(), *self.s_range)
         phi = np.clip(np.asarray(phi, float).ravel(), *self.phi_range)
         return np.stack([sp(s, phi, grid=False) for sp in self._splines], axis=1)
+
+    def normals(self, s: np.ndarray, phi: np.ndarray) -> np.ndarray:
+        """Unit normals ``(k, 3)`` of the smooth surface, ``P_s x P_phi`` at paired
+        parameters (zero rows where the map is singular)."""
+        s = np.clip(np.asarray(s, float).ravel(), *self.s_range)
+        phi = np.clip(np.asarray(phi, float).ravel(), *self.phi_range)
+        Ps = np.stack([sp(s, phi, dx=1, grid=False) for sp in self._splines], axis=1)
+        Pp = np.stack([sp(s, phi, dy=1, grid=False) for sp in self._splines], axis=1)
+        n = np.cross(Ps, Pp)
+        ln = np.linalg.norm(n, axis=1)
+        return n / np.where(ln > 0, ln, 1.0)[:, None]
 
 
 # ----------------------------------------------------------------------------- intersections
@@ -320,11 +332,11 @@ def orient_loops(loops: np.ndarray, sphi: np.ndarray) -> np.ndarray:
     return loops
 
 
-def _axis_with_joints(inet: IntrinsicNet, family: int, ci: int, pos: np.ndarray,
-                      to3d: Callable[[np.ndarray, np.ndarray], np.ndarray],
-                      min_gap: float) -> tuple[np.ndarray, np.ndarray]:
-    """Dense 3D axis of curve ``ci`` of ``family`` with its joints (at base arc lengths
-    ``pos``) inserted as vertices, all on the smooth curve; the joints' arc lengths on it."""
+def _axis_parameters(inet: IntrinsicNet, family: int, ci: int, pos: np.ndarray,
+                     min_gap: float) -> tuple[np.ndarray, np.ndarray]:
+    """``(s, phi)`` samples ``(k, 2)`` of curve ``ci`` of ``family`` in order of the base arc
+    length, with its joints (at base arc lengths ``pos``) inserted, and which of them are
+    the joints ``(k,)`` bool."""
     sig = (inet.sigma1 if family == 1 else inet.sigma3)[ci]
     offset = (inet.offsets1 if family == 1 else inet.offsets3)[ci]
     # samples (not the ends) closer than min_gap to a joint are dropped: no sliver segments
@@ -340,11 +352,69 @@ def _axis_with_joints(inet: IntrinsicNet, family: int, ci: int, pos: np.ndarray,
     t_all = np.concatenate([sig[keep], pos])
     is_joint = np.concatenate([np.zeros(int(keep.sum()), bool), np.ones(len(pos), bool)])
     order = np.argsort(t_all, kind="stable")
-    t_all, is_joint = t_all[order], is_joint[order]
-    sp = inet.points(family, offset, t_all)
-    X = to3d(sp[:, 0], sp[:, 1])
-    arc = polyline_arclength(X)
-    return X, arc[is_joint]
+    return inet.points(family, offset, t_all[order]), is_joint[order]
+
+
+@dataclass
+class NetParameters:
+    """A geodesic net in the parameters ``(s, phi)``, before any map to 3D.
+
+    sphi : (n, 2) joints;  loops : (m, 4) net-loops;  lamellae : per lamella ``(family,
+    joints (j,) int, samples (k, 2) (s, phi) in order along it with the joints among them,
+    is_joint (k,) bool)``;  extra : as :func:`map_net`'s.
+    """
+
+    sphi: np.ndarray
+    loops: np.ndarray
+    lamellae: list[tuple[int, np.ndarray, np.ndarray, np.ndarray]]
+    extra: dict[str, np.ndarray]
+
+    def net(self, to3d: Callable[[np.ndarray, np.ndarray], np.ndarray]) -> Net:
+        """The :class:`Net` under the map ``to3d(s, phi) -> (k, 3)`` (metres): joints, loops,
+        lamellae with their dense axes and ``joint_s`` measured along them."""
+        lamellae = []
+        for i, (fam, idx, sp, is_joint) in enumerate(self.lamellae):
+            X = to3d(sp[:, 0], sp[:, 1])
+            lamellae.append(Lamella(id=i, family=fam, joints=idx.copy(),
+                                    joint_s=polyline_arclength(X)[is_joint], axis=X))
+        return Net(joints=to3d(self.sphi[:, 0], self.sphi[:, 1]), loops=self.loops.copy(),
+                   lamellae=lamellae)
+
+    def samples(self) -> np.ndarray:
+        """All lamellae's ``(s, phi)`` samples stacked ``(M, 2)``, lamella after lamella."""
+        return np.concatenate([sp for _, _, sp, _ in self.lamellae]) if self.lamellae \
+            else np.zeros((0, 2))
+
+
+def net_parameters(inet: IntrinsicNet, min_joints: int = 2) -> NetParameters:
+    """Joints, loops and lamellae of an intrinsic net in ``(s, phi)``: the part of
+    :func:`map_net` that does not depend on the map."""
+    J = _joints(inet)
+    if len(J["k1"]) == 0:
+        raise NoNetError("the two families of curves do not intersect on the surface; choose "
+                         "a different crossing angle or more lamellae")
+    sphi = J["sphi"]
+    loops, along = net_loops(J["k1"], J["p1"], J["k3"], J["p3"], sphi)
+    lamellae, lam_curve = [], []
+    for fam, curves, key, pos in ((1, inet.curves1, "c1", J["p1"]), (3, inet.curves3, "c3", J["p3"])):
+        for ci, curve in enumerate(curves):
+            idx = along[key][ci] if ci < len(along[key]) else np.zeros(0, np.int64)
+            if len(idx) < min_joints:
+                continue
+            sp, is_joint = _axis_parameters(inet, fam, ci, pos[idx],
+                                            min_gap=0.1 * inet.info.get("step", 0.0))
+            lamellae.append((fam, idx, sp, is_joint))
+            lam_curve.append((fam, ci))
+    # joints on no lamella (crossings of two stubs) are left out, indices renumbered
+    used = np.zeros(len(sphi), bool)
+    for _, idx, _, _ in lamellae:
+        used[idx] = True
+    used[loops.ravel()] = True
+    new = np.cumsum(used) - 1
+    lamellae = [(fam, new[idx], sp, isj) for fam, idx, sp, isj in lamellae]
+    extra = {"sphi": sphi[used], "curve1": J["k1"][used], "curve3": J["k3"][used],
+             "lamella_curve": np.asarray(lam_curve, np.int64).reshape(-1, 2)}
+    return NetParameters(sphi=sphi[used], loops=new[loops], lamellae=lamellae, extra=extra)
 
 
 def map_net(inet: IntrinsicNet, to3d: Callable[[np.ndarray, np.ndarray], np.ndarray],
@@ -369,37 +439,8 @@ def map_net(inet: IntrinsicNet, to3d: Callable[[np.ndarray, np.ndarray], np.ndar
         ``sphi (n, 2)`` joint parameters; ``curve1``, ``curve3 (n,)`` curve index of each joint;
         ``lamella_curve`` (family, curve index) of each lamella.
     """
-    J = _joints(inet)
-    if len(J["k1"]) == 0:
-        raise NoNetError("the two families of curves do not intersect on the surface; choose "
-                         "a different crossing angle or more lamellae")
-    sphi = J["sphi"]
-    loops, along = net_loops(J["k1"], J["p1"], J["k3"], J["p3"], sphi)
-    joints3d = to3d(sphi[:, 0], sphi[:, 1])
-    lamellae, lam_curve = [], []
-    next_id = 0
-    for fam, curves, key, pos in ((1, inet.curves1, "c1", J["p1"]), (3, inet.curves3, "c3", J["p3"])):
-        for ci, curve in enumerate(curves):
-            idx = along[key][ci] if ci < len(along[key]) else np.zeros(0, np.int64)
-            if len(idx) < min_joints:
-                continue
-            axis, js = _axis_with_joints(inet, fam, ci, pos[idx], to3d,
-                                         min_gap=0.1 * inet.info.get("step", 0.0))
-            lamellae.append(Lamella(id=next_id, family=fam, joints=idx, joint_s=js, axis=axis))
-            lam_curve.append((fam, ci))
-            next_id += 1
-    # joints on no lamella (crossings of two stubs) are left out, indices renumbered
-    used = np.zeros(len(sphi), bool)
-    for lam in lamellae:
-        used[lam.joints] = True
-    used[loops.ravel()] = True
-    new = np.cumsum(used) - 1
-    for lam in lamellae:
-        lam.joints = new[lam.joints]
-    net = Net(joints=joints3d[used], loops=new[loops], lamellae=lamellae)
-    extra = {"sphi": sphi[used], "curve1": J["k1"][used], "curve3": J["k3"][used],
-             "lamella_curve": np.asarray(lam_curve, np.int64).reshape(-1, 2)}
-    return net, extra
+    par = net_parameters(inet, min_joints)
+    return par.net(to3d), par.extra
 
 
 def map_back(inet: IntrinsicNet, P: np.ndarray, rev: Revolution) -> tuple[Net, dict]:

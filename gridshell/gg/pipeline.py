@@ -35,7 +35,8 @@ from gridshell.geometry.net import Net
 from gridshell.measure.fairness import net_fairness
 from gridshell.measure.quality import Gate, design_gates, gate_lines, gate_summary, passed
 from gridshell.gg.clairaut import geodesic_net
-from gridshell.gg.mapback import map_back, map_to_revolution
+from gridshell.gg.mapback import map_back, map_to_revolution, net_parameters
+from gridshell.gg.path import exact_path_possible, gg_path, path_info
 from gridshell.gg.revolution import rebuild_revolution
 from gridshell.gg.alignment import GGSequence, gg_alignment_sequence
 
@@ -585,17 +586,28 @@ def _gate_stage(s: dict[str, Any]) -> dict[str, Any]:
     return {"quality": quality}
 
 
-@stage("sequence", needs=("net", "aligned", "metrics", "frames", "progress"),
+@stage("sequence", needs=("net", "aligned", "metrics", "frames", "progress", "inet", "rev", "P"),
        gives=("sequence", "metrics"))
 def _sequence_stage(s: dict[str, Any]) -> dict[str, Any]:
     """The alignment sequence from the deployed to the collapsed net (``frames`` steps; none
-    with 0) and its length figures ``delta_l``, ``sequence_length_error`` (%)."""
+    with 0): the physical path through surfaces of revolution
+    (:func:`gridshell.gg.path.gg_path`), or where it does not apply (a Clairaut turning point)
+    the optimized sequence (:func:`gg_alignment_sequence`); its length figures ``delta_l``,
+    ``sequence_length_error`` (%) and ``sequence_path`` (how it was made)."""
     net, aligned, frames, metrics = s["net"], s["aligned"], int(s["frames"]), s["metrics"]
     seq = None
     if frames > 0:
         _say(s["progress"], f"alignment sequence: {frames} steps from deployed to collapsed")
-        seq = gg_alignment_sequence(net.joints, aligned, net.edges(), frames=frames,
-                                    progress=s["progress"])
+        seq = gg_path(s["inet"], s["rev"], net, aligned, s["P"], frames=frames)
+        if seq is None:
+            why = exact_path_possible(net_parameters(s["inet"]), s["rev"], s["inet"].c) or \
+                "the traced net does not match its parameters"
+            seq = gg_alignment_sequence(net.joints, aligned, net.edges(), frames=frames,
+                                        progress=s["progress"])
+            metrics["sequence_path"] = {"physical": False, "why": why,
+                                        "method": "optimized joint sequence (approximate)"}
+        else:
+            metrics["sequence_path"] = {"physical": True, **path_info(seq)}
         metrics["delta_l"] = _pct(summary(delta_l(net.joints, aligned, seq.edges)))
         metrics["sequence_length_error"] = 100.0 * max(
             float(np.nanmax(delta_l(net.joints, V, seq.edges))) for V in seq.V)
@@ -734,6 +746,8 @@ def gg_files(bundle: DesignBundle, report: dict | None = None, *, render: bool =
         for k, V in enumerate(sequence.V):
             extra[f"sequence/frame_{k:0{width}d}.obj"] = (
                 lambda p, V=V: write_mesh(p, V, net.loops))
+        if getattr(sequence, "strips", None) is not None:
+            extra["sequence/strips.npz"] = sequence.strips.save
     if render:
         from gridshell.render.net_preview import net_preview
 

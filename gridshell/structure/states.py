@@ -1,5 +1,12 @@
 """Stresses in the states of the alignment sequence and in the collapsed state (transport).
 
+A bundle with the dense strips of a **physical path** (``sequence/strips.npz``, written by the
+GG pipeline: :mod:`gridshell.gg.path`, the net through surfaces of revolution on which every
+lamella stays a geodesic with its arc lengths) is measured on them: the Darboux curvatures of
+every lamella's dense axis with the state's own strip normals, every state judged but those
+the path marks approximate (:func:`strip_state_record`). Otherwise (NCP kinds; GG nets with a
+Clairaut turning point, older bundles):
+
 A state is known by its joints only (``sequence/frame_*.obj``, ``aligned.obj``): each lamella
 is the cubic spline (not-a-knot) through its joints at the design's arc lengths (the alignment
 keeps them), and the strip's section normal at a joint is the normal of the joint mesh there
@@ -182,6 +189,103 @@ def state_record(bundle: DesignBundle, V: np.ndarray, normals: np.ndarray, secti
             "lamellae_max_utilisation": per}
 
 
+#: the dense strips of a physical alignment path (written by the GG pipeline)
+STRIPS = "sequence/strips.npz"
+
+
+def read_strips(path: Path | None, n_joints: int, n_lamellae: int) -> dict[str, Any] | None:
+    """The dense strips of every state (``sequence/strips.npz``: ``X``, ``N (F, M, 3)``,
+    ``lamella``, ``joint (M,)``, ``t``, ``approximate``, ``bound (F,)``, ``method``), or None
+    when absent, unreadable or not of this net (``n_joints`` joints, lamella ids below
+    ``n_lamellae``)."""
+    if path is None or not (path / STRIPS).is_file():
+        return None
+    try:
+        with np.load(path / STRIPS, allow_pickle=False) as z:
+            d = {k: z[k] for k in ("X", "N", "lamella", "joint", "t", "approximate", "bound",
+                                   "method")}
+    except (OSError, ValueError, KeyError):
+        return None
+    X, N = d["X"], d["N"]
+    F = len(d["t"])
+    if X.ndim != 3 or X.shape != N.shape or X.shape[0] != F or X.shape[2] != 3 or \
+            d["lamella"].shape != (X.shape[1],) or d["joint"].shape != (X.shape[1],) or \
+            not np.all(np.isfinite(X)) or not np.all(np.isfinite(N)) or F < 2 or \
+            d["joint"].max(initial=-1) >= n_joints or d["lamella"].max(initial=0) >= n_lamellae:
+        return None
+    d["method"] = str(d["method"])
+    return d
+
+
+def strip_state_record(strips: dict[str, Any], f: int, orientation: str, section: Section,
+                       material: Material) -> dict[str, Any]:
+    """Utilisation of every lamella in state ``f`` of the dense strips of a physical path
+    (:func:`read_strips`): the Darboux curvatures of each lamella's dense axis with the
+    state's strip normals (:func:`gridshell.structure.frames.darboux_curvatures`), measured,
+    not assumed; the worst point's nearest joint."""
+    from gridshell.structure.frames import darboux_curvatures
+
+    X, N, lam_of, joint = strips["X"][f], strips["N"][f], strips["lamella"], strips["joint"]
+    ids = np.unique(lam_of)
+    per: dict[int, float] = {}
+    best = (0.0, -1, -1)
+    kw = ks = kt = 0.0
+    for lid in ids:
+        m = np.flatnonzero(lam_of == lid)
+        dc = darboux_curvatures(X[m], N[m])
+        k = strip_curvatures(dc, orientation, section, 0.0)
+        u = strip_stresses(k, section, material).utilisation
+        if not len(u) or not np.all(np.isfinite(u)):
+            continue
+        i = int(np.argmax(u))
+        per[int(lid)] = float(u[i])
+        if u[i] > best[0]:
+            at = np.flatnonzero(joint[m] >= 0)
+            j = int(joint[m][at[np.argmin(np.abs(at - i))]]) if len(at) else -1
+            best = (float(u[i]), int(lid), j)
+        kw = max(kw, float(np.abs(k.weak).max()))
+        ks = max(ks, float(np.abs(k.strong).max()))
+        kt = max(kt, float(np.abs(k.twist).max()))
+    return {"max_utilisation": best[0], "worst_lamella": best[1], "worst_joint": best[2],
+            "max_turn_deg": 0.0, "resolved": True,
+            "max_weak_curvature_per_m": kw, "max_strong_curvature_per_m": ks,
+            "max_twist_rad_per_m": kt, "max_geodesic_residual_per_m": 0.0,
+            "length_error": float(strips["bound"][f]),
+            "lamellae_max_utilisation": [per.get(i) for i in range(int(ids.max()) + 1)]}
+
+
+def _path_states(bundle: DesignBundle, strips: dict[str, Any], section: Section,
+                 material: Material) -> dict[str, Any]:
+    """:func:`bundle_states` from the dense strips of a physical path: every state judged
+    but those the path marks approximate (their length error is their bound)."""
+    orientation = KIND_ORIENTATION[bundle.kind]
+    F = len(strips["t"])
+    out = []
+    for f in range(F):
+        rec = strip_state_record(strips, f, orientation, section, material)
+        out.append({"name": f"frame_{f:03d}", "t": float(strips["t"][f]),
+                    "approximate": bool(strips["approximate"][f]), **rec})
+    collapsed = out[-1]
+    judged = [f["max_utilisation"] for f in out if is_judged(f)]
+    return {"method": strips["method"], "fold_deg": FOLD_DEG, "frames": out,
+            "physical_path": True,
+            "approximate_path": PATH_APPROXIMATE,
+            "approximate": [f["name"] for f in out if f["approximate"]],
+            "unresolved": [],
+            "collapsed": {"name": collapsed["name"],
+                          "max_utilisation": collapsed["max_utilisation"],
+                          "worst_lamella": collapsed["worst_lamella"],
+                          "worst_joint": collapsed["worst_joint"]},
+            "sequence_max_utilisation": max(judged, default=0.0)}
+
+
+#: the approximate states of a physical path: where the design surface is only isometric to
+#: the surface of revolution, the blend between them
+PATH_APPROXIMATE = ("approximate states: the blend from the design surface to the surface of "
+                    "revolution it is isometric to (bounded by their length_error); reported, "
+                    "not judged")
+
+
 def bundle_states(bundle: DesignBundle, path: Path | None, section: Section,
                   material: Material) -> dict[str, Any]:
     """``structure.json["states"]``: the record of :func:`state_record` for every frame of the
@@ -189,8 +293,13 @@ def bundle_states(bundle: DesignBundle, path: Path | None, section: Section,
     for the deployed and the collapsed joints; ``frames`` in order, each with ``name`` and
     ``t`` (0 deployed, 1 collapsed) and ``approximate`` (the intermediate states:
     :data:`APPROXIMATE`, not judged); ``collapsed``; ``unresolved``: the names of the folded
-    states (not judged); ``sequence_max_utilisation`` over the resolved ones."""
+    states (not judged); ``sequence_max_utilisation`` over the resolved ones. A bundle with
+    the dense strips of a physical path (:data:`STRIPS`) is measured on them instead
+    (:func:`strip_state_record`; ``physical_path`` True)."""
     n = len(bundle.net.joints)
+    strips = read_strips(path, n, len(bundle.net.lamellae))
+    if strips is not None:
+        return _path_states(bundle, strips, section, material)
     METHOD = METHODS[KIND_ORIENTATION[bundle.kind]]     # noqa: N806 (this kind's method)
     loops = bundle.net.loops
     frames = _frames(path, n)
