@@ -20,9 +20,13 @@ beta_m)``, arc length kept), weak-axis bending only, into the straight bundle; a
 ``tau``-way (rotation by ``tau`` times its angle), carries it onto the collapsed net.
 
 Exact where the net has no turning point (``c < r`` on every lamella: ``s`` monotone along
-it); where the design surface is only isometric to the surface of revolution the first states
-blend the design net into the net on that surface (marked approximate, bounded by the change
-of the lamellae's joint-to-joint arc lengths, :func:`segment_length_error`).
+it) and the design surface is of revolution. Where it is only isometric to its surface of
+revolution (the isometry maps the one onto the other, not the states), every closing state
+carries the design's difference from the surface of revolution, scaled by ``lambda``: each
+lamella keeps the design's arc lengths exactly and turns, segment to segment, by the
+revolution state's turns plus ``lambda`` times the design's difference (its bending and twist
+between the two), placed by its joints (:func:`_carried_state`); the joints' disagreement is
+the state's bound, and a state beyond :data:`CARRIED_APPROXIMATE` of a segment is approximate.
 """
 from __future__ import annotations
 
@@ -51,14 +55,19 @@ METHOD_PATH = ("physical path (GG): each state the net on a surface of revolutio
 #: samples of the profile integrals (Z_lambda, the unbending)
 PROFILE_SAMPLES = 4097
 
+#: a state whose joints disagree by more than this share of the mean joint-to-joint segment
+#: (a carried state, :func:`_carried_state`) is approximate (reported, not judged)
+CARRIED_APPROXIMATE = 0.01
+
 #: samples of a lamella per joint-to-joint segment in the stored strips (the traced curves
 #: are denser; measured on the vase at 1:10: the states' utilisation within 0.5 % of the
 #: full resolution's)
 SAMPLES_PER_SEGMENT = 8
 
 #: a design net further than this share of the diagonal from the net on its surface of
-#: revolution (after the best rigid motion) is blended into it over the first states
-BLEND_TOL = 1e-3
+#: revolution (after the best rigid motion) is not itself of revolution: its states carry the
+#: difference (:func:`_carried_state`)
+CARRY_TOL = 1e-3
 
 
 @dataclass
@@ -70,8 +79,8 @@ class StripStates:
     lamella consecutive, in order along it);  joint : (M,) joint index of a sample on a joint,
     else -1;  t : (F,) path parameter (0 deployed, 1 collapsed);  approximate : (F,) states not
     on the exact path;  bound : (F,) largest relative change of a joint-to-joint arc length
-    from the deployed state (dimensionless);  phase : (F,) ``"deployed"``, ``"blend"``,
-    ``"close"``, ``"unbend"``;  method : how they were made.
+    from the deployed state (dimensionless);  phase : (F,) ``"deployed"``, ``"close"``,
+    ``"unbend"``;  method : how they were made.
     """
 
     X: np.ndarray
@@ -251,6 +260,83 @@ def exact_path_possible(par: NetParameters, rev: Revolution, c: float) -> str:
     return ""
 
 
+def _segment_frames(X: np.ndarray, N: np.ndarray) -> np.ndarray:
+    """Frames ``(k-1, 3, 3)`` of the segments of a strip ``X (k,3)`` with normals ``N (k,3)``:
+    columns tangent ``T``, ``U = N x T``, ``N`` (the mean normal of the segment's ends made
+    orthogonal to ``T``)."""
+    T = _unit(np.diff(X, axis=0))
+    n = 0.5 * (N[1:] + N[:-1])
+    n = _unit(n - np.einsum("ij,ij->i", n, T)[:, None] * T)
+    return np.stack([T, np.cross(n, T), n], axis=2)
+
+
+def _turns(X: np.ndarray, N: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Segment frames ``(k-1, 3, 3)`` of a strip and the rotation vectors ``(k-2, 3)`` that
+    turn each into the next, in the segment's own frame (its discrete Darboux rotations:
+    bending about both axes and twist, times the segment length)."""
+    F = _segment_frames(X, N)
+    loc = np.einsum("kji,kjl->kil", F[:-1], F[1:])          # F_i^T F_i+1
+    return F, Rotation.from_matrix(loc).as_rotvec() if len(loc) else np.zeros((0, 3))
+
+
+def _strip(ell: np.ndarray, F0: np.ndarray, rv: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The strip ``(X (k,3), N (k,3))`` with segment lengths ``ell (k-1,)``, first segment
+    frame ``F0`` and the turns ``rv (k-2, 3)`` (:func:`_turns`), from the origin."""
+    L = Rotation.from_rotvec(rv).as_matrix() if len(rv) else np.zeros((0, 3, 3))
+    F = np.empty((len(ell), 3, 3))
+    F[0] = F0
+    for i in range(len(L)):
+        F[i + 1] = F[i] @ L[i]
+    X = np.concatenate([np.zeros((1, 3)), np.cumsum(ell[:, None] * F[:, :, 0], axis=0)])
+    n = F[:, :, 2]
+    N = _unit(np.concatenate([n[:1], 0.5 * (n[1:] + n[:-1]), n[-1:]]))
+    return X, N
+
+
+def _carried_state(dep, rev1, revl, lam, lamella, joint):
+    """State ``lambda`` of a design surface only isometric to its surface of revolution: the
+    revolution's state ``revl`` with the design's difference from the revolution's deployed
+    state ``rev1`` carried along, scaled by ``lambda`` (all the difference deployed, none
+    closed). Every lamella keeps the design's arc lengths exactly and turns, segment to
+    segment, by ``omega_lambda + lambda (omega_design - omega_1)``; it is placed by the best
+    rigid fit of its joints to ``J_lambda + lambda (J_design - J_1)``, a joint the mean of its
+    lamellae's. ``dep``, ``rev1``, ``revl``: ``(X (M,3), N (M,3), J (n,3))``. Returns the
+    state and the joints' disagreement, the largest distance between a joint's two
+    placements (metres)."""
+    (Xd, Nd, Jd), (X1, N1, J1), (Xl, Nl, Jl) = dep, rev1, revl
+    target = Jl + lam * (Jd - J1)
+    X, N = np.empty_like(Xd), np.empty_like(Nd)
+    acc, cnt = np.zeros_like(Jd), np.zeros(len(Jd))
+    seen: dict[int, np.ndarray] = {}
+    worst = 0.0
+    for lid in np.unique(lamella):
+        m = np.flatnonzero(lamella == lid)
+        on = joint[m] >= 0
+        j = joint[m][on]
+        if len(m) < 3:
+            x, n = Xl[m] + lam * (Xd[m] - X1[m]), Nl[m]
+        else:
+            _, rd = _turns(Xd[m], Nd[m])
+            _, r1 = _turns(X1[m], N1[m])
+            Fl, rl = _turns(Xl[m], Nl[m])
+            x, n = _strip(np.linalg.norm(np.diff(Xd[m], axis=0), axis=1), Fl[0],
+                          rl + lam * (rd - r1))
+            if len(j) >= 2:
+                R, b = _kabsch(x[on], target[j])
+            else:
+                R, b = np.eye(3), (Xl[m] + lam * (Xd[m] - X1[m])).mean(0) - x.mean(0)
+            x, n = x @ R.T + b, n @ R.T
+        X[m], N[m] = x, n
+        for q, p in zip(j.tolist(), x[on]):
+            if q in seen:
+                worst = max(worst, float(np.linalg.norm(seen[q] - p)))
+            seen[q] = p
+        np.add.at(acc, j, x[on])
+        np.add.at(cnt, j, 1.0)
+    J = np.where(cnt[:, None] > 0, acc / np.maximum(cnt, 1.0)[:, None], target)
+    return X, N, J, worst
+
+
 def _sample_joints(par: NetParameters) -> tuple[np.ndarray, np.ndarray]:
     """Lamella index and joint index (-1: none) of every sample of ``par.samples()``."""
     lamella = np.concatenate([np.full(len(x), i) for i, (_, _, x, _) in enumerate(par.lamellae)])
@@ -262,14 +348,12 @@ def _sample_joints(par: NetParameters) -> tuple[np.ndarray, np.ndarray]:
     return lamella, joint
 
 
-def _schedule(frames: int, blend: bool) -> list[tuple[str, float]]:
-    """``(phase, parameter)`` of states 1..frames: the blend's weight, the closing's
-    ``lambda``, the unbending's ``tau`` (a third of the states unbend)."""
-    k0 = 2 if blend and frames >= 6 else 0
+def _schedule(frames: int) -> list[tuple[str, float]]:
+    """``(phase, parameter)`` of states 1..frames: the closing's ``lambda``, the
+    unbending's ``tau`` (a third of the states unbend)."""
     kB = max(1, int(round(frames / 3)))
-    kA = max(frames - k0 - kB, 1)
-    return ([("blend", k / k0) for k in range(1, k0 + 1)]
-            + [("close", 1.0 - k / kA) for k in range(1, kA + 1)]
+    kA = max(frames - kB, 1)
+    return ([("close", 1.0 - k / kA) for k in range(1, kA + 1)]
             + [("unbend", k / kB) for k in range(1, kB + 1)])
 
 
@@ -320,7 +404,7 @@ def gg_path(inet: IntrinsicNet, rev: Revolution, net: Net, aligned: np.ndarray,
     else:
         X_dep, N_dep = X1, N1
     off = np.linalg.norm(X_dep[joint >= 0] - joints[joint[joint >= 0]], axis=1)
-    if np.max(off, initial=0.0) > (1e-6 if P is not None else BLEND_TOL) * diag:
+    if np.max(off, initial=0.0) > (1e-6 if P is not None else CARRY_TOL) * diag:
         return None                                     # the net was not mapped through P
     R, b = _kabsch(J1, joints)                          # revolution frame -> design frame
     gap = float(np.max(np.linalg.norm(J1 @ R.T + b - joints, axis=1))) / diag
@@ -329,30 +413,38 @@ def gg_path(inet: IntrinsicNet, rev: Revolution, net: Net, aligned: np.ndarray,
     JB = state(_unbending_state(prof, 1.0, phi_m))[2] @ R.T + b
     move = _rigid_towards(JB, np.asarray(aligned, float))   # straight bundle -> aligned
     Xs, Ns, Vs, phase = [X_dep], [N_dep], [joints], ["deployed"]
+    carried = gap > CARRY_TOL               # the design is not itself of revolution
+    rev1 = (X1 @ R.T + b, N1 @ R.T, J1 @ R.T + b)
+    mismatch = [0.0]
     hist = [{"frame": 0, "phase": "deployed", "lambda": 1.0, "tau": 0.0}]
-    for k, (ph, x) in enumerate(_schedule(max(int(frames), 2), gap > BLEND_TOL), start=1):
-        if ph == "blend":                               # design -> revolution
-            X, N, J = ((1 - x) * X_dep + x * (X1 @ R.T + b), _unit((1 - x) * N_dep + x * (N1 @ R.T)),
-                       (1 - x) * joints + x * (J1 @ R.T + b))
-        else:
-            X, N, J = state(_closing_state(prof, x, phi_m) if ph == "close"
-                            else _unbending_state(prof, x, phi_m))
-            X, N, J = X @ R.T + b, N @ R.T, J @ R.T + b
-            if ph == "unbend":
-                X, N, J = move(X, x), move(N, x, vector=True), move(J, x)
+    for k, (ph, x) in enumerate(_schedule(max(int(frames), 2)), start=1):
+        X, N, J = state(_closing_state(prof, x, phi_m) if ph == "close"
+                        else _unbending_state(prof, x, phi_m))
+        X, N, J = X @ R.T + b, N @ R.T, J @ R.T + b
+        miss = 0.0
+        if ph == "unbend":
+            X, N, J = move(X, x), move(N, x, vector=True), move(J, x)
+        elif carried and x > 0:
+            X, N, J, miss = _carried_state((X_dep, N_dep, joints), rev1, (X, N, J), x,
+                                           lamella, joint)
         Xs.append(X)
         Ns.append(N)
         Vs.append(J)
         phase.append(ph)
-        hist.append({"frame": k, "phase": ph, "lambda": x if ph == "close" else
-                     (0.0 if ph == "unbend" else 1.0), "tau": x if ph == "unbend" else 0.0})
+        mismatch.append(miss)
+        hist.append({"frame": k, "phase": ph, "lambda": x if ph == "close" else 0.0,
+                     "tau": x if ph == "unbend" else 0.0})
     Vs[-1] = np.asarray(aligned, float).copy()
     t = np.linspace(0.0, 1.0, len(Vs))
     for h, tk in zip(hist, t):
         h["t"] = float(tk)
     bound = np.array([segment_length_error(X, X_dep, lamella, joint) for X in Xs])
+    # a carried state's lamellae keep their lengths exactly; its error is the joints'
+    # disagreement, relative to the mean joint-to-joint segment
+    seg = float(np.mean(np.linalg.norm(np.diff(joints[net.edges()], axis=1)[:, 0], axis=1)))
+    bound = np.maximum(bound, np.asarray(mismatch) / max(seg, 1e-300))
     strips = StripStates(X=np.stack(Xs), N=np.stack(Ns), lamella=lamella, joint=joint, t=t,
-                         approximate=np.array([p == "blend" for p in phase]), bound=bound,
+                         approximate=bound > CARRIED_APPROXIMATE, bound=bound,
                          phase=np.array(phase), sphi=sp.copy(),
                          lam=np.array([h["lambda"] for h in hist]),
                          tau=np.array([h["tau"] for h in hist]))

@@ -281,9 +281,9 @@ def _path_states(bundle: DesignBundle, strips: dict[str, Any], section: Section,
 
 #: the approximate states of a physical path: where the design surface is only isometric to
 #: the surface of revolution, the blend between them
-PATH_APPROXIMATE = ("approximate states: the blend from the design surface to the surface of "
-                    "revolution it is isometric to (bounded by their length_error); reported, "
-                    "not judged")
+PATH_APPROXIMATE = ("approximate states: the lamellae carried from the design surface onto the "
+                    "surface of revolution it is isometric to, their joints disagreeing by more "
+                    "than 1 % of a segment (length_error); reported, not judged")
 
 
 def bundle_states(bundle: DesignBundle, path: Path | None, section: Section,

@@ -136,3 +136,27 @@ def test_turning_point_has_no_closed_form_path():
     path = gg_path(g["inet"], g["rev"], g["net"], aligned, P)
     assert why and "turn" in why
     assert path is None
+
+
+def test_a_design_only_isometric_to_its_surface_of_revolution_carries_its_difference():
+    """The sample dome is only isometric to its surface of revolution: each closing state
+    carries the design's difference from it, scaled by lambda - every lamella keeps its arc
+    lengths exactly (its turns interpolated, placed by its joints); the joints' disagreement
+    is the bound, a state beyond 1 % of a segment is approximate, and the closed state
+    (lambda = 0) is the revolution's own, exact."""
+    from gridshell.api import design_gg
+    from gridshell.geometry.net import polyline_arclength
+
+    seq = design_gg("samples/dome.obj").report["sequence"]
+    s = seq.strips
+    carried = np.flatnonzero((s.phase == "close") & (s.lam > 0))
+    assert len(carried) >= 6
+    for lid in np.unique(s.lamella):
+        m = np.flatnonzero(s.lamella == lid)
+        a0 = polyline_arclength(s.X[0][m])
+        for f in carried:
+            np.testing.assert_allclose(polyline_arclength(s.X[f][m]), a0, atol=1e-9 * a0[-1])
+    assert np.all(s.bound[carried] > 0)
+    np.testing.assert_array_equal(s.approximate, s.bound > 0.01)
+    closed = int(np.flatnonzero((s.phase == "close") & (s.lam == 0))[0])
+    assert not s.approximate[closed] and s.bound[closed] < 1e-3
