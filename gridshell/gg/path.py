@@ -30,7 +30,7 @@ the state's bound, and a state beyond :data:`CARRIED_APPROXIMATE` of a segment i
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -39,6 +39,7 @@ from scipy.interpolate import CubicSpline
 from scipy.spatial.transform import Rotation, Slerp
 
 from gridshell.geometry.net import Net, polyline_arclength
+from gridshell.gg.alignment import GGSequence
 from gridshell.gg.clairaut import IntrinsicNet
 from gridshell.gg.mapback import NetParameters, SurfaceMap, net_parameters
 from gridshell.gg.revolution import Revolution
@@ -105,22 +106,13 @@ class StripStates:
 
 
 @dataclass
-class GGPath:
-    """A GG alignment path: the joints of every state (as
-    :class:`gridshell.gg.alignment.GGSequence`) and its dense strips.
+class GGPath(GGSequence):
+    """A GG alignment path: the joints of every state (a
+    :class:`gridshell.gg.alignment.GGSequence`, ``length_error`` the states'
+    :attr:`StripStates.bound`, ``history`` per state ``{"frame", "t", "phase", "lambda",
+    "tau"}``) and its dense strips ``strips`` (:class:`StripStates`)."""
 
-    V : list of (n, 3) joints per state, metres (``V[0]`` the deployed net, ``V[-1]`` the
-    collapsed one);  t : (K+1,);  edges : (E, 2) joint-mesh edges;  length_error : (K+1,) the
-    states' :attr:`StripStates.bound`;  history : per state ``{"frame", "t", "phase",
-    "lambda", "tau"}``;  strips : :class:`StripStates`.
-    """
-
-    V: list[np.ndarray]
-    t: np.ndarray
-    edges: np.ndarray
-    length_error: np.ndarray
-    strips: StripStates
-    history: list[dict] = field(default_factory=list)
+    strips: StripStates | None = None
 
 
 def _unit(X: np.ndarray) -> np.ndarray:
