@@ -102,7 +102,12 @@ _EQ_ROWS = (("gravity", "load", ""), ("supports", "supported joints", ""),
             ("utilisation_design", "utilisation of the design state", ""),
             ("utilisation_peak", "utilisation at equilibrium", ""),
             ("reaction_max_N", "largest support reaction", "N"),
-            ("weight_N", "self-weight", "N"), ("newton", "Newton", ""))
+            ("weight_N", "self-weight", "N"), ("snow_total_kN", "snow load, total", "kN"),
+            ("deflection_max_mm", "largest deflection", "mm"),
+            ("deflection_vertical_max_mm", "largest vertical deflection", "mm"),
+            ("span_m", "span", "m"), ("span_over_deflection", "span / deflection", ""),
+            ("bolt_shear_max_N", "largest bolt shear (joint force)", "N"),
+            ("bolt_shear_mean_N", "mean bolt shear", "N"), ("newton", "Newton", ""))
 
 
 def equilibrium_section(d: Path, kv_table: Any, figure: Any) -> str:

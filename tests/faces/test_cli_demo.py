@@ -167,3 +167,20 @@ def test_a_failing_demo_leaves_the_previous_output(tmp_path, monkeypatch, capsys
     assert main(["demo", "--quick", "--only", "gg", "-o", str(out)]) == 4
     assert sorted(p.name for p in out.iterdir()) == [demo.MARKER, manifest.MANIFEST]
     assert [p.name for p in tmp_path.iterdir()] == ["demo"]          # no temporary left
+
+
+@pytest.mark.slow
+def test_quick_demo_reports_the_full_scale_snow_case(quick_demo):
+    """The GG demo at 1:1 in spruce C24 under 1 kN/m2 (issue 28): deflection and the bolts'
+    shear in the summary and, with their units, in report.html's equilibrium section."""
+    code, out, summary = quick_demo
+    eq = json.loads((out / "gg" / "equilibrium" / "equilibrium.json").read_text())["figures"]
+    html = (out / "gg" / "report.html").read_text()
+    section = html[html.index('<section id="equilibrium">'):]
+    section = section[:section.index("</section>")]
+    for label in ("largest deflection [mm]", "span / deflection",
+                  "largest bolt shear (joint force) [N]", "snow load, total [kN]"):
+        assert label in section, label
+    assert f"{eq['deflection_max_mm']:.4g}"[:3] in section
+    assert eq["snow_total_kN"] > 0 and eq["bolt_shear_max_N"] > 0
+    assert "GG at 1:1 under snow" in json.dumps(summary) or "full_scale" in json.dumps(summary)
