@@ -44,6 +44,10 @@ def add_args(p: argparse.ArgumentParser) -> None:
                    help="rod elements between neighbouring joints (default 3)")
     g.add_argument("--max-iter", type=count(1), default=100,
                    help="Newton iterations at most (default 100)")
+    g.add_argument("--state", type=count(0), default=None, metavar="K",
+                   help="also check the alignment path: its state frame_K (sequence/"
+                        "strips.npz) as rods of the strip as cut with every joint held; "
+                        "prints how far the strips move from the state (%% of the diagonal)")
 
 
 def parse_supports(text: str):
@@ -72,7 +76,7 @@ def run(args: Any) -> int:
                    thickness=args.thickness, scale=args.scale,
                    supports=parse_supports(args.supports), gravity=args.gravity,
                    snow=args.snow, per_bay=args.per_bay, max_iter=args.max_iter,
-                   progress=progress)
+                   state=args.state, progress=progress)
     print_summary(args, "Simulate", summary(args, sim))
     return 0
 
@@ -113,6 +117,13 @@ def summary(args: Any, sim: Any) -> dict[str, Any]:
         summary["bolts"] = (f"largest shear {fig['bolt_shear_max_N']:.3g} N (joint "
                             f"{fig['bolt_shear_max_joint']}), mean "
                             f"{fig['bolt_shear_mean_N']:.3g} N")
+    if "path_state" in fig:
+        ps = fig["path_state"]
+        summary["path check"] = (
+            f"{ps['state']} (t = {ps['t']:.3g}) with its {ps['held_joints']} joints held: the "
+            f"strips move at most {ps['deviation_max_pct']:.3g} % (mean "
+            f"{ps['deviation_mean_pct']:.2g} %) of the diagonal, utilisation "
+            f"{ps['utilisation_peak']:.3g}" + ("" if ps["converged"] else " (not converged)"))
     u = fig["utilisation_peak"]
     summary["verdict"] = (f"{'elastic' if u <= 1 else 'OVERSTRESSED'}: peak utilisation "
                           f"{u:.2f} under {fig['gravity']}")

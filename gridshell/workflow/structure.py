@@ -112,15 +112,19 @@ def simulate(bundle: str | os.PathLike, out: str | os.PathLike | None = None, *,
              material: Any = None, width: float | None = None, thickness: float | None = None,
              scale: Any = None, supports: Any = "boundary", gravity: bool = False,
              snow: float | None = None, per_bay: int = 3, max_iter: int = 100,
-             write: bool = True, progress: Progress = None) -> Simulation:
+             state: int | None = None, write: bool = True,
+             progress: Progress = None) -> Simulation:
     """The elastic equilibrium of the deployed gridshell of the bundle directory ``bundle``:
     every lamella a discrete elastic rod of the real strip (``width`` x ``thickness`` mm at
     ``scale``, ``material``), joints turning about their axis only, ``supports`` (``"boundary"``
     or joint indices) held at the design, optionally under ``gravity`` and a ``snow`` load
     (kN/m2 of plan area, with self-weight: deflection, span / deflection and bolt shear in the
     figures); ``per_bay`` rod elements
-    between joints, at most ``max_iter`` Newton iterations. With ``write`` the result goes to
-    ``out`` (default ``DIR/equilibrium``), replaced atomically."""
+    between joints, at most ``max_iter`` Newton iterations. ``state``: also the check of the
+    alignment path, state ``frame_<state>`` of ``sequence/strips.npz`` as rods with its joints
+    held (:func:`gridshell.structure.pathcheck.state_equilibrium`; figures ``path_state``).
+    With ``write`` the result goes to ``out`` (default ``DIR/equilibrium``), replaced
+    atomically."""
     from gridshell.core.atomic import check_output
     from gridshell.core.errors import InputError
     from gridshell.design.bundle import read_bundle
@@ -133,6 +137,7 @@ def simulate(bundle: str | os.PathLike, out: str | os.PathLike | None = None, *,
         check_output(target, owner="simulate")
     if per_bay < 1 or max_iter < 1:
         raise InputError("--per-bay and --max-iter must be at least 1")
+    strips = _path_strips(bundle_dir, b, state) if state is not None else None
     strip, section, mat = strip_of(bundle_dir, material, width=width, thickness=thickness,
                                    scale=scale)
     if progress:
@@ -141,6 +146,13 @@ def simulate(bundle: str | os.PathLike, out: str | os.PathLike | None = None, *,
     eq = equilibrium(b, mat, section, supports=supports, gravity=gravity, snow=snow,
                      per_bay=per_bay,
                      max_iter=max_iter, progress=progress)
+    if strips is not None:
+        from gridshell.structure.pathcheck import state_equilibrium
+
+        if progress:
+            progress(f"the alignment path's frame_{state:03d} as rods with its joints held")
+        eq.figures["path_state"] = state_equilibrium(b, strips, state, mat, section,
+                                                     max_iter=max_iter)
     record = _record(eq, mat, section)
     if write:
         if progress:
@@ -161,6 +173,24 @@ def write_simulation(bundle: str | os.PathLike, sim: Simulation,
     check_output(target, owner="simulate")
     _write(target, sim.bundle, sim.equilibrium, sim.record, sim.section, sim.material)
     return replace(sim, out=target)
+
+
+def _path_strips(bundle_dir: Path, b: Any, state: int) -> dict[str, Any]:
+    """The dense strips of the bundle's alignment path with state ``state`` in range, or
+    :class:`InputError` naming what is missing."""
+    from gridshell.core.errors import InputError
+    from gridshell.structure.states import STRIPS, read_strips
+
+    strips = read_strips(bundle_dir, len(b.net.joints), len(b.net.lamellae))
+    if strips is None:
+        raise InputError(f"--state: {bundle_dir} has no alignment path ({STRIPS}, written by "
+                         "gg with --frames >= 1 on a net without a Clairaut turning point); "
+                         "re-run the design or leave out --state")
+    F = len(strips["t"])
+    if not 0 <= state < F:
+        raise InputError(f"--state {state}: the path has states 0 to {F - 1} (frame_000 "
+                         f"deployed ... frame_{F - 1:03d} collapsed)")
+    return strips
 
 
 def _scale(strip: StripSection) -> str:
