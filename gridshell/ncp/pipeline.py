@@ -53,6 +53,7 @@ class NCPState:
     post: PostOptResult
     sequence: AlignmentSequence
     aligned_2d: np.ndarray
+    strips: dict[str, Any] | None = None
 
 
 def _phlw_failure(info: dict, mode: str, exc: Exception) -> ConvergenceError:
@@ -446,13 +447,36 @@ def _bundle_stage(state: dict[str, Any]) -> dict[str, Any]:
     return {"design": Design(bundle, _report(state, metrics))}
 
 
+@stage("strips", needs=("design", "sequence", "opts"), gives=("design",))
+def _strips_stage(state: dict[str, Any]) -> dict[str, Any]:
+    """The strips of every alignment state: the sequence's joints and own axes, the strips
+    between them at their elastic equilibrium from the cut shape
+    (:func:`gridshell.structure.heldpath.held_path`; ``sequence/strips.npz``, metrics
+    ``sequence_path``)."""
+    from gridshell.structure.heldpath import held_path
+
+    design, seq, o = state["design"], state["sequence"], state["opts"]
+    st = held_path(design.bundle, seq.V, seq.r, seq.t, progress=o.progress)
+    design.report["state"].strips = st
+    design.bundle.metrics["sequence_path"] = {
+        "physical": True, "method": st["method"],
+        "axis_bound_max_rad": float(np.max(st["bound"])),
+        "newton_iterations": [int(i) for i in st["iterations"]],
+        "fold_deg_max": float(np.max(st["turn_deg"])),
+        "approximate": [int(k) for k in np.flatnonzero(st["approximate"])]}
+    o.say(f"strips of {len(seq.V)} alignment states: axes within "
+          f"{np.degrees(np.max(st['bound'])):.2g} deg, "
+          f"{int(np.sum(st['approximate']))} approximate")
+    return {"design": design}
+
+
 #: The NCP pipeline as named stages over one state dict (:func:`ncp_state`), in order. Each
 #: stage's wall time (s) goes to ``state["timings"][name]``; ``metrics["timings"]`` holds those
 #: up to ``metrics`` and the ``total`` (taken by ``gate``). ``run_stages(NCP_STAGES, state,
 #: until=name)`` stops after a stage (e.g. ``"tracing"`` for the traced net alone).
 NCP_STAGES: tuple[Stage, ...] = (_surface_stage, _directions_stage, _tracing_stage,
                                  _collapse_stage, _postopt_stage, _simulation_stage,
-                                 _metrics_stage, _gate_stage, _bundle_stage)
+                                 _metrics_stage, _gate_stage, _bundle_stage, _strips_stage)
 
 
 def design_ncp(source: Any, *, mode: str = "phlw", curves: int | tuple[int, int] | None = None,
@@ -545,7 +569,8 @@ def ncp_files(bundle: DesignBundle, report: dict, *, render: bool = True,
     ``surface.json`` (the PHLW B-spline), ``report.json``,
     ``axes_r.npy`` (rotation axes of the post-optimized joints) and ``aligned_r.npy`` (of the
     aligned ones) for ``gridshell verify``, ``sequence/frame_000.obj ...`` (the alignment
-    sequence; the last frame equals ``aligned.obj``), and with ``render``:
+    sequence; the last frame equals ``aligned.obj``), ``sequence/strips.npz`` (the strips of
+    every state, :mod:`gridshell.structure.heldpath`), and with ``render``:
     ``sequence/frame_000.png ...``, ``alignment.gif``, ``delta_a_before.png``,
     ``delta_a_after.png`` (Fig. 13), ``delta_l.png``, ``delta_n.png`` (Fig. 16) and
     ``collapse.png`` (Fig. 15).
@@ -569,6 +594,12 @@ def ncp_files(bundle: DesignBundle, report: dict, *, render: bool = True,
     width = max(3, len(str(nf - 1)))
     for k, V in enumerate(st.sequence.V):
         extra[f"sequence/frame_{k:0{width}d}.obj"] = (lambda p, V=V: write_mesh(p, V, loops))
+    if st.strips is not None:
+        strips = st.strips
+        extra["sequence/strips.npz"] = (lambda p: np.savez_compressed(
+            p, **{k: strips[k] for k in ("X", "N", "lamella", "joint", "kcut", "t",
+                                         "approximate", "bound", "iterations", "turn_deg")},
+            method=np.array(strips["method"])))
     if render:
         from gridshell.render import ncp_maps
         from gridshell.render.net_preview import net_preview

@@ -120,17 +120,25 @@ def _interp_rows(s: np.ndarray, xs: np.ndarray, Y: np.ndarray) -> np.ndarray:
 def build_model(bundle, material: Material, section: Section, *,
                 supports: str | np.ndarray = "boundary", gravity: bool = False,
                 per_bay: int = 3, stiffness: Stiffness | None = None,
-                joint_factor: float = 100.0) -> DeployedModel:
+                joint_factor: float = 100.0,
+                joint_axes: np.ndarray | None = None, couple: bool = True,
+                rigid_check: bool = True) -> DeployedModel:
     """The rod network of a design bundle (:class:`~gridshell.design.bundle.DesignBundle`) built as
     ``section`` of ``material`` (module docstring). ``supports``: "boundary" or joint indices;
-    ``joint_factor``: joint stiffness relative to the strips' stiffest rotation (a penalty)."""
+    ``joint_factor``: joint stiffness relative to the strips' stiffest rotation (a penalty);
+    ``joint_axes (n, 3)``: the joint axes to start from instead of the net normals (an NCP
+    state's own rotation axes, signed consistently: the strips' width directions follow
+    them); ``couple``: False leaves out the joints' common-axis terms (rods that only share
+    their joint nodes); ``rigid_check``: False when the caller holds more than the supports'
+    positions (the rods' frame angles: supports on one line then hold)."""
     net = bundle.net
     st = stiffness or Stiffness()
     if per_bay < 1:
         raise InputError(f"per_bay must be >= 1, got {per_bay}")
     scale = float(section.scale)
     J = net.joints * scale
-    NJ = joint_normals(net.joints, net.loops)
+    NJ = joint_normals(net.joints, net.loops) if joint_axes is None else \
+        rod.unit(np.asarray(joint_axes, float))
     tangent = bundle.kind in TANGENT_KINDS
     E, G = material.E, material.G
     EA, B1 = E * section.area, st.strong * E * section.I_strong
@@ -175,23 +183,19 @@ def build_model(bundle, material: Material, section: Section, *,
     theta_all, a1_all = np.concatenate(theta), np.concatenate(a1)
     le = np.concatenate([r.lbar for r in rods])
     kJ = joint_factor * max(B1, B2, GJ, 1e-300) / float(np.median(le))
-    joints = _joint_specs(Xall, rods, theta_all, a1_all, joint_at, NJ, kJ)
+    joints = _joint_specs(Xall, rods, theta_all, a1_all, joint_at, NJ, kJ) if couple else []
     network = RodNetwork(Xall, rods, theta_all, a1_all, joints=joints)
-    used = np.zeros(len(J), bool)
-    for r in rods:
-        used[r.nodes[r.nodes < len(J)]] = True
+    used = np.isin(np.arange(len(J)), np.concatenate([r.nodes for r in rods]))
     joint_node = np.where(used, np.arange(len(J)), -1)
     sup = _supports(net, supports)
     sup = sup[joint_node[sup] >= 0]
-    fixed = np.zeros(network.n, bool)
-    fixed[network.pos_dofs(sup).reshape(-1)] = True
-    network.fixed = fixed
+    network.fixed = np.isin(np.arange(network.n), network.pos_dofs(sup).reshape(-1))
     if gravity:
         network.forces[:, 2] -= GRAVITY * _lumped_mass(len(Xall), rods)
-    _check_supported(Xall, sup, len(J))
+    if rigid_check:
+        _check_supported(Xall, sup, len(J))
     return DeployedModel(network, joint_node, sup, lam_nodes, lam_ids, scale, bundle.kind,
-                         rest, section, material, gravity,
-                         loops=net.loops.copy())
+                         rest, section, material, gravity, loops=net.loops.copy())
 
 
 def _lamella_nodes(lam, J: np.ndarray, scale: float, n_nodes: int, per_bay: int):

@@ -2,9 +2,11 @@
 
 A bundle with the dense strips of a **physical path** (``sequence/strips.npz``, written by the
 GG pipeline: :mod:`gridshell.gg.path`, the net through surfaces of revolution on which every
-lamella stays a geodesic with its arc lengths) is measured on them: the Darboux curvatures of
-every lamella's dense axis with the state's own strip normals, every state judged but those
-the path marks approximate (:func:`strip_state_record`). Otherwise (NCP kinds; GG nets with a
+lamella stays a geodesic with its arc lengths; by the NCP pipeline:
+:mod:`gridshell.structure.heldpath`, the strips at equilibrium between the kinematic
+sequence's joints and axes) is measured on them: the Darboux curvatures of every lamella's
+dense axis with the state's own strip normals (less the cut curvature), every state judged
+but those the path marks approximate (:func:`strip_state_record`). Otherwise (GG nets with a
 Clairaut turning point, older bundles):
 
 A state is known by its joints only (``sequence/frame_*.obj``, ``aligned.obj``): each lamella
@@ -117,7 +119,7 @@ def slerp_axes(r0: np.ndarray, r1: np.ndarray, t: float) -> np.ndarray:
     return r / np.maximum(np.linalg.norm(r, axis=1), 1e-300)[:, None]
 
 
-def _max_turn(X: np.ndarray) -> float:
+def max_turn(X: np.ndarray) -> float:
     """Largest angle (degrees) between consecutive chords of the joint polyline ``X (j,3)``."""
     d = np.diff(np.asarray(X, float), axis=0)
     n = np.linalg.norm(d, axis=1)
@@ -165,7 +167,7 @@ def state_record(bundle: DesignBundle, V: np.ndarray, normals: np.ndarray, secti
         a, b = np.concatenate([dc.kn for dc in dcs]), np.concatenate(k_cut)
         a, b = np.nan_to_num(a), np.where(np.isfinite(a), b, 0.0)
         sign = 1.0 if np.sum((a - b) ** 2) <= np.sum((a + b) ** 2) else -1.0
-    turn = max((_max_turn(V[lam.joints]) for lam in lams), default=0.0)
+    turn = max((max_turn(V[lam.joints]) for lam in lams), default=0.0)
     per, best = [], (0.0, -1, -1)
     kw = ks = kt = 0.0
     for lam, dc, kc in zip(lams, dcs, k_cut):
@@ -195,7 +197,8 @@ STRIPS = "sequence/strips.npz"
 
 def read_strips(path: Path | None, n_joints: int, n_lamellae: int) -> dict[str, Any] | None:
     """The dense strips of every state (``sequence/strips.npz``: ``X``, ``N (F, M, 3)``,
-    ``lamella``, ``joint (M,)``, ``t``, ``approximate``, ``bound (F,)``, ``method``), or None
+    ``lamella``, ``joint (M,)``, ``t``, ``approximate``, ``bound (F,)``, ``method``; ``kcut
+    (M,)`` the strips' cut curvature, 1/m of the design, 0 when absent), or None
     when absent, unreadable or not of this net (``n_joints`` joints, lamella ids below
     ``n_lamellae``)."""
     if path is None or not (path / STRIPS).is_file():
@@ -204,12 +207,14 @@ def read_strips(path: Path | None, n_joints: int, n_lamellae: int) -> dict[str, 
         with np.load(path / STRIPS, allow_pickle=False) as z:
             d = {k: z[k] for k in ("X", "N", "lamella", "joint", "t", "approximate", "bound",
                                    "method")}
+            d["kcut"] = z["kcut"] if "kcut" in z.files else np.zeros(z["X"].shape[1])
     except (OSError, ValueError, KeyError):
         return None
     X, N = d["X"], d["N"]
     F = len(d["t"])
     if X.ndim != 3 or X.shape != N.shape or X.shape[0] != F or X.shape[2] != 3 or \
             d["lamella"].shape != (X.shape[1],) or d["joint"].shape != (X.shape[1],) or \
+            d["kcut"].shape != (X.shape[1],) or not np.all(np.isfinite(d["kcut"])) or \
             not np.all(np.isfinite(X)) or not np.all(np.isfinite(N)) or F < 2 or \
             d["joint"].max(initial=-1) >= n_joints or d["lamella"].max(initial=0) >= n_lamellae:
         return None
@@ -222,7 +227,8 @@ def strip_state_record(strips: dict[str, Any], f: int, orientation: str, section
     """Utilisation of every lamella in state ``f`` of the dense strips of a physical path
     (:func:`read_strips`): the Darboux curvatures of each lamella's dense axis with the
     state's strip normals (:func:`gridshell.structure.frames.darboux_curvatures`), measured,
-    not assumed; the worst point's nearest joint."""
+    not assumed, less the cut curvature ``kcut`` (orthogonal strips; signed like the state's
+    in-plane curvature); the worst point's nearest joint."""
     from gridshell.structure.frames import darboux_curvatures
 
     X, N, lam_of, joint = strips["X"][f], strips["N"][f], strips["lamella"], strips["joint"]
@@ -233,7 +239,10 @@ def strip_state_record(strips: dict[str, Any], f: int, orientation: str, section
     for lid in ids:
         m = np.flatnonzero(lam_of == lid)
         dc = darboux_curvatures(X[m], N[m])
-        k = strip_curvatures(dc, orientation, section, 0.0)
+        kc = strips["kcut"][m]
+        if np.sum((dc.kn - kc) ** 2) > np.sum((dc.kn + kc) ** 2):
+            kc = -kc
+        k = strip_curvatures(dc, orientation, section, kc)
         u = strip_stresses(k, section, material).utilisation
         if not len(u) or not np.all(np.isfinite(u)):
             continue
@@ -250,7 +259,8 @@ def strip_state_record(strips: dict[str, Any], f: int, orientation: str, section
             "max_turn_deg": 0.0, "resolved": True,
             "max_weak_curvature_per_m": kw, "max_strong_curvature_per_m": ks,
             "max_twist_rad_per_m": kt, "max_geodesic_residual_per_m": 0.0,
-            "length_error": float(strips["bound"][f]),
+            ("length_error" if orientation == "tangent" else "axis_error_rad"):
+                float(strips["bound"][f]),
             "lamellae_max_utilisation": [per.get(i) for i in range(int(ids.max()) + 1)]}
 
 
@@ -269,7 +279,7 @@ def _path_states(bundle: DesignBundle, strips: dict[str, Any], section: Section,
     judged = [f["max_utilisation"] for f in out if is_judged(f)]
     return {"method": strips["method"], "fold_deg": FOLD_DEG, "frames": out,
             "physical_path": True,
-            "approximate_path": PATH_APPROXIMATE,
+            "approximate_path": PATH_APPROXIMATE[orientation],
             "approximate": [f["name"] for f in out if f["approximate"]],
             "unresolved": [],
             "collapsed": {"name": collapsed["name"],
@@ -281,9 +291,16 @@ def _path_states(bundle: DesignBundle, strips: dict[str, Any], section: Section,
 
 #: the approximate states of a physical path: where the design surface is only isometric to
 #: the surface of revolution, the blend between them
-PATH_APPROXIMATE = ("approximate states: the lamellae carried from the design surface onto the "
-                    "surface of revolution it is isometric to, their joints disagreeing by more "
-                    "than 1 % of a segment (length_error); reported, not judged")
+PATH_APPROXIMATE = {
+    "tangent": ("approximate states: the lamellae carried from the design surface onto the "
+                "surface of revolution it is isometric to, their joints disagreeing by more "
+                "than 1 % of a segment (length_error); reported, not judged"),
+    "orthogonal": ("approximate states: the strips' equilibrium between the held joints did "
+                   "not converge, their width directions leave the sequence's axes at a "
+                   "joint by more than 0.05 rad (axis_error_rad), or the kinematic sequence "
+                   "folds a lamella there (its joint-to-joint chords turn by more than 30 "
+                   "degrees, or by 10 degrees more than in both end states: no path a strip "
+                   "takes); reported, not judged")}
 
 
 def bundle_states(bundle: DesignBundle, path: Path | None, section: Section,

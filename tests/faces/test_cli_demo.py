@@ -101,6 +101,24 @@ def test_quick_demo_ncp_alignment_sequence(quick_demo):
                              / ell0) for V in frames)
     assert worst == pytest.approx(saved["sequence_length_error"], rel=1e-4, abs=1e-6)
     assert worst < 2
+    # the strips of every state (issue 28): through the sequence's joints, at equilibrium
+    # from the cut arcs; the check judges every state on them
+    from gridshell.structure.states import read_strips
+
+    strips = read_strips(out / "ncp", len(b.net.joints), len(b.net.lamellae))
+    assert strips is not None and len(strips["t"]) == len(frames)
+    on = strips["joint"] >= 0
+    for f, V in enumerate(frames):
+        np.testing.assert_allclose(strips["X"][f][on], V[strips["joint"][on]], atol=1e-9)
+    st = json.loads((out / "ncp" / "structure.json").read_text())
+    states = st["states"]
+    assert states["physical_path"] and states["approximate"] == []
+    weak = max(f["max_weak_curvature_per_m"] for f in states["frames"])
+    u = [f["max_utilisation"] for f in states["frames"]]
+    for f in states["frames"]:
+        assert f["max_strong_curvature_per_m"] < 0.05 * weak, f
+    assert u[-1] < 0.05 * u[0]                       # collapsed: flat, as cut
+    assert u[0] == pytest.approx(st["max_utilisation_deployed"], rel=0.1)
 
 
 def test_quick_demo_figures_meet_the_paper_bounds(quick_demo):

@@ -12,7 +12,7 @@ from gridshell.ncp.pipeline import NCP_STAGES, NCPOptions, design_ncp, ncp_state
 from tests.helpers.ncp_cases import torus
 
 ORDER = ["surface", "directions", "tracing", "collapse", "postopt", "simulation", "metrics",
-         "gate", "bundle"]
+         "gate", "bundle", "strips"]
 
 
 def test_stages_are_named_in_pipeline_order():
