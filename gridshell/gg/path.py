@@ -271,6 +271,26 @@ def _turns(X: np.ndarray, N: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return F, Rotation.from_matrix(loc).as_rotvec() if len(loc) else np.zeros((0, 3))
 
 
+def _lamella_turns(X: np.ndarray, N: np.ndarray, lamella: np.ndarray
+                   ) -> dict[int, tuple[np.ndarray, np.ndarray]]:
+    """:func:`_turns` of every lamella of the strips ``X, N (M, 3)`` (``lamella (M,)``: the
+    samples of a lamella consecutive) at once: lamella id -> (segment frames, turns), for
+    lamellae of at least 3 samples."""
+    F = _segment_frames(X, N)                                # (M-1): some span two lamellae
+    same = lamella[1:] == lamella[:-1]
+    pair = same[:-1] & same[1:]
+    loc = np.einsum("kji,kjl->kil", F[:-1][pair], F[1:][pair])
+    rv = np.zeros((len(pair), 3))
+    if len(loc):
+        rv[pair] = Rotation.from_matrix(loc).as_rotvec()
+    out = {}
+    for lid in np.unique(lamella):
+        m = np.flatnonzero(lamella == lid)
+        if len(m) >= 3:
+            out[int(lid)] = (F[m[0]:m[-1]], rv[m[0]:m[-1] - 1])
+    return out
+
+
 def _strip(ell: np.ndarray, F0: np.ndarray, rv: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The strip ``(X (k,3), N (k,3))`` with segment lengths ``ell (k-1,)``, first segment
     frame ``F0`` and the turns ``rv (k-2, 3)`` (:func:`_turns`), from the origin."""
@@ -285,7 +305,14 @@ def _strip(ell: np.ndarray, F0: np.ndarray, rv: np.ndarray) -> tuple[np.ndarray,
     return X, N
 
 
-def _carried_state(dep, rev1, revl, lam, lamella, joint):
+def _turn_excess(dep, rev1, lamella: np.ndarray) -> dict[int, np.ndarray]:
+    """Per lamella the design's turns less those of the revolution's deployed state,
+    ``omega_design - omega_1`` (:func:`_carried_state`)."""
+    d, r = _lamella_turns(dep[0], dep[1], lamella), _lamella_turns(rev1[0], rev1[1], lamella)
+    return {lid: d[lid][1] - r[lid][1] for lid in d}
+
+
+def _carried_state(dep, rev1, revl, lam, lamella, joint, excess):
     """State ``lambda`` of a design surface only isometric to its surface of revolution: the
     revolution's state ``revl`` with the design's difference from the revolution's deployed
     state ``rev1`` carried along, scaled by ``lambda`` (all the difference deployed, none
@@ -294,8 +321,10 @@ def _carried_state(dep, rev1, revl, lam, lamella, joint):
     rigid fit of its joints to ``J_lambda + lambda (J_design - J_1)``, a joint the mean of its
     lamellae's. ``dep``, ``rev1``, ``revl``: ``(X (M,3), N (M,3), J (n,3))``. Returns the
     state and the joints' disagreement, the largest distance between a joint's two
-    placements (metres)."""
+    placements (metres). ``excess``: lamella id -> ``omega_design - omega_1``
+    (:func:`_turn_excess`, the same for every state)."""
     (Xd, Nd, Jd), (X1, N1, J1), (Xl, Nl, Jl) = dep, rev1, revl
+    turns = _lamella_turns(Xl, Nl, lamella)
     target = Jl + lam * (Jd - J1)
     X, N = np.empty_like(Xd), np.empty_like(Nd)
     acc, cnt = np.zeros_like(Jd), np.zeros(len(Jd))
@@ -308,11 +337,9 @@ def _carried_state(dep, rev1, revl, lam, lamella, joint):
         if len(m) < 3:
             x, n = Xl[m] + lam * (Xd[m] - X1[m]), Nl[m]
         else:
-            _, rd = _turns(Xd[m], Nd[m])
-            _, r1 = _turns(X1[m], N1[m])
-            Fl, rl = _turns(Xl[m], Nl[m])
+            Fl, rl = turns[int(lid)]
             x, n = _strip(np.linalg.norm(np.diff(Xd[m], axis=0), axis=1), Fl[0],
-                          rl + lam * (rd - r1))
+                          rl + lam * excess[int(lid)])
             if len(j) >= 2:
                 R, b = _kabsch(x[on], target[j])
             else:
@@ -408,6 +435,7 @@ def gg_path(inet: IntrinsicNet, rev: Revolution, net: Net, aligned: np.ndarray,
     carried = gap > CARRY_TOL               # the design is not itself of revolution
     rev1 = (X1 @ R.T + b, N1 @ R.T, J1 @ R.T + b)
     mismatch = [0.0]
+    excess = None                           # the design's turns beyond the revolution's
     hist = [{"frame": 0, "phase": "deployed", "lambda": 1.0, "tau": 0.0}]
     for k, (ph, x) in enumerate(_schedule(max(int(frames), 2)), start=1):
         X, N, J = state(_closing_state(prof, x, phi_m) if ph == "close"
@@ -417,8 +445,10 @@ def gg_path(inet: IntrinsicNet, rev: Revolution, net: Net, aligned: np.ndarray,
         if ph == "unbend":
             X, N, J = move(X, x), move(N, x, vector=True), move(J, x)
         elif carried and x > 0:
+            if excess is None:
+                excess = _turn_excess((X_dep, N_dep, joints), rev1, lamella)
             X, N, J, miss = _carried_state((X_dep, N_dep, joints), rev1, (X, N, J), x,
-                                           lamella, joint)
+                                           lamella, joint, excess)
         Xs.append(X)
         Ns.append(N)
         Vs.append(J)

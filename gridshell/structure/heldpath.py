@@ -123,7 +123,7 @@ def _edge_directors(net, q: np.ndarray) -> np.ndarray:
 
 
 def held_state(bundle: DesignBundle, V: np.ndarray, R: np.ndarray, r0: np.ndarray, *,
-               max_iter: int = 40) -> dict[str, Any]:
+               rtol: float = 1e-9, max_iter: int = 40) -> dict[str, Any]:
     """One state (module docstring): per lamella (bundle order, lamellae of >= 2 joints) its
     rod nodes ``X`` (design metres), width directions ``N``, joint index per node (-1 between)
     ``joint``, cut curvature ``kcut`` (1/m of the design); ``converged``, ``iterations``,
@@ -143,7 +143,7 @@ def held_state(bundle: DesignBundle, V: np.ndarray, R: np.ndarray, r0: np.ndarra
     at_joint = np.flatnonzero(np.any(net.edge_nodes < nJ, axis=1))
     fixed[net.theta_dofs(at_joint)] = True
     net.fixed = fixed
-    res = solve(net, max_iter=max_iter)
+    res = solve(net, rtol=rtol, max_iter=max_iter)
     m1 = _edge_directors(net, res.q)
     P = net.positions(res.q) / model.scale
     curve = collapse_curvature(sb) if cut_shape(sb) == "curve" else None
