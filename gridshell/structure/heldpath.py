@@ -7,8 +7,10 @@ axes only; a strip's shape between two joints follows from the strip itself. At 
 
 1. every joint-to-joint piece of a lamella's design axis is carried rigidly onto the state
    (its chord onto the state's chord, the design's joint axis onto the state's axis at its
-   first joint) and its ends moved onto the state's joints (the alignment keeps the chords to
-   ``Delta_l``): a start with the design's arc lengths;
+   first joint) and its ends moved onto the state's joints: the strip's arc lengths are the
+   design's, changed by the state's change of the chord (the kinematic sequence keeps the
+   chords only approximately; ``length_error``, a state above :data:`LENGTH_TOL` is
+   approximate);
 2. the lamellae become discrete elastic rods of the strip as cut
    (:func:`gridshell.structure.deployed.build_model`: rest shape the cut shape, strong-axis
    curvature only), every joint held at the state's position, the rods' width direction at
@@ -55,6 +57,11 @@ AXIS_TOL = 0.05
 #: kinematic simulation (:mod:`gridshell.ncp.alignment`), not a motion the strips take: the
 #: AA pseudosphere's sequence turns them by up to 79 degrees where both ends turn them by 10
 FOLD_MARGIN_DEG = 10.0
+
+#: a state whose joint-to-joint chords differ from the design's by more than this share is
+#: approximate: the strips, inextensible, are given the state's chord lengths between joints
+#: (the kinematic sequence keeps them only approximately, paper 4.2.4), as GG's carried states
+LENGTH_TOL = 0.01
 
 #: samples of the carried design axis per joint-to-joint piece
 CARRY_SAMPLES = 8
@@ -164,7 +171,10 @@ def held_state(bundle: DesignBundle, V: np.ndarray, R: np.ndarray, r0: np.ndarra
         joint.append(j)
         kcut.append(cut_curvature(sb, lam, s, curve))
     turn = max((max_turn(V[lam.joints]) for lam in lams), default=0.0)
-    return {"X": X, "N": N, "joint": joint, "kcut": kcut, "ids": [lam.id for lam in lams],
+    E = bundle.net.edges()
+    l0 = np.linalg.norm(np.diff(bundle.net.joints[E], axis=1)[:, 0], axis=1)
+    dl = np.abs(np.linalg.norm(np.diff(V[E], axis=1)[:, 0], axis=1) / np.maximum(l0, 1e-300) - 1)
+    return {"length_error": float(dl.max(initial=0.0)),"X": X, "N": N, "joint": joint, "kcut": kcut, "ids": [lam.id for lam in lams],
             "converged": bool(res.converged), "iterations": int(res.iterations),
             "bound": bound, "turn_deg": turn}
 
@@ -192,12 +202,13 @@ def held_path(bundle: DesignBundle, frames: list[np.ndarray], axes: list[np.ndar
     bound = np.array([s["bound"] for s in states])
     turn = np.array([s["turn_deg"] for s in states])
     folded = (turn > FOLD_DEG) | (turn > max(turn[0], turn[-1]) + FOLD_MARGIN_DEG)
-    approximate = np.array([(not s["converged"]) or s["bound"] > AXIS_TOL
-                            for s in states]) | folded
+    approximate = np.array([(not s["converged"]) or s["bound"] > AXIS_TOL or
+                            s["length_error"] > LENGTH_TOL for s in states]) | folded
     return {"X": np.stack([np.concatenate(s["X"]) for s in states]),
             "N": np.stack([np.concatenate(s["N"]) for s in states]),
             "lamella": lamella, "joint": np.concatenate(states[0]["joint"]),
             "kcut": np.concatenate(states[0]["kcut"]), "t": np.asarray(t, float),
             "approximate": approximate, "bound": bound, "method": METHOD_HELD,
             "iterations": np.array([s["iterations"] for s in states]),
-            "turn_deg": turn}
+            "turn_deg": turn,
+            "length_error": np.array([s["length_error"] for s in states])}

@@ -297,7 +297,8 @@ PATH_APPROXIMATE = {
                 "than 1 % of a segment (length_error); reported, not judged"),
     "orthogonal": ("approximate states: the strips' equilibrium between the held joints did "
                    "not converge, their width directions leave the sequence's axes at a "
-                   "joint by more than 0.05 rad (axis_error_rad), or the kinematic sequence "
+                   "joint by more than 0.05 rad (axis_error_rad), the sequence changes a "
+                   "joint-to-joint length by more than 1 %, or the kinematic sequence "
                    "folds a lamella there (its joint-to-joint chords turn by more than 30 "
                    "degrees, or by 10 degrees more than in both end states: no path a strip "
                    "takes); reported, not judged")}
