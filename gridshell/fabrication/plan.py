@@ -38,6 +38,8 @@ def plan_figure(net: Net, title: str = ""):
     """A matplotlib Figure of the plan. Each id sits on its lamella, at the middle unless its
     box would overlap a box placed before: then at the first place along the lamella
     (:data:`LABEL_AT`) where it overlaps none (or, if there is none, overlaps least)."""
+    import textwrap
+
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
@@ -56,7 +58,9 @@ def plan_figure(net: Net, title: str = ""):
     ax.set_aspect("equal")
     ax.set_xlabel("m")
     ax.set_ylabel("m")
-    ax.set_title(title or "assembly plan: lamella ids (blue family 1, red family 3)")
+    # one line per "; " clause, each wrapped to the figure's width: never clipped at its edges
+    text = title or "assembly plan: lamella ids (blue family 1, red family 3)"
+    ax.set_title("\n".join(textwrap.fill(part, 72) for part in text.split("; ")), fontsize=11)
     fig.tight_layout()
     ax.set_xlim(ax.get_xlim())      # the ids do not move the limits or the layout
     ax.set_ylim(ax.get_ylim())

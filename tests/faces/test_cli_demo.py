@@ -45,6 +45,8 @@ def test_quick_demo_writes_everything(quick_demo):
     html = (out / "ncp" / "report.html").read_text()
     assert "data:image/gif;base64," in html and "<svg" in html   # GIF and cut sheets inline
     assert "data:image/gif;base64," in (out / "gg" / "report.html").read_text()
+    for k in ("gg", "ncp"):          # issue 30: the report under 2 MB (full demo: 1.66 MB)
+        assert (out / k / "report.html").stat().st_size < 2_000_000
     assert not [p for p in out.parent.iterdir() if p.name.startswith(".")]  # no temporaries
 
 

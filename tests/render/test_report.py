@@ -86,7 +86,9 @@ def test_report_is_self_contained_valid_html(bundle):
     tags = [t for t, _ in c.attrs]
     assert "link" not in tags
     scripts = [a for t, a in c.attrs if t == "script"]  # the viewer's: scene, three.js, viewer
-    assert scripts == [{"type": "application/json", "id": "gridshell-scene"}, {}, {}]
+    assert scripts[:1] == [{"type": "application/gzip", "id": "gridshell-scene"}]
+    assert scripts[1]["type"] == "application/gzip" and scripts[1]["id"] == "gridshell-three"
+    assert scripts[2:] == [{}]
     srcs = [a["src"] for t, a in c.attrs if "src" in a]
     assert len(srcs) == 2 and all(s.startswith("data:image/png;base64,") for s in srcs)
     hrefs = [a["href"] for _, a in c.attrs if "href" in a]

@@ -20,17 +20,20 @@ from gridshell.core.errors import InputError
 from gridshell.render.report import write_report
 from gridshell.design.section import DEFAULT_CUT, resolve_section
 from gridshell.render.viewer import assets
-from gridshell.render.viewer.scene import build_scene, decode, strip_solids_vertices
+from gridshell.render.viewer.scene import (build_scene, decode, strip_solids_vertices,
+                                           strip_vertices)
 from gridshell.geometry.strips3d import nearest_vertex_normals, strip_solid
 
 VENDOR = Path(assets.__file__).parent / "vendor"
 
 
 def _scene_of(html: str) -> dict:
-    m = re.search(r'<script type="application/json" id="gridshell-scene">(.*?)</script>', html,
+    from gridshell.render.viewer.page import unpacked
+
+    m = re.search(r'<script type="application/gzip" id="gridshell-scene">(.*?)</script>', html,
                   re.S)
     assert m, "the scene is embedded"
-    return json.loads(m.group(1))
+    return json.loads(unpacked(m.group(1)))
 
 
 def _tri_areas(V: np.ndarray, F: np.ndarray) -> np.ndarray:
@@ -114,13 +117,17 @@ def test_scene_decodes_to_the_bundle_geometry(gg):
     axes, joints and surface as stored, one strip array per state of the sequence."""
     html = write_report(gg).read_text(encoding="utf-8")
     S = _scene_of(html)
+    assert "F" not in S["strips"]               # the viewer makes the faces
+    S = build_scene(gg)
+    assert {k: v for k, v in S.items() if k != "strips"} == \
+        {k: v for k, v in _scene_of(html).items() if k != "strips"}
     b = read_bundle(gg)
     w, t = S["section"]["width_m"], S["section"]["thickness_m"]
     assert (w, t) == pytest.approx((0.2, 0.01))
     assert len(S["states"]) == 3 == len(S["strips"]["V"]) == len(S["joints"]["V"])
     F = decode(S["strips"]["F"], "u4").reshape(-1, 3).astype(np.int64)
     assert len(F) == S["strips"]["nf"]
-    V0 = decode(S["strips"]["V"][0], "f4").reshape(-1, 3).astype(float)
+    V0 = strip_vertices(S, 0)
     assert len(V0) == S["strips"]["nv"] and F.max() < len(V0)
     by_id = {lam.id: lam for lam in b.net.lamellae}
     for rec in S["lamellae"]:
@@ -143,7 +150,9 @@ def test_scene_decodes_to_the_bundle_geometry(gg):
         want = np.stack([np.interp(np.linspace(0, s[-1], k), s, lam.axis[:, c])
                          for c in range(3)], axis=1)
         off = centre - want
-        assert np.allclose(np.linalg.norm(off, axis=1), t / 2, rtol=1e-3)
+        q = S["strips"]["quant"]                  # uint16 over the strips' box
+        step = float(np.max(np.subtract(q["hi"], q["lo"]))) / q["steps"]
+        assert np.allclose(np.linalg.norm(off, axis=1), t / 2, rtol=1e-3, atol=step)
         n = nearest_vertex_normals(want, b.surface_V, b.surface_F)
         side = np.sum(off * n, axis=1) / (t / 2)
         assert np.all(side > 0.95) if lam.family == 1 else np.all(side < -0.95)
@@ -157,11 +166,11 @@ def test_scene_decodes_to_the_bundle_geometry(gg):
     assert _tri_areas(Vs.astype(float), Fs.astype(np.int64)).sum() == pytest.approx(
         surface_area(b.surface_V, b.surface_F), rel=1e-6)
     # the last state: every strip near the aligned joints' line (the x axis)
-    Vk = decode(S["strips"]["V"][-1], "f4").reshape(-1, 4, 3).mean(axis=1)
+    Vk = strip_vertices(S, -1).reshape(-1, 4, 3).mean(axis=1)
     assert np.abs(Vk[:, 1:]).max() < 1e-2 * L  # between joints: the carried axis (spline)
     # a lamella kept isometric (family 1 of this case: its joints at their arc lengths on the
     # line) keeps its section in the aligned state: the strip neither collapses nor stretches
-    Vk = decode(S["strips"]["V"][-1], "f4").reshape(-1, 3).astype(float)
+    Vk = strip_vertices(S, -1)
     for rec in S["lamellae"]:
         if rec["family"] == 1:
             a = _tri_areas(Vk[rec["v0"]:rec["v0"] + rec["nv"]],
@@ -207,7 +216,7 @@ def test_scene_utilisation_from_structure_json(gg):
         else:
             assert np.allclose(seg, 0.1)
     html = write_report(gg).read_text(encoding="utf-8")
-    assert '"has_structure":true' in html
+    assert _scene_of(html)["has_structure"] is True
     (gg / "structure.json").write_text('{"lamellae": 3}')
     with pytest.raises(InputError, match="structure.json"):
         build_scene(gg)
@@ -312,3 +321,18 @@ def test_report_in_headless_chromium(tmp_path):
         br.close()
     assert not problems, problems
     assert not requests, requests
+
+
+def test_strip_faces_follow_from_the_samples_alone(gg):
+    """The page leaves the strips' faces out (the viewer makes them from each lamella's
+    samples, as strip_solid_faces does): the scene's faces are exactly those."""
+    from gridshell.geometry.strips3d import strip_solid_faces
+
+    S = build_scene(gg)
+    F = decode(S["strips"]["F"], "u4").reshape(-1, 3).astype(np.int64)
+    for rec in S["lamellae"]:
+        k = rec["samples"]
+        assert rec["nv"] == 4 * k and rec["nf"] == 8 * (k - 1) + 4
+        np.testing.assert_array_equal(F[rec["f0"]:rec["f0"] + rec["nf"]],
+                                      strip_solid_faces(k) + rec["v0"])
+    assert sum(r["nf"] for r in S["lamellae"]) == S["strips"]["nf"] == len(F)

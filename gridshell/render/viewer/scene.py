@@ -1,7 +1,8 @@
 """The scene of the WebGL viewer: a bundle's surface, strips and joints as compact arrays.
 
 Everything the page draws, in metres, as little-endian float32 / uint32 arrays in base64
-(:func:`encode`, :func:`decode`):
+(:func:`encode`, :func:`decode`; the strips' vertices, most of the scene, as uint16 over their
+bounding box, :func:`quantized` / :func:`strip_vertices`):
 
 - the **surface** (``surface.obj``, triangulated);
 - the **strips**: each lamella axis resampled to ``m`` points by arc length and swept by the
@@ -39,14 +40,16 @@ from gridshell.geometry.strips3d import (is_tangent, nearest_vertex_normals, pac
 from gridshell.geometry.vectors import row_norms, unit_rows as _unit
 from gridshell.design.section import resolve_section
 
-__all__ = ["encode", "decode", "build_scene", "scene_json", "strip_solids_vertices",
-           "MAX_SAMPLES", "MAX_STATES"]
+__all__ = ["encode", "decode", "build_scene", "quantized", "scene_json", "strip_solids_vertices",
+           "strip_vertices", "MAX_SAMPLES", "MAX_STATES", "QUANT"]
 
 #: axis samples per lamella at most (and at least 8); the step is ~1/100 of the bbox diagonal
 MAX_SAMPLES = 96
 _STEP = 1.0 / 100.0
 #: states of the alignment sequence shown at most (evenly picked, first and last kept)
-MAX_STATES = 25
+MAX_STATES = 9
+#: the strips' vertices are stored as uint16 over their bounding box: this many steps
+QUANT = 65535
 #: a joint's loops count as collapsed below this fraction of their deployed vector area
 _COLLAPSED = 1e-3
 
@@ -55,6 +58,23 @@ def encode(a: np.ndarray, dtype: str) -> str:
     """Base64 of ``a`` as little-endian ``dtype`` ("f4" or "u4"), flattened."""
     arr = np.ascontiguousarray(np.asarray(a).reshape(-1), dtype=np.dtype(dtype).newbyteorder("<"))
     return base64.b64encode(arr.tobytes()).decode("ascii")
+
+
+def quantized(X: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> str:
+    """Base64 of the points ``X (k, 3)`` as little-endian uint16 per coordinate over the box
+    ``lo``, ``hi`` (:data:`QUANT` steps: about 1.5e-5 of the box)."""
+    span = np.where(hi > lo, hi - lo, 1.0)
+    q = np.rint((np.asarray(X, float).reshape(-1, 3) - lo) / span * QUANT)
+    return encode(np.clip(q, 0, QUANT), "u2")
+
+
+def strip_vertices(S: dict[str, Any], k: int) -> np.ndarray:
+    """The strip vertices ``(nv, 3)`` (metres) of state ``k`` of a scene (:func:`build_scene`),
+    from their uint16 quantization (:func:`quantized`)."""
+    st = S["strips"]
+    lo, hi = np.asarray(st["quant"]["lo"], float), np.asarray(st["quant"]["hi"], float)
+    span = np.where(hi > lo, hi - lo, 1.0)
+    return lo + decode(st["V"][k], "u2").reshape(-1, 3).astype(float) / QUANT * span
 
 
 def decode(text: str, dtype: str) -> np.ndarray:
@@ -382,14 +402,18 @@ def build_scene(bundle_dir: str | os.PathLike) -> dict[str, Any]:
     Ftri = Ftri[np.all(Ftri >= 0, axis=1)]
     lo, hi = allP.min(axis=0), allP.max(axis=0)
     lo_hi = _extremes(strip_V)
+    q_lo = np.min([X.min(axis=0) for X in strip_V], axis=0)
+    q_hi = np.max([X.max(axis=0) for X in strip_V], axis=0)
     return {
-        "format": "gridshell.viewer", "version": 1, "kind": b.kind, "units": "m",
+        "format": "gridshell.viewer", "version": 2, "kind": b.kind, "units": "m",
         "tangent": bool(tangent), "section": _section_json(section),
         "bbox": [lo.tolist(), hi.tolist()],
         "surface": {"V": encode(V, "f4"), "F": encode(Ftri, "u4"), "nv": len(V),
                     "nf": len(Ftri)},
         "strips": {"F": encode(strip_F, "u4"), "nv": int(len(strip_V[0])),
-                   "nf": int(len(strip_F)), "V": [encode(X, "f4") for X in strip_V]},
+                   "nf": int(len(strip_F)),
+                   "quant": {"lo": q_lo.tolist(), "hi": q_hi.tolist(), "steps": QUANT},
+                   "V": [quantized(X, q_lo, q_hi) for X in strip_V]},
         "lamellae": _lamellae_json(lams, arcs, fracs, offsets, lam_util),
         "joints": {"n": int(len(net.joints)), "radius": min(0.6 * w, diag / 80.0),
                    "V": [encode(J, "f4") for J in states],
@@ -426,11 +450,15 @@ def _lamellae_json(lams: list, arcs: list, fracs: list, offsets: list,
             for lam, s, f, o in zip(lams, arcs, fracs, offsets)]
 
 
-def scene_json(bundle_dir: str | os.PathLike) -> str:
-    """:func:`build_scene` as compact JSON, safe inside an HTML ``<script>`` element."""
+def scene_json(bundle_dir: str | os.PathLike, faces: bool = True) -> str:
+    """:func:`build_scene` as compact JSON, safe inside an HTML ``<script>`` element; without
+    ``faces`` the strips' faces are left out (they depend on each lamella's number of samples
+    alone, :func:`gridshell.geometry.strips3d.strip_solid_faces`: the viewer makes them)."""
     from gridshell.design.bundle import finite_json
 
-    text = json.dumps(finite_json(build_scene(bundle_dir)), separators=(",", ":"),
-                      allow_nan=False)
+    S = build_scene(bundle_dir)
+    if not faces:
+        S["strips"].pop("F")
+    text = json.dumps(finite_json(S), separators=(",", ":"), allow_nan=False)
     # no "<" (base64 and numbers have none): no "</" either, and the 2 MB need no second scan
     return text.replace("</", "<\\/") if "<" in text else text

@@ -5,8 +5,39 @@
   "use strict";
   var root = document.getElementById("gridshell-viewer");
   var dataEl = document.getElementById("gridshell-scene");
+  var threeEl = document.getElementById("gridshell-three");
   if (!root || !dataEl) { return; }
-  var S = JSON.parse(dataEl.textContent);
+
+  // the scene and three.js come gzip-compressed in base64 (render/viewer/page.py)
+  function unpack(elem) {
+    if (elem.type !== "application/gzip") { return Promise.resolve(elem.textContent); }
+    if (typeof DecompressionStream === "undefined") {
+      return Promise.reject(new Error("no DecompressionStream"));
+    }
+    var bin = atob(elem.textContent.trim()), u8 = new Uint8Array(bin.length);
+    for (var i = 0; i < bin.length; i++) { u8[i] = bin.charCodeAt(i); }
+    var stream = new Blob([u8]).stream().pipeThrough(new DecompressionStream("gzip"));
+    return new Response(stream).text();
+  }
+  Promise.all([unpack(dataEl), threeEl ? unpack(threeEl) : Promise.resolve(null)]).then(
+    function (texts) {
+      if (texts[1] !== null && typeof THREE === "undefined") {
+        var lib = document.createElement("script");
+        lib.textContent = texts[1];
+        document.head.appendChild(lib);             // runs now: defines THREE
+      }
+      start(JSON.parse(texts[0]));
+    },
+    function () {
+      var note = document.createElement("p");
+      note.className = "gv-note";
+      note.textContent = "This browser cannot unpack the 3D view (it needs " +
+        "DecompressionStream: Chrome 80, Firefox 113, Safari 16.4 or later). " +
+        "The pictures below show the design.";
+      root.querySelector(".gv-view").appendChild(note);
+    });
+
+  function start(S) {
 
   function bytes(b64) {
     var bin = atob(b64), u8 = new Uint8Array(bin.length);
@@ -63,8 +94,35 @@
   surface.renderOrder = 0;
   world.add(surface);
 
-  var stripPos = S.strips.V.map(f32);
-  var stripIdx = u32(S.strips.F);
+  // strip vertices: uint16 over their box (render/viewer/scene.py, quantized)
+  var Q = S.strips.quant;
+  function dequant(b64) {
+    var u = new Uint16Array(bytes(b64)), out = new Float32Array(u.length);
+    var sp = [0, 1, 2].map(function (c) { return (Q.hi[c] > Q.lo[c] ? Q.hi[c] - Q.lo[c] : 1) / Q.steps; });
+    for (var i = 0; i < u.length; i++) { out[i] = Q.lo[i % 3] + u[i] * sp[i % 3]; }
+    return out;
+  }
+  var stripPos = S.strips.V.map(dequant);
+  // the faces of each lamella's solid depend on its number of samples k alone
+  // (geometry/strips3d.py strip_solid_faces: vertex 4i + c is corner c of section i)
+  function solidFaces() {
+    var F = new Uint32Array(S.strips.nf * 3);
+    S.lamellae.forEach(function (lam) {
+      var k = lam.samples, v = lam.v0, f = 3 * lam.f0;
+      for (var a = 0; a < 4; a++) {
+        var b = (a + 1) % 4;
+        for (var i = 0; i < k - 1; i++) {
+          var p = v + 4 * i;
+          F.set([p + a, p + b, p + 4 + b, p + a, p + 4 + b, p + 4 + a], f);
+          f += 6;
+        }
+      }
+      var last = v + 4 * (k - 1);
+      F.set([v, v + 2, v + 1, v, v + 3, v + 2, last, last + 1, last + 2, last, last + 2, last + 3], f);
+    });
+    return F;
+  }
+  var stripIdx = S.strips.F ? u32(S.strips.F) : solidFaces();
   var nStripV = S.strips.nv;
   var posAttr = new THREE.BufferAttribute(new Float32Array(stripPos[0]), 3);
   posAttr.setUsage(THREE.DynamicDrawUsage);
@@ -339,4 +397,5 @@
   root.setAttribute("data-ready", "1");
   window.gridshellViewer = {setState: setState, render: render,
                             states: S.states.length, scene: S};
+  }
 })();
