@@ -49,6 +49,19 @@ def png_bytes(fig: Any, pad: int = 8) -> bytes:
     return buf.getvalue()
 
 
+#: pictures of states and frames are at least this wide (pixels) after cropping: drawn again
+#: at a higher resolution when the content of the first drawing is narrower (issue 30)
+MIN_FRAME_PX = 800
+
+
+def dpi_for_width(dpi: float, width: int, target: int = MIN_FRAME_PX) -> int | None:
+    """The resolution at which content ``width`` pixels wide at ``dpi`` becomes ``target``
+    pixels wide (8 % to spare: the crop's margins do not scale), or None when it already is."""
+    if width >= target or width <= 0:
+        return None
+    return int(np.ceil(dpi * target / width * 1.08))
+
+
 def content_box(images: Sequence[np.ndarray], pad: int = 8) -> tuple[int, int, int, int]:
     """``(y0, y1, x0, x1)``: the smallest box holding every non-white pixel of all the
     ``(h, w, 3)`` uint8 images (one size), widened by ``pad`` pixels; the whole image when all

@@ -13,7 +13,8 @@ from typing import Sequence
 import numpy as np
 
 from gridshell.core.errors import InputError
-from gridshell.render.figure import content_box, cube_limits, png_bytes, pyplot
+from gridshell.render.figure import (MIN_FRAME_PX, content_box, cube_limits, dpi_for_width,
+                                     png_bytes, pyplot)
 
 __all__ = ["edge_map", "vertex_map", "collapse_plot", "sequence_frames", "gif"]
 
@@ -102,15 +103,37 @@ def collapse_plot(points: np.ndarray, normals: np.ndarray, joints: np.ndarray | 
 
 
 def sequence_frames(frames: Sequence[np.ndarray], edges: np.ndarray, *, title: str = "",
-                    dpi: int = 80, elev: float = 25.0, azim: float = -60.0) -> list[bytes]:
+                    dpi: int = 80, elev: float = 25.0, azim: float = -60.0,
+                    min_width: int = MIN_FRAME_PX) -> list[bytes]:
     """PNG bytes of every state ``(n, 3)`` of the alignment sequence, same axes for all.
 
     One figure is drawn for all states (the edges and joints are moved, the title changed),
     and every picture is cropped to the one box that holds the content of all of them (plus
     :data:`_PAD` pixels, :func:`~.figure.content_box`): all PNGs have one size, ready for
-    :func:`gif`."""
-    from mpl_toolkits.mplot3d.art3d import Line3DCollection
+    :func:`gif`, at least ``min_width`` pixels wide (drawn again at a higher ``dpi`` when the
+    content is narrower)."""
     from PIL import Image
+
+    rgb, box = _frame_pixels(frames, edges, title, dpi, elev, azim)
+    for _ in range(3):                      # the crop's margins do not scale: at most 3 tries
+        better = dpi_for_width(dpi, box[3] - box[2], min_width)
+        if better is None:
+            break
+        dpi = better
+        rgb, box = _frame_pixels(frames, edges, title, dpi, elev, azim)
+    y0, y1, x0, x1 = box
+    out = []
+    for a in rgb:
+        buf = io.BytesIO()
+        Image.fromarray(a[y0:y1, x0:x1]).save(buf, format="PNG")
+        out.append(buf.getvalue())
+    return out
+
+
+def _frame_pixels(frames, edges, title: str, dpi: float, elev: float, azim: float):
+    """The RGB arrays of :func:`sequence_frames`' drawings at ``dpi`` and their common
+    content box."""
+    from mpl_toolkits.mplot3d.art3d import Line3DCollection
 
     plt = pyplot()
     E = np.asarray(edges, np.int64).reshape(-1, 2)
@@ -137,13 +160,7 @@ def sequence_frames(frames: Sequence[np.ndarray], edges: np.ndarray, *, title: s
             rgb.append(np.asarray(fig.canvas.buffer_rgba())[..., :3].copy())
     finally:
         plt.close(fig)
-    y0, y1, x0, x1 = content_box(rgb, _PAD)
-    out = []
-    for a in rgb:
-        buf = io.BytesIO()
-        Image.fromarray(a[y0:y1, x0:x1]).save(buf, format="PNG")
-        out.append(buf.getvalue())
-    return out
+    return rgb, content_box(rgb, _PAD)
 
 
 def gif(pngs: Sequence[bytes], duration_ms: int = 250) -> bytes:

@@ -173,7 +173,40 @@ def _data_uri(path: Path) -> str:
         smaller = _smaller_picture(data)
         if smaller is not None and len(smaller[1]) < len(data):
             mime, data = smaller
+    elif mime == "image/gif" and len(data) > GIF_ABOVE:
+        data = _smaller_gif(data) or data
     return f"data:{mime};base64," + base64.b64encode(data).decode("ascii")
+
+
+#: an animated GIF larger than this (bytes) is embedded at :data:`GIF_WIDTH` pixels wide
+GIF_ABOVE = 200_000
+GIF_WIDTH = 560
+
+
+def _smaller_gif(gif: bytes) -> bytes | None:
+    """The animated GIF ``gif`` scaled down to :data:`GIF_WIDTH` pixels wide (frames, their
+    times and the loop kept), or None if it cannot be read or is not wider."""
+    import io
+
+    from PIL import Image, ImageSequence, UnidentifiedImageError
+
+    try:
+        im = Image.open(io.BytesIO(gif))
+        if im.size[0] <= GIF_WIDTH:
+            return None
+        size = (GIF_WIDTH, max(1, round(im.size[1] * GIF_WIDTH / im.size[0])))
+        frames, times = [], []
+        for fr in ImageSequence.Iterator(im):
+            frames.append(fr.convert("RGB").resize(size, Image.Resampling.LANCZOS))
+            times.append(fr.info.get("duration", 250))
+    except (OSError, UnidentifiedImageError):
+        return None
+    pal = frames[0].quantize(colors=128)
+    out = io.BytesIO()
+    frames = [f.quantize(palette=pal, dither=Image.Dither.NONE) for f in frames]
+    frames[0].save(out, "GIF", save_all=True, append_images=frames[1:], duration=times,
+                   loop=im.info.get("loop", 0), optimize=True)
+    return out.getvalue()
 
 
 def _smaller_picture(png: bytes) -> tuple[str, bytes] | None:

@@ -19,7 +19,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from gridshell.core.errors import InputError
-from gridshell.render.figure import cube_limits, png_bytes, pyplot
+from gridshell.render.figure import MIN_FRAME_PX, cube_limits, dpi_for_width, png_bytes, pyplot
 
 __all__ = ["state_images", "states_png", "sequence_pngs"]
 
@@ -39,14 +39,28 @@ def _edge_colours(n_edges: int, families: np.ndarray | None) -> Any:
 
 def state_images(frames: Sequence[np.ndarray], edges: np.ndarray, *,
                  families: np.ndarray | None = None, dpi: int = 100,
-                 view: tuple[float, float] | None = None) -> list[Any]:
+                 view: tuple[float, float] | None = None,
+                 min_width: int = MIN_FRAME_PX) -> list[Any]:
     """Pictures of the states ``frames [(n, 3)]`` (metres) of a net with ``edges (E, 2)``.
 
     One camera (``view = (elev, azim)`` in degrees, default
     :func:`gridshell.render.ribbons.view_angles` of all states together, so that neither the
     deployed net nor a collapsed line is seen edge-on) and limits over all states; the common
-    white margin is cropped. Returns PIL RGB images, all of one size.
+    white margin is cropped. Returns PIL RGB images, all of one size, at least ``min_width``
+    pixels wide (drawn again at a higher ``dpi`` when the content is narrower).
     """
+    imgs = _state_pictures(frames, edges, families, dpi, view)
+    for _ in range(3):                      # the crop's margins do not scale: at most 3 tries
+        better = dpi_for_width(dpi, imgs[0].size[0], min_width)
+        if better is None:
+            break
+        dpi = better
+        imgs = _state_pictures(frames, edges, families, dpi, view)
+    return imgs
+
+
+def _state_pictures(frames, edges, families, dpi: float, view) -> list[Any]:
+    """:func:`state_images` at ``dpi``."""
     from mpl_toolkits.mplot3d.art3d import Line3DCollection
     from PIL import Image, ImageOps
 
@@ -137,14 +151,17 @@ def states_png(frames: Sequence[np.ndarray], edges: np.ndarray, *,
     families : (E,) int, optional
         Lamella family of each edge, for the colours.
     columns : int, optional
-        States per row (default all in one row up to 4, then rows of 3).
+        States per row (default 2: each state at least
+        :data:`~gridshell.render.figure.MIN_FRAME_PX` wide, the sheet twice that).
     """
-    imgs = state_images(frames, edges, families=families, dpi=dpi)
+    # 10 % more: the sheet's margins and labels take their share of each cell
+    imgs = state_images(frames, edges, families=families, dpi=dpi,
+                        min_width=int(1.1 * MIN_FRAME_PX))
     n = len(imgs)
     labels = list(labels) if labels is not None else [f"state {k}" for k in range(n)]
     if len(labels) != n:
         raise InputError(f"{len(labels)} labels for {n} states")
-    cols = columns or (n if n <= 4 else 3)
+    cols = columns or (n if n <= 2 else 2)
     rows = int(np.ceil(n / cols))
     w, h = imgs[0].size
     plt = pyplot()

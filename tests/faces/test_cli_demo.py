@@ -204,3 +204,19 @@ def test_quick_demo_reports_the_full_scale_snow_case(quick_demo):
     assert f"{eq['deflection_max_mm']:.4g}"[:3] in section
     assert eq["snow_total_kN"] > 0 and eq["bolt_shear_max_N"] > 0
     assert "GG at 1:1 under snow" in json.dumps(summary) or "full_scale" in json.dumps(summary)
+
+
+@pytest.mark.slow
+def test_quick_demo_pictures_are_readable(quick_demo):
+    """Issue 30: the states and frames at least 800 px wide (the GIF from the same frames)."""
+    from PIL import Image
+
+    from gridshell.render.figure import MIN_FRAME_PX
+
+    _, out, _ = quick_demo
+    for k in ("gg", "ncp"):
+        for name in ("sequence/frame_000.png", "alignment.gif"):
+            with Image.open(out / k / name) as im:
+                assert im.width >= MIN_FRAME_PX, (k, name, im.size)
+    with Image.open(out / "gg" / "states.png") as im:
+        assert im.width >= 1.75 * MIN_FRAME_PX

@@ -242,14 +242,17 @@ def test_states_png_strip_and_sequence_pngs():
     with Image.open(io.BytesIO(states_png(frames, E, labels=["deployed", "t = 0.5",
                                                              "collapsed"], title="GG",
                                           families=fam, dpi=60))) as im:
-        assert im.width > 2 * im.height
+        # two states per row, each at least MIN_FRAME_PX wide (issue 30: readable)
+        from gridshell.render.figure import MIN_FRAME_PX
+
+        assert im.width >= 1.75 * MIN_FRAME_PX          # margins and labels aside
         px = np.asarray(im.convert("L"), float)
     ink = px < 200                         # not a white page with small pictures in it
     rows, cols = np.flatnonzero(ink.any(1)), np.flatnonzero(ink.any(0))
     assert (cols[-1] - cols[0]) > 0.9 * px.shape[1] and (rows[-1] - rows[0]) > 0.8 * px.shape[0]
     pngs = sequence_pngs(frames, E, title="GG alignment", dpi=60)
     sizes = {Image.open(io.BytesIO(b)).size for b in pngs}
-    assert len(pngs) == 3 and len(sizes) == 1
+    assert len(pngs) == 3 and len(sizes) == 1 and min(w for w, _ in sizes) >= MIN_FRAME_PX
     with pytest.raises(InputError, match="labels"):
         states_png(frames, E, labels=["one"])
     with pytest.raises(InputError, match="edge families"):
