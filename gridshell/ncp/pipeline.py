@@ -464,6 +464,7 @@ def _strips_stage(state: dict[str, Any]) -> dict[str, Any]:
         "newton_iterations": [int(i) for i in st["iterations"]],
         "fold_deg_max": float(np.max(st["turn_deg"])),
         "length_error_max": float(np.max(st["length_error"])),
+        "strong_ratio_max": float(np.max(st["strong_ratio"][1:-1], initial=0.0)),
         "approximate": [int(k) for k in np.flatnonzero(st["approximate"])]}
     o.say(f"strips of {len(seq.V)} alignment states: axes within "
           f"{np.degrees(np.max(st['bound'])):.2g} deg, "
@@ -600,7 +601,7 @@ def ncp_files(bundle: DesignBundle, report: dict, *, render: bool = True,
         extra["sequence/strips.npz"] = (lambda p: np.savez_compressed(
             p, **{k: strips[k] for k in ("X", "N", "lamella", "joint", "kcut", "t",
                                          "approximate", "bound", "iterations", "turn_deg",
-                                         "length_error")},
+                                         "length_error", "strong_ratio")},
             method=np.array(strips["method"])))
     if render:
         from gridshell.render import ncp_maps

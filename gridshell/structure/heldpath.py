@@ -26,8 +26,9 @@ bound of a state is the largest angle (radians) between the strips' width direct
 joint and the sequence's axis there; a state whose Newton iteration did not converge or whose
 bound exceeds :data:`AXIS_TOL`, or whose joints fold a lamella (its joint-to-joint chords turn
 by more than :data:`gridshell.structure.states.FOLD_DEG`, or by :data:`FOLD_MARGIN_DEG` more
-than in both end states: the blended kinematic sequence there is no path a strip takes), is
-approximate (reported, not judged).
+than in both end states: the blended kinematic sequence there is no path a strip takes), or
+(an intermediate state) whose strips must bend about their strong axis by more than
+:data:`STRONG_TOL` of the sequence's largest weak-axis curvature, is approximate (reported, not judged).
 """
 from __future__ import annotations
 
@@ -62,6 +63,13 @@ FOLD_MARGIN_DEG = 10.0
 #: approximate: the strips, inextensible, are given the state's chord lengths between joints
 #: (the kinematic sequence keeps them only approximately, paper 4.2.4), as GG's carried states
 LENGTH_TOL = 0.01
+
+#: an intermediate state whose held strips bend about their strong axis by more than this
+#: share of the sequence's largest weak-axis curvature is approximate: a strip 20 times wider than
+#: thick does not bend in its plane where it can bend and twist out of it, so the kinematic
+#: sequence there is not the strips' motion (the criterion of a physical path, issue 28:
+#: strong-axis curvature below 5 % of the weak one)
+STRONG_TOL = 0.05
 
 #: samples of the carried design axis per joint-to-joint piece
 CARRY_SAMPLES = 8
@@ -171,12 +179,29 @@ def held_state(bundle: DesignBundle, V: np.ndarray, R: np.ndarray, r0: np.ndarra
         joint.append(j)
         kcut.append(cut_curvature(sb, lam, s, curve))
     turn = max((max_turn(V[lam.joints]) for lam in lams), default=0.0)
+    strong, weak = _strong_and_weak(X, N, kcut)
     E = bundle.net.edges()
     l0 = np.linalg.norm(np.diff(bundle.net.joints[E], axis=1)[:, 0], axis=1)
     dl = np.abs(np.linalg.norm(np.diff(V[E], axis=1)[:, 0], axis=1) / np.maximum(l0, 1e-300) - 1)
     return {"length_error": float(dl.max(initial=0.0)),"X": X, "N": N, "joint": joint, "kcut": kcut, "ids": [lam.id for lam in lams],
             "converged": bool(res.converged), "iterations": int(res.iterations),
-            "bound": bound, "turn_deg": turn}
+            "bound": bound, "turn_deg": turn, "strong": strong, "weak": weak}
+
+
+def _strong_and_weak(X: list, N: list, kcut: list) -> tuple[float, float]:
+    """The largest strong-axis curvature change (in-plane, against the cut curvature, signed
+    like it) and the largest weak-axis curvature of the strips ``X, N`` (1/m of the design)."""
+    from gridshell.structure.frames import darboux_curvatures
+
+    strong = weak = 0.0
+    for x, n, kc in zip(X, N, kcut):
+        dc = darboux_curvatures(x, n)
+        if np.sum((dc.kn - kc) ** 2) > np.sum((dc.kn + kc) ** 2):
+            kc = -kc
+        inner = slice(1, -1) if len(x) > 2 else slice(None)
+        strong = max(strong, float(np.abs(dc.kn - kc)[inner].max(initial=0.0)))
+        weak = max(weak, float(np.abs(dc.kg)[inner].max(initial=0.0)))
+    return strong, weak
 
 
 def held_path(bundle: DesignBundle, frames: list[np.ndarray], axes: list[np.ndarray],
@@ -202,13 +227,17 @@ def held_path(bundle: DesignBundle, frames: list[np.ndarray], axes: list[np.ndar
     bound = np.array([s["bound"] for s in states])
     turn = np.array([s["turn_deg"] for s in states])
     folded = (turn > FOLD_DEG) | (turn > max(turn[0], turn[-1]) + FOLD_MARGIN_DEG)
+    weak_max = max(max(s["weak"] for s in states), 1e-300)
+    ratio = np.array([s["strong"] for s in states]) / weak_max
+    forced = ratio > STRONG_TOL
+    forced[[0, -1]] = False                    # the end states are the design's own
     approximate = np.array([(not s["converged"]) or s["bound"] > AXIS_TOL or
-                            s["length_error"] > LENGTH_TOL for s in states]) | folded
+                            s["length_error"] > LENGTH_TOL for s in states]) | folded | forced
     return {"X": np.stack([np.concatenate(s["X"]) for s in states]),
             "N": np.stack([np.concatenate(s["N"]) for s in states]),
             "lamella": lamella, "joint": np.concatenate(states[0]["joint"]),
             "kcut": np.concatenate(states[0]["kcut"]), "t": np.asarray(t, float),
             "approximate": approximate, "bound": bound, "method": METHOD_HELD,
             "iterations": np.array([s["iterations"] for s in states]),
-            "turn_deg": turn,
+            "turn_deg": turn, "strong_ratio": ratio,
             "length_error": np.array([s["length_error"] for s in states])}

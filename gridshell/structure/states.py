@@ -301,7 +301,9 @@ PATH_APPROXIMATE = {
                    "joint-to-joint length by more than 1 %, or the kinematic sequence "
                    "folds a lamella there (its joint-to-joint chords turn by more than 30 "
                    "degrees, or by 10 degrees more than in both end states: no path a strip "
-                   "takes); reported, not judged")}
+                   "takes), or (between the ends) it bends the strips about their strong "
+                   "axis by more than 5 % of their weak-axis curvature (not the strips' own "
+                   "motion); reported, not judged")}
 
 
 def bundle_states(bundle: DesignBundle, path: Path | None, section: Section,
