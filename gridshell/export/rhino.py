@@ -3,7 +3,8 @@
 **Units and frame.** The model is in the user's unit and frame: ``ModelUnitSystem`` is the
 bundle's input unit (``design.json`` ``"units"``, metres when absent; ``units=`` overrides it)
 and every coordinate is the bundle's metres divided by the unit's size in metres. Nothing is
-moved. Lengths in user strings are in the same unit (``units`` names it) and in metres
+moved but the collapsed state and the surface of revolution, which live in frames of their own
+and are placed onto the design by the best rigid fit (``collapsed``, ``revolution`` below). Lengths in user strings are in the same unit (``units`` names it) and in metres
 (``*_m``).
 
 **Layers and objects**::
@@ -25,8 +26,11 @@ moved. Lengths in user strings are in the same unit (``units`` names it) and in 
                       cylinders) per lamella and joint, the hole through the strip (real
                       diameter = hole / scale)
     collapsed         the collapsed (aligned) state: one polyline per lamella through its
-                      aligned joints (aligned.obj)
-    revolution        GG: the isometric surface of revolution as a mesh
+                      aligned joints (aligned.obj), moved rigidly onto the deployed joints
+                      (best fit): in the input's frame, through the middle of the net
+    revolution        GG: the isometric surface of revolution as a mesh, moved rigidly onto
+                      the designed surface (best fit of its grid to surface.obj's) when the
+                      two grids match, else as stored
     sheet 01, ...     the cut sheets, one layer each, as curves in the XY plane beside the
                       model: the sheet's border, each part's outline (arcs exact), holes,
                       score marks and engraved labels, at the physical size of the cut files
@@ -353,17 +357,18 @@ def _body(bundle, *, name: str, units: Any, params: Any, bspline: Any) -> dict[s
                               bspline.knots_v, m.u(bspline.ctrl)),
             m.attrs("B-spline surface", "B-spline surface", kind=bundle.kind))
     if bundle.revolution_V is not None:
-        m.model.Objects.AddMesh(geo.mesh(m.u(bundle.revolution_V), bundle.revolution_F),
+        m.model.Objects.AddMesh(geo.mesh(m.u(_placed_revolution(bundle)), bundle.revolution_F),
                                 m.attrs("revolution", "surface of revolution", kind=bundle.kind))
     strips = _strips(m, bundle, params, with_holes)
 
     through: dict[int, list[int]] = {}
+    collapsed = _placed_collapsed(bundle)
     for lam in bundle.net.lamellae:
         for j in lam.joints.tolist():
             through.setdefault(j, []).append(int(lam.id))
         if len(lam.joints) >= 2:
             m.model.Objects.AddPolyline(
-                geo.point_list(m.u(bundle.aligned[lam.joints])),
+                geo.point_list(m.u(collapsed[lam.joints])),
                 m.attrs("collapsed", f"L{lam.id} collapsed", state="collapsed",
                         lamella_id=int(lam.id), family=int(lam.family),
                         joints=" ".join(str(j) for j in lam.joints.tolist())))
@@ -567,3 +572,27 @@ def _cut_sheets(judged, bundle, fab, force: bool) -> tuple[bool, str, Any, Any, 
     if not (ok or force):
         return ok, why, None, fab, None
     return (ok, why, *plan_sheets(bundle, fab))
+
+
+def _placed_collapsed(bundle) -> np.ndarray:
+    """The aligned joints ``(n, 3)`` moved by the rigid motion that best fits them to the
+    deployed joints (metres of the design)."""
+    from gridshell.geometry.vectors import rigid_fit
+
+    A = np.asarray(bundle.aligned, float)
+    if len(A) < 3:
+        return A
+    R, b = rigid_fit(A, bundle.net.joints)
+    return A @ R.T + b
+
+
+def _placed_revolution(bundle) -> np.ndarray:
+    """The surface of revolution's vertices moved by the rigid motion that best fits them to
+    the designed surface's, vertex for vertex (the two grids match), else as stored."""
+    from gridshell.geometry.vectors import rigid_fit
+
+    V = np.asarray(bundle.revolution_V, float)
+    if V.shape != np.asarray(bundle.surface_V).shape or len(V) < 3:
+        return V
+    R, b = rigid_fit(V, bundle.surface_V)
+    return V @ R.T + b

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["row_norms", "unit_rows"]
+__all__ = ["rigid_fit", "row_norms", "unit_rows"]
 
 
 def row_norms(X: np.ndarray) -> np.ndarray:
@@ -20,3 +20,14 @@ def unit_rows(X: np.ndarray) -> np.ndarray:
     Dimensionless."""
     n = row_norms(X)[..., None]
     return np.divide(X, n, out=np.zeros_like(X), where=n > 0)
+
+
+def rigid_fit(A: np.ndarray, B: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Rotation ``R (3, 3)`` and translation ``b (3,)`` with ``A @ R.T + b`` closest to ``B``
+    (``(k, 3)`` corresponding points; least squares, a proper rotation: Kabsch)."""
+    A, B = np.asarray(A, float), np.asarray(B, float)
+    ca, cb = A.mean(0), B.mean(0)
+    U, _, Vt = np.linalg.svd((A - ca).T @ (B - cb))
+    d = np.sign(np.linalg.det(Vt.T @ U.T)) or 1.0
+    R = Vt.T @ np.diag([1.0, 1.0, d]) @ U.T
+    return R, cb - ca @ R.T

@@ -39,6 +39,7 @@ from scipy.interpolate import CubicSpline
 from scipy.spatial.transform import Rotation, Slerp
 
 from gridshell.geometry.net import Net, polyline_arclength
+from gridshell.geometry.vectors import rigid_fit
 from gridshell.gg.alignment import GGSequence
 from gridshell.gg.clairaut import IntrinsicNet
 from gridshell.gg.mapback import NetParameters, SurfaceMap, net_parameters
@@ -118,17 +119,6 @@ class GGPath(GGSequence):
 def _unit(X: np.ndarray) -> np.ndarray:
     n = np.linalg.norm(X, axis=-1, keepdims=True)
     return X / np.where(n > 0, n, 1.0)
-
-
-def _kabsch(A: np.ndarray, B: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Rotation ``R`` and translation ``b`` with ``A @ R.T + b`` closest to ``B`` (least
-    squares, proper rotation)."""
-    ca, cb = A.mean(0), B.mean(0)
-    H = (A - ca).T @ (B - cb)
-    U, _, Vt = np.linalg.svd(H)
-    d = np.sign(np.linalg.det(Vt.T @ U.T)) or 1.0
-    R = Vt.T @ np.diag([1.0, 1.0, d]) @ U.T
-    return R, cb - ca @ R.T
 
 
 class _Profile:
@@ -341,7 +331,7 @@ def _carried_state(dep, rev1, revl, lam, lamella, joint, excess):
             x, n = _strip(np.linalg.norm(np.diff(Xd[m], axis=0), axis=1), Fl[0],
                           rl + lam * excess[int(lid)])
             if len(j) >= 2:
-                R, b = _kabsch(x[on], target[j])
+                R, b = rigid_fit(x[on], target[j])
             else:
                 R, b = np.eye(3), (Xl[m] + lam * (Xd[m] - X1[m])).mean(0) - x.mean(0)
             x, n = x @ R.T + b, n @ R.T
@@ -380,7 +370,7 @@ def _rigid_towards(J: np.ndarray, target: np.ndarray):
     """``move(X, tau)``: the rigid motion carrying ``J`` onto ``target`` (best fit), done the
     fraction ``tau`` (rotation by ``tau`` times its angle about the centre of ``J``, which
     moves ``tau`` of the way); ``move(N, tau, vector=True)`` turns vectors."""
-    Rf, bf = _kabsch(J, target)
+    Rf, bf = rigid_fit(J, target)
     rot = Slerp([0.0, 1.0], Rotation.from_matrix(np.stack([np.eye(3), Rf])))
     c = J.mean(0)
     shift = c @ Rf.T + bf - c
@@ -425,7 +415,7 @@ def gg_path(inet: IntrinsicNet, rev: Revolution, net: Net, aligned: np.ndarray,
     off = np.linalg.norm(X_dep[joint >= 0] - joints[joint[joint >= 0]], axis=1)
     if np.max(off, initial=0.0) > (1e-6 if P is not None else CARRY_TOL) * diag:
         return None                                     # the net was not mapped through P
-    R, b = _kabsch(J1, joints)                          # revolution frame -> design frame
+    R, b = rigid_fit(J1, joints)                          # revolution frame -> design frame
     gap = float(np.max(np.linalg.norm(J1 @ R.T + b - joints, axis=1))) / diag
     if np.dot(N_dep.ravel(), (N1 @ R.T).ravel()) < 0:
         N_dep = -N_dep                                  # one orientation for all states

@@ -242,7 +242,17 @@ def test_layers_objects_and_user_strings(tmp_path):
     assert np.linalg.norm(centre - b.net.joints[j]) < 0.01
     col = objs["collapsed"][0]
     assert col.Attributes.GetUserString("state") == "collapsed"
-    np.testing.assert_allclose(_points(col.Geometry), b.aligned[b.net.lamellae[0].joints])
+    # in the input's frame: the aligned joints moved rigidly onto the deployed ones (issue 30)
+    from gridshell.geometry.vectors import rigid_fit
+
+    R, t = rigid_fit(b.aligned, b.net.joints)
+    lam0 = b.net.lamellae[0].joints
+    np.testing.assert_allclose(_points(col.Geometry), b.aligned[lam0] @ R.T + t, atol=1e-9)
+    got = np.concatenate([_points(o.Geometry) for o in objs["collapsed"]])
+    assert np.linalg.norm(got.mean(0) - b.net.joints.mean(0)) < \
+        0.25 * np.linalg.norm(np.ptp(b.net.joints, axis=0))
+    seg = lambda P: np.linalg.norm(np.diff(P, axis=0), axis=1)     # noqa: E731 (rigid)
+    np.testing.assert_allclose(seg(_points(col.Geometry)), seg(b.aligned[lam0]), rtol=1e-9)
     assert model.Strings["gridshell.kind"] == "GG"
     assert not list(tmp_path.glob(".gg.3dm*"))  # atomic
 
@@ -320,10 +330,17 @@ def test_failing_design_has_no_sheets_unless_forced(tmp_path):
 
 def test_3dm_with_revolution_and_errors(tmp_path):
     b = make_bundle("GG")
-    b.revolution_V, b.revolution_F = b.surface_V + [0, 0, 1], b.surface_F
+    # the surface of revolution in a frame of its own (turned and moved): placed back onto
+    # the designed surface by the best rigid fit of the two grids
+    c, s_ = np.cos(0.8), np.sin(0.8)
+    Q = np.array([[c, -s_, 0.0], [s_, c, 0.0], [0.0, 0.0, 1.0]])
+    b.revolution_V, b.revolution_F = b.surface_V @ Q.T + [5.0, -2.0, 1.0], b.surface_F
     out = export_3dm(b, tmp_path / "rev.3dm", sheets=False)["path"]
     _, names, objs = _read(out)
     assert "revolution" in names and len(objs["revolution"]) == 1
+    mesh = objs["revolution"][0].Geometry
+    V = np.array([[p.X, p.Y, p.Z] for p in mesh.Vertices])
+    assert np.abs(V - b.surface_V).max() < 1e-5 * np.linalg.norm(np.ptp(b.surface_V, 0))
     with pytest.raises(InputError, match=".3dm"):
         export_3dm(b, tmp_path / "model.obj")
     with pytest.raises(InputError, match="not a design bundle"):
