@@ -295,6 +295,15 @@ def test_report_in_headless_chromium(tmp_path):
         blank, spread = _blank(before)
         assert not blank, f"the canvas is blank (pixel spread {spread:.1f})"
         (tmp_path / "before.png").write_bytes(before)
+        # the model fills most of its canvas (issue 30): what differs from the background
+        # spans most of the width or the height
+        img = np.asarray(Image.open(io.BytesIO(before)).convert("RGB"), float)
+        ink = np.abs(img - np.array([0xf4, 0xf5, 0xf7], float)).max(axis=2) > 12
+        ys = np.nonzero(ink.mean(axis=1) > 0.01)[0]     # rows / columns the model crosses
+        xs = np.nonzero(ink.mean(axis=0) > 0.01)[0]
+        fx, fy = (xs[-1] - xs[0]) / img.shape[1], (ys[-1] - ys[0]) / img.shape[0]
+        assert max(fx, fy) > 0.7 and max(fx, fy) < 0.99, \
+            f"the model spans {100 * fx:.0f} % x {100 * fy:.0f} % of the canvas"
         br.evaluate("document.querySelector('[data-control=state]').focus()")
         br.key("End", 35)
         assert br.evaluate("document.querySelector('[data-control=state]').value") == "2"

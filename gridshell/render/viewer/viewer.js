@@ -188,9 +188,22 @@
   var controls = new THREE.OrbitControls(camera, canvas);
   controls.enableDamping = false;
 
+  // the extent (diagonal) of the strips shown in a state: the home view frames that state
+  function stateDiag(k) {
+    var P = stripPos[k], a = [Infinity, Infinity, Infinity], b = [-Infinity, -Infinity, -Infinity];
+    for (var i = 0; i < P.length; i++) {
+      var c = i % 3;
+      if (P[i] < a[c]) { a[c] = P[i]; }
+      if (P[i] > b[c]) { b[c] = P[i]; }
+    }
+    return Math.hypot(b[0] - a[0], b[1] - a[1], b[2] - a[2]) || diag;
+  }
+
   function homeView() {
     var ext = new THREE.Vector3(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
-    var d = 1.0 * diag / (2 * Math.tan(THREE.MathUtils.degToRad(camera.fov / 2)));
+    // the state's diagonal over 0.75 of the view's height (wider views: of its width too)
+    var fit = stateDiag(shownCentre) / Math.min(1, camera.aspect || 1);
+    var d = 0.75 * fit / (2 * Math.tan(THREE.MathUtils.degToRad(camera.fov / 2)));
     var dir = new THREE.Vector3(ext.y >= ext.x ? 0.85 : 0.35, ext.y >= ext.x ? -0.35 : -0.85,
                                 0.75).normalize();
     camera.position.copy(dir.multiplyScalar(d));
