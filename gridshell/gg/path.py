@@ -252,20 +252,13 @@ def _segment_frames(X: np.ndarray, N: np.ndarray) -> np.ndarray:
     return np.stack([T, np.cross(n, T), n], axis=2)
 
 
-def _turns(X: np.ndarray, N: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Segment frames ``(k-1, 3, 3)`` of a strip and the rotation vectors ``(k-2, 3)`` that
-    turn each into the next, in the segment's own frame (its discrete Darboux rotations:
-    bending about both axes and twist, times the segment length)."""
-    F = _segment_frames(X, N)
-    loc = np.einsum("kji,kjl->kil", F[:-1], F[1:])          # F_i^T F_i+1
-    return F, Rotation.from_matrix(loc).as_rotvec() if len(loc) else np.zeros((0, 3))
-
-
 def _lamella_turns(X: np.ndarray, N: np.ndarray, lamella: np.ndarray
                    ) -> dict[int, tuple[np.ndarray, np.ndarray]]:
-    """:func:`_turns` of every lamella of the strips ``X, N (M, 3)`` (``lamella (M,)``: the
-    samples of a lamella consecutive) at once: lamella id -> (segment frames, turns), for
-    lamellae of at least 3 samples."""
+    """Per lamella of the strips ``X, N (M, 3)`` (``lamella (M,)``: the samples of a lamella
+    consecutive), all at once: lamella id -> (segment frames ``(k-1, 3, 3)``, the rotation
+    vectors ``(k-2, 3)`` that turn each frame into the next in the segment's own frame: its
+    discrete Darboux rotations, bending about both axes and twist times the segment length),
+    for lamellae of at least 3 samples."""
     F = _segment_frames(X, N)                                # (M-1): some span two lamellae
     same = lamella[1:] == lamella[:-1]
     pair = same[:-1] & same[1:]
@@ -283,7 +276,7 @@ def _lamella_turns(X: np.ndarray, N: np.ndarray, lamella: np.ndarray
 
 def _strip(ell: np.ndarray, F0: np.ndarray, rv: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The strip ``(X (k,3), N (k,3))`` with segment lengths ``ell (k-1,)``, first segment
-    frame ``F0`` and the turns ``rv (k-2, 3)`` (:func:`_turns`), from the origin."""
+    frame ``F0`` and the turns ``rv (k-2, 3)`` (:func:`_lamella_turns`), from the origin."""
     L = Rotation.from_rotvec(rv).as_matrix() if len(rv) else np.zeros((0, 3, 3))
     F = np.empty((len(ell), 3, 3))
     F[0] = F0

@@ -42,7 +42,8 @@ from gridshell.geometry.net import Lamella, Net, polyline_arclength
 from gridshell.structure import rod
 from gridshell.structure.materials import get_material
 from gridshell.structure.section import Section
-from gridshell.structure.states import FOLD_DEG, max_turn
+from gridshell.measure.metrics import delta_l
+from gridshell.structure.states import FOLD_DEG, max_turn, signed_like
 
 __all__ = ["AXIS_TOL", "METHOD_HELD", "SECTION", "carried_lamellae", "held_path", "held_state"]
 
@@ -178,14 +179,13 @@ def held_state(bundle: DesignBundle, V: np.ndarray, R: np.ndarray, r0: np.ndarra
         N.append(Nn)
         joint.append(j)
         kcut.append(cut_curvature(sb, lam, s, curve))
-    turn = max((max_turn(V[lam.joints]) for lam in lams), default=0.0)
     strong, weak = _strong_and_weak(X, N, kcut)
-    E = bundle.net.edges()
-    l0 = np.linalg.norm(np.diff(bundle.net.joints[E], axis=1)[:, 0], axis=1)
-    dl = np.abs(np.linalg.norm(np.diff(V[E], axis=1)[:, 0], axis=1) / np.maximum(l0, 1e-300) - 1)
-    return {"length_error": float(dl.max(initial=0.0)),"X": X, "N": N, "joint": joint, "kcut": kcut, "ids": [lam.id for lam in lams],
+    dl = delta_l(bundle.net.joints, V, bundle.net.edges())
+    return {"X": X, "N": N, "joint": joint, "kcut": kcut, "ids": [lam.id for lam in lams],
             "converged": bool(res.converged), "iterations": int(res.iterations),
-            "bound": bound, "turn_deg": turn, "strong": strong, "weak": weak}
+            "bound": bound, "turn_deg": max((max_turn(V[lam.joints]) for lam in lams),
+                                            default=0.0),
+            "length_error": float(np.nanmax(dl, initial=0.0)), "strong": strong, "weak": weak}
 
 
 def _strong_and_weak(X: list, N: list, kcut: list) -> tuple[float, float]:
@@ -196,8 +196,7 @@ def _strong_and_weak(X: list, N: list, kcut: list) -> tuple[float, float]:
     strong = weak = 0.0
     for x, n, kc in zip(X, N, kcut):
         dc = darboux_curvatures(x, n)
-        if np.sum((dc.kn - kc) ** 2) > np.sum((dc.kn + kc) ** 2):
-            kc = -kc
+        kc = signed_like(kc, dc.kn)
         inner = slice(1, -1) if len(x) > 2 else slice(None)
         strong = max(strong, float(np.abs(dc.kn - kc)[inner].max(initial=0.0)))
         weak = max(weak, float(np.abs(dc.kg)[inner].max(initial=0.0)))

@@ -49,8 +49,7 @@ def state_bundle(bundle: DesignBundle, strips: dict[str, Any], f: int) -> Design
                          "re-run the design")
     seen = cnt > 0
     J[seen] = acc[seen] / cnt[seen, None]
-    return dataclasses.replace(bundle, net=Net(J, bundle.net.loops, lamellae),
-                               aligned=bundle.aligned)
+    return dataclasses.replace(bundle, net=Net(J, bundle.net.loops, lamellae))
 
 
 def state_equilibrium(bundle: DesignBundle, strips: dict[str, Any], f: int,

@@ -119,6 +119,14 @@ def slerp_axes(r0: np.ndarray, r1: np.ndarray, t: float) -> np.ndarray:
     return r / np.maximum(np.linalg.norm(r, axis=1), 1e-300)[:, None]
 
 
+def signed_like(k_cut: np.ndarray, kn: np.ndarray) -> np.ndarray:
+    """The cut curvature ``k_cut`` with the sign (one for the whole lamella) that fits the
+    measured in-plane curvature ``kn`` best (a strip's normal, and so the sign of its in-plane
+    curvature, is arbitrary)."""
+    k_cut = np.asarray(k_cut, float)
+    return -k_cut if np.sum((kn - k_cut) ** 2) > np.sum((kn + k_cut) ** 2) else k_cut
+
+
 def max_turn(X: np.ndarray) -> float:
     """Largest angle (degrees) between consecutive chords of the joint polyline ``X (j,3)``."""
     d = np.diff(np.asarray(X, float), axis=0)
@@ -239,10 +247,7 @@ def strip_state_record(strips: dict[str, Any], f: int, orientation: str, section
     for lid in ids:
         m = np.flatnonzero(lam_of == lid)
         dc = darboux_curvatures(X[m], N[m])
-        kc = strips["kcut"][m]
-        if np.sum((dc.kn - kc) ** 2) > np.sum((dc.kn + kc) ** 2):
-            kc = -kc
-        k = strip_curvatures(dc, orientation, section, kc)
+        k = strip_curvatures(dc, orientation, section, signed_like(strips["kcut"][m], dc.kn))
         u = strip_stresses(k, section, material).utilisation
         if not len(u) or not np.all(np.isfinite(u)):
             continue

@@ -12,6 +12,7 @@ from __future__ import annotations
 import base64
 import gzip
 import os
+from functools import lru_cache
 
 from gridshell.render.viewer.assets import THREE_VERSION, three_script, viewer_css, viewer_script
 from gridshell.render.viewer.scene import scene_json
@@ -44,11 +45,8 @@ def viewer_section(bundle_dir: str | os.PathLike) -> str:
     )
 
 
-_THREE: list[str] = []
 
-
+@lru_cache(maxsize=1)
 def _three_packed() -> str:
     """:func:`packed` three.js, computed once per process."""
-    if not _THREE:
-        _THREE.append(packed(three_script()))
-    return _THREE[0]
+    return packed(three_script())
