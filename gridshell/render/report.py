@@ -180,7 +180,7 @@ def _data_uri(path: Path) -> str:
 
 #: an animated GIF larger than this (bytes) is embedded at :data:`GIF_WIDTH` pixels wide
 GIF_ABOVE = 200_000
-GIF_WIDTH = 560
+GIF_WIDTH = 480
 
 
 def _smaller_gif(gif: bytes) -> bytes | None:
