@@ -419,7 +419,7 @@ def _check_finite(bundle) -> None:
 def export_3dm(bundle, path: str | os.PathLike, *, width: float | None = None,
                thickness: float | None = None, hole: float | None = None,
                scale: Any = None, sheet: Any = None, params: Any = None, units: Any = None,
-               sheets: bool = True, force: bool = False,
+               sheets: bool = True, force: bool = False, verified: bool = False,
                progress: Callable[[str], None] | None = None) -> dict[str, Any]:
     """Write a design to a Rhino ``.3dm`` file (Rhino 8 format), atomically; returns what was
     written (``path``, ``units``, object counts per layer, ``sheets``, the fabrication
@@ -445,6 +445,9 @@ def export_3dm(bundle, path: str | os.PathLike, *, width: float | None = None,
         Draw the cut sheets (planned in memory as ``gridshell fabricate`` would).
     force : bool
         Draw the cut sheets of a design that fails its figures too.
+    verified : bool
+        The caller has just verified these very files (``gridshell build``'s verify stage):
+        the design's figures are not computed again before the sheets are drawn.
 
     The design check and the cut-sheet plan run in a second process (:mod:`gridshell.core.aside`,
     forked on Linux) while this one builds the rest of the model; the file is the same.
@@ -453,7 +456,7 @@ def export_3dm(bundle, path: str | os.PathLike, *, width: float | None = None,
     path = check_3dm_path(path)
     info = write_model(bundle, path, width=width, thickness=thickness, hole=hole, scale=scale,
                        sheet=sheet, params=params, units=units, sheets=sheets, force=force,
-                       progress=progress, publish=True)
+                       verified=verified, progress=progress, publish=True)
     info["path"] = str(path)
     return info
 
@@ -492,7 +495,7 @@ def check_3dm_path(path: str | os.PathLike) -> Path:
 def write_model(bundle, path: str | os.PathLike, *, width: float | None = None,
                 thickness: float | None = None, hole: float | None = None,
                 scale: Any = None, sheet: Any = None, params: Any = None, units: Any = None,
-                sheets: bool = True, force: bool = False,
+                sheets: bool = True, force: bool = False, verified: bool = False,
                 progress: Callable[[str], None] | None = None, publish: bool = False,
                 shown: str | os.PathLike | None = None) -> dict[str, Any]:
     """The body of :func:`export_3dm` (same parameters): build the model, then write it to
@@ -523,7 +526,7 @@ def write_model(bundle, path: str | os.PathLike, *, width: float | None = None,
         from gridshell.geometry.bspline import BSplineSurface
 
         bspline = BSplineSurface.load(bundle_dir / "surface.json")
-    judged = bundle_dir if bundle_dir is not None else bundle
+    judged = None if verified else bundle_dir if bundle_dir is not None else bundle
     if sheets:
         _say(progress, "checking the design's figures and planning the cut sheets")
     # the cut sheets (design check, then plan) computed aside, in a second process, while this
@@ -560,13 +563,16 @@ def write_model(bundle, path: str | os.PathLike, *, width: float | None = None,
 
 def _cut_sheets(judged, bundle, fab, force: bool) -> tuple[bool, str, Any, Any, str | None]:
     """``(ok, why, layout, params, fallback)``: the verdict on the design
-    (:func:`gridshell.design.verification.design_verdict` of ``judged``, its directory or itself) and,
+    (:func:`gridshell.design.verification.design_verdict` of ``judged``, its directory or itself;
+    ``judged`` None: verified by the caller, it holds) and,
     if it holds or ``force``, its cut sheets planned (:func:`.fabparams.plan_sheets`; ``layout``
     None otherwise) with the parameters the plan used and why joints too close for holes
     became marks (``fallback``, None when they did not)."""
     from gridshell.design.verification import design_verdict
     from gridshell.export.fabparams import plan_sheets
 
+    if judged is None:
+        return (True, "", *plan_sheets(bundle, fab))
     verdict = design_verdict(judged)
     ok, why = verdict.ok, verdict.why()
     if not (ok or force):

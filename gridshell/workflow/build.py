@@ -338,10 +338,12 @@ def _fabricate(out: Path, pick: dict[str, Any], sheet: str | None) -> dict[str, 
 
 
 def _outputs(out: Path, pick: dict[str, Any], sheet: str | None) -> dict[str, Any]:
-    """render.png, report.html and the Rhino model (the .3dm in a second process)."""
+    """render.png, report.html and the Rhino model (the .3dm in a second process; the verify
+    stage has gated these very files, so the export does not judge the design again)."""
     from gridshell.workflow.outputs import write_outputs
 
-    opts = {"width": pick["width"], "thickness": pick["thickness"], "scale": pick["scale"]}
+    opts = {"width": pick["width"], "thickness": pick["thickness"], "scale": pick["scale"],
+            "verified": True}
     if sheet:
         opts["sheet"] = sheet
     done = write_outputs(out, png=True, report=True, rhino=out / RHINO, rhino_options=opts)

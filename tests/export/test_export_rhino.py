@@ -326,6 +326,9 @@ def test_failing_design_has_no_sheets_unless_forced(tmp_path):
     _, names, _ = _read(tmp_path / "a.3dm")
     assert not [n for n in names if n.startswith("sheet")]
     assert write_3dm(d, tmp_path / "b.3dm", force=True)["sheets"]
+    # a caller that has verified these files (gridshell build) says so: not judged again
+    info = write_3dm(d, tmp_path / "c.3dm", verified=True)
+    assert info["sheets"] and not [n for n in info["notes"] if "figures" in n]
 
 
 def test_3dm_with_revolution_and_errors(tmp_path):
