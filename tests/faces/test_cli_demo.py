@@ -2,8 +2,11 @@
 from __future__ import annotations
 
 import contextlib
+import fnmatch
 import io
 import json
+import re
+from pathlib import Path
 
 import pytest
 
@@ -220,3 +223,82 @@ def test_quick_demo_pictures_are_readable(quick_demo):
                 assert im.width >= MIN_FRAME_PX, (k, name, im.size)
     with Image.open(out / "gg" / "states.png") as im:
         assert im.width >= 1.75 * MIN_FRAME_PX
+
+
+# --- the README's output tables against a real run (issue 30: every file written, nothing else)
+README = Path(__file__).resolve().parents[2] / "README.md"
+_TICK = re.compile(r"`([^`\s]+)`")
+
+
+def _table(heading: str) -> dict[str, str]:
+    """``first cell -> row`` of the first table after the README line ``heading``."""
+    text = README.read_text(encoding="utf-8")
+    rows: dict[str, str] = {}
+    header = True
+    for line in text[text.index(heading):].splitlines()[1:]:
+        if line.startswith("|---"):
+            header = False
+        elif line.startswith("|") and not header:
+            first, rest = line.strip("|").split("|", 1)
+            rows[first.strip()] = rest
+        elif rows:
+            break
+    return rows
+
+
+def _patterns(cell: str) -> list[str]:
+    """The file names (``a.png``, ``sheet_NN.png``, ``delta_*.png``) and folders (``dir/``)
+    a table cell names in backticks."""
+    return [t.replace("NN", "[0-9][0-9]") for t in _TICK.findall(cell)
+            if "." in t or t.endswith("/") or "*" in t]
+
+
+def _files(folder: Path) -> list[str]:
+    return sorted(str(p.relative_to(folder)) for p in folder.rglob("*") if p.is_file())
+
+
+def _matches(pattern: str, rel: str) -> bool:
+    if pattern.endswith("/"):
+        return rel.startswith(pattern)
+    return fnmatch.fnmatch(rel, pattern) or fnmatch.fnmatch(Path(rel).name, pattern)
+
+
+def _check_row(patterns: list[str], files: list[str], where: str) -> None:
+    unlisted = [f for f in files if not any(_matches(p, f) for p in patterns)]
+    assert not unlisted, f"README {where}: written but not listed: {unlisted}"
+    absent = [p for p in patterns if not any(_matches(p, f) for f in files)]
+    assert not absent, f"README {where}: listed but not written: {absent}"
+
+
+@pytest.mark.slow
+def test_readme_output_tables_list_what_the_demo_writes(quick_demo):
+    """The README's table of the demo's output and its table of the design bundle list every
+    file the (quick) demo writes and nothing else; a pattern (``sequence/frame_*``,
+    ``sheet_NN.png``, ``fabrication/``) stands for the files it matches."""
+    _, out, _ = quick_demo
+    demo_rows = _table("replaces `out/demo/` only when everything succeeded")
+    bundle = [p for cell in _table("## The design bundle") for p in _patterns(cell)]
+    assert {"`gg/`", "`phlw/`", "`ncp/`", "`demo.json`"} <= set(demo_rows)
+    top = [p.name + "/" * p.is_dir() for p in out.iterdir()]
+    _check_row([*(_patterns(k)[0] for k in demo_rows), "manifest.json"], top, "demo table")
+    seen_bundle: set[str] = set()
+    for key, cell in demo_rows.items():
+        name = _patterns(key)[0]
+        if not name.endswith("/"):
+            continue
+        files = _files(out / name)
+        own = [*_patterns(cell), "manifest.json"]
+        if "design bundle" in cell:        # the bundle's files: the design bundle's table
+            own += bundle
+            seen_bundle |= {p for p in bundle if any(_matches(p, f) for f in files)}
+        else:
+            _check_row(own, files, f"demo table, {name}")
+            continue
+        unlisted = [f for f in files if not any(_matches(p, f) for p in own)]
+        assert not unlisted, f"README demo table, {name}: written but not listed: {unlisted}"
+        absent = [p for p in _patterns(cell) if not any(_matches(p, f) for f in files)]
+        assert not absent, f"README demo table, {name}: listed but not written: {absent}"
+    never = [p for p in bundle if p not in seen_bundle]
+    assert not never, f"README design bundle table: no bundle of the demo has {never}"
+    with pytest.raises(AssertionError, match="not listed"):      # the check can fail
+        _check_row(["a.png"], ["a.png", "b.png"], "x")
