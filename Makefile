@@ -95,8 +95,11 @@ test: $(STAMP) browser
 test-fast: $(STAMP)
 	$(PY) -m pytest -q -m "not slow and not browser"
 
+# Every stage's time and memory, then the timings the README quotes (benchmarks/readme.py:
+# benchmarks/readme_timings.json, copied into README.md).
 bench: $(STAMP)
 	$(PY) benchmarks/run_all.py
+	$(PY) benchmarks/readme.py --update-readme
 
 clean:
 	rm -rf $(VENV) out build *.egg-info

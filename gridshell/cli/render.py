@@ -18,6 +18,9 @@ def add_args(p: argparse.ArgumentParser) -> None:
     add_bundle_arg(p, "; files go into it")
     p.add_argument("--report", action="store_true",
                    help="also write DIR/report.html: one self-contained page of the design")
+    p.add_argument("--pdf", action="store_true",
+                   help="also write DIR/report.pdf: the pack on A4 pages (overview, assembly: "
+                        "strips and the joints' order, cut sheets, structure)")
     p.add_argument("--3dm", dest="rhino", metavar="PATH",
                    help="also export the design to this Rhino .3dm file ('gridshell export' "
                         "with its defaults: strips, holes, surface, collapsed state, cut sheets)")
@@ -70,7 +73,7 @@ def run(args: Any) -> int:
     elif frames:
         sequence, animate = f"{len(frames)} frames -> alignment.gif", True
     res = write_outputs(bundle, sequence=animate,
-                        report=args.report, rhino=args.rhino,
+                        report=args.report, pdf=args.pdf, rhino=args.rhino,
                         width=None if args.width is None else args.width / 1000.0,
                         size=tuple(args.size), progress=progress.callback)
     out, report, info = res["render"], res["report"], res["rhino"]
@@ -79,6 +82,8 @@ def run(args: Any) -> int:
         written += [f"sequence/frame_*.png ({len(res['sequence']['frames'])})", gif.name]
     if report is not None:
         written.append(report.name)
+    if res["pdf"] is not None:
+        written.append(res["pdf"].name)
     rhino = None
     if info is not None:
         rhino = info["path"]
@@ -93,6 +98,7 @@ def run(args: Any) -> int:
         "render": str(out),
         "alignment sequence": sequence,
         "report": str(report) if report else "not written (--report)",
+        "pdf": str(res["pdf"]) if res["pdf"] else "not written (--pdf)",
         "rhino": str(rhino) if rhino else "not written (--3dm PATH)",
         "files": ", ".join(written),
     }

@@ -285,6 +285,16 @@ def _lamella_table(lamellae: list[dict]) -> str:
     return f'<div class="scroll"><table>{head}{"".join(rows)}</table></div>'
 
 
+#: the fabrication report's counts the report shows, named
+_FAB_ROWS = (("shape", "collapsed shape of the strips"), ("n_strips", "strips (lamellae)"),
+             ("n_pieces", "pieces cut"), ("n_sheets", "sheets"),
+             ("n_joint_marks", "holes or marks on the parts (two per joint)"),
+             ("utilisation", "share of the sheets' area the parts cover (as nested)"),
+             ("material_used", "share of the sheets' area in the part outlines"),
+             ("labels_dropped", "labels left out (no room)"),
+             ("radius_mm", "collapse circle's radius [mm of the model]"))
+
+
 def _fabrication_section(d: Path) -> str:
     """The cut files' section: the fabrication report's counts (read by
     :func:`gridshell.design.section.read_fabrication_report`: a corrupt report is an error),
@@ -297,9 +307,8 @@ def _fabrication_section(d: Path) -> str:
     parts = ['<section id="fabrication"><h2>Fabrication</h2>']
     rep = read_fabrication_report(d)
     if rep is not None:
-        keys = ("shape", "n_strips", "n_pieces", "n_sheets", "n_joint_marks", "utilisation",
-                "material_used", "labels_dropped", "radius_mm")
-        parts.append(_kv_table((k, rep[k]) for k in keys if k in rep))
+        parts.append(_kv_table((name, rep[k]) for k, name in _FAB_ROWS
+                               if rep.get(k) is not None))
     plan = fab / "plan.png"
     if plan.is_file():
         parts.append(_figure(plan, _CAPTIONS["plan.png"], wide=True))
@@ -332,6 +341,15 @@ def _figures_verdict(decided: list[str]) -> tuple[bool | None, str]:
                    "thresholds")
 
 
+def figures_line(bundle_dir: str | os.PathLike) -> tuple[bool | None, str]:
+    """(all pass, the banner's text) of the paper's figures stored in the bundle's
+    design.json (None: none stored)."""
+    from gridshell.design.bundle import read_design_json
+
+    checks = metric_checks(read_design_json(Path(bundle_dir)).get("metrics") or {})
+    return _figures_verdict([r["status"] for r in checks if r["status"] != "info"])
+
+
 def report_html(bundle_dir: str | os.PathLike) -> str:
     """The HTML text of the report of ``bundle_dir`` (see :func:`write_report`)."""
     from gridshell.core.version import __version__
@@ -346,6 +364,7 @@ def report_html(bundle_dir: str | os.PathLike) -> str:
     lams = design["lamellae"]
     checks = metric_checks(metrics)
     decided = [r["status"] for r in checks if r["status"] != "info"]
+    from gridshell.render.assembly_page import assembly_section
     from gridshell.render.verdicts import (banner_html, bill_of_materials,
                                            equilibrium_section, verdicts)
 
@@ -396,6 +415,7 @@ def report_html(bundle_dir: str | os.PathLike) -> str:
         "</section>",
         f'<section id="pictures"><h2>Pictures</h2>{figs}</section>',
         _fabrication_section(d),
+        assembly_section(d),
         _structure_section(d),
         equilibrium_section(d, _kv_table, _figure),
         f'<section id="lamellae"><h2>Lamellae</h2>{_lamella_table(lams)}</section>',

@@ -9,7 +9,8 @@ import json
 from pathlib import Path
 from typing import Any
 
-__all__ = ["banner_html", "bill_of_materials", "equilibrium_section", "verdicts"]
+__all__ = ["banner_html", "bill_of_materials", "equilibrium_rows", "equilibrium_section",
+           "verdicts"]
 
 
 def _json(path: Path) -> dict[str, Any] | None:
@@ -82,8 +83,10 @@ def bill_of_materials(d: Path) -> list[tuple[str, str]]:
                        f"{p.get('width', 0):g} mm wide"),
             ("total strip length", f"{length_mm / 1000:.2f} m")]
     design = _json(d / "design.json") or {}
-    joints = design.get("n_joints")
-    if joints:
+    if design.get("lamellae"):
+        from gridshell.design.assembly import assembly_plan
+
+        joints = len(assembly_plan(design, fab)["steps"])      # where two strips cross
         rows.append(("joints", f"{joints}: one bolt or rivet each, through a "
                                f"{p.get('hole', 0):g} mm hole in both strips"
                                if p.get("joints", "hole") == "hole" else
@@ -110,6 +113,13 @@ _EQ_ROWS = (("gravity", "load", ""), ("supports", "supported joints", ""),
             ("bolt_shear_mean_N", "mean bolt shear", "N"), ("newton", "Newton", ""))
 
 
+def equilibrium_rows(f: dict[str, Any]) -> list[tuple[str, Any]]:
+    """``[(name [unit], value)]`` of the equilibrium's figures ``f`` (equilibrium.json's
+    ``figures``) that are there, in the report's order."""
+    return [(f"{label}" + (f" [{unit}]" if unit else ""), f[k]) for k, label, unit in _EQ_ROWS
+            if k in f]
+
+
 def equilibrium_section(d: Path, kv_table: Any, figure: Any) -> str:
     """The equilibrium's section (``gridshell simulate``): its figures named, with units,
     and its picture (``kv_table`` / ``figure``: the page's blocks)."""
@@ -117,9 +127,7 @@ def equilibrium_section(d: Path, kv_table: Any, figure: Any) -> str:
     if not e:
         return ""
 
-    f = e.get("figures", {})
-    rows = [(f"{label}" + (f" [{unit}]" if unit else ""), f[k]) for k, label, unit in _EQ_ROWS
-            if k in f]
+    rows = equilibrium_rows(e.get("figures", {}))
     pic = d / "equilibrium" / "equilibrium.png"
     fig = figure(pic, "the equilibrium over the design (deviation coloured)") \
         if pic.is_file() else ""

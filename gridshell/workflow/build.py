@@ -9,7 +9,7 @@ directory ``out`` (the pack: a design bundle with everything made from it)::
     equilibrium/       the elastic equilibrium of the deployed gridshell (gridshell simulate)
     fabrication/       cut files, nested on sheets, DXF + SVG in mm (gridshell fabricate)
     model.3dm          the Rhino model (gridshell export)
-    render.png, report.html   (gridshell render --report)
+    render.png, report.html, report.pdf   (gridshell render --report --pdf)
     build.json         what was chosen and why, each stage's key, time and verdict
     manifest.json      every file of the pack
 
@@ -170,7 +170,7 @@ def build(model: str | os.PathLike, out: str | os.PathLike, *, kind: str = "auto
             stage("fabricate", k_fab, lambda: _fabricate(out, pick, sheet), ("fabrication",))
             stage("simulate", k_sim, lambda: _simulate(out, pick, job), ("equilibrium",))
         stage("outputs", build_key(k_fab, "outputs"), lambda: _outputs(out, pick, sheet),
-              (RHINO, "report.html"))
+              (RHINO, "report.html", "report.pdf"))
     finally:
         if (out / "design.json").is_file():
             _record(out, res, time.perf_counter() - t0)
@@ -338,14 +338,17 @@ def _fabricate(out: Path, pick: dict[str, Any], sheet: str | None) -> dict[str, 
 
 
 def _outputs(out: Path, pick: dict[str, Any], sheet: str | None) -> dict[str, Any]:
-    """render.png, report.html and the Rhino model (the .3dm in a second process; the verify
-    stage has gated these very files, so the export does not judge the design again)."""
+    """render.png, report.html, report.pdf and the Rhino model (the .3dm and the PDF in second
+    processes; the verify stage has gated these very files, so the export does not judge the
+    design again)."""
     from gridshell.workflow.outputs import write_outputs
 
     opts = {"width": pick["width"], "thickness": pick["thickness"], "scale": pick["scale"],
             "verified": True}
     if sheet:
         opts["sheet"] = sheet
-    done = write_outputs(out, png=True, report=True, rhino=out / RHINO, rhino_options=opts)
-    return {"files": [str(p.relative_to(out)) for p in (done.get("render"), done.get("report"))
+    done = write_outputs(out, png=True, report=True, pdf=True, rhino=out / RHINO,
+                         rhino_options=opts)
+    return {"files": [str(p.relative_to(out)) for p in (done.get("render"), done.get("report"),
+                                                        done.get("pdf"))
                       if p is not None] + [RHINO]}

@@ -22,7 +22,8 @@ __all__ = ["write_outputs"]
 
 
 def write_outputs(bundle: str | os.PathLike, *, png: bool = True, sequence: bool = False,
-                  report: bool = False, rhino: str | os.PathLike | None = None,
+                  report: bool = False, pdf: bool = False,
+                  rhino: str | os.PathLike | None = None,
                   width: float | None = None, size: tuple[int, int] | None = None,
                   rhino_options: dict[str, Any] | None = None,
                   progress: Callable[[str], None] | None = None) -> dict[str, Any]:
@@ -38,6 +39,9 @@ def write_outputs(bundle: str | os.PathLike, *, png: bool = True, sequence: bool
         (:func:`gridshell.render.sequence.render_bundle_sequence`).
     report : bool
         ``report.html`` (:func:`gridshell.render.report.write_report`), after the pictures.
+    pdf : bool
+        ``report.pdf`` (:func:`gridshell.render.pdf.pdf_document`: overview, assembly, sheets,
+        structure), made in a second process after render.png while this one writes the rest.
     rhino : path-like, optional
         The .3dm file (:func:`gridshell.export.rhino.export_3dm`, with ``rhino_options``: any
         of its keyword arguments but ``progress``; the model is built in another process,
@@ -49,38 +53,22 @@ def write_outputs(bundle: str | os.PathLike, *, png: bool = True, sequence: bool
     -------
     dict
         ``render`` (Path or None), ``sequence`` (the sequence renderer's result or None),
-        ``report`` (Path or None), ``rhino`` (what :func:`~gridshell.export.rhino.export_3dm`
+        ``report`` and ``pdf`` (Path or None), ``rhino`` (what :func:`~gridshell.export.rhino.export_3dm`
         returns, or None).
     """
-    from gridshell.core.aside import Aside, can_fork
-    from gridshell.core.atomic import atomic_path
-    from gridshell.design.bundle import read_bundle
-
     bundle = Path(bundle)
     say = progress or (lambda msg: None)
-    out: dict[str, Any] = {"render": None, "sequence": None, "report": None, "rhino": None}
+    out: dict[str, Any] = {"render": None, "sequence": None, "report": None, "pdf": None,
+                           "rhino": None}
     with ExitStack() as stack:
-        job = None
-        if rhino is not None:
-            from gridshell.export.rhino import check_3dm_path, write_model
-
-            path = check_3dm_path(rhino)
-            options = dict(rhino_options or {})
-            if "progress" in options:
-                raise TypeError("write_outputs: rhino_options takes no progress (the model is "
-                                "built in another process, which prints nothing)")
-            read_bundle(bundle)             # read once, before the fork: both processes have it
-            tmp = stack.enter_context(atomic_path(path))
-            inside = path.resolve().parent == bundle.resolve()
-            say(f"exporting {path.name if inside else path}"
-                + (" (in a second process)" if can_fork() else ""))
-            job = stack.enter_context(Aside(write_model, bundle, tmp, shown=path, **options))
+        job = None if rhino is None else _rhino_job(stack, bundle, rhino, rhino_options, say)
         if png:
             from gridshell.render.ribbons import render_bundle
 
             say("rendering render.png")
             kw = {} if size is None else {"size": tuple(size)}
             out["render"] = render_bundle(bundle, width=width, **kw)
+        paper = _pdf_job(stack, bundle, say) if pdf else None      # after render.png
         if sequence:
             from gridshell.render.sequence import render_bundle_sequence
 
@@ -90,6 +78,44 @@ def write_outputs(bundle: str | os.PathLike, *, png: bool = True, sequence: bool
 
             say("writing report.html")
             out["report"] = write_report(bundle)
+        if paper is not None:
+            paper[0].result()
+            out["pdf"] = paper[1]
         if job is not None:
-            out["rhino"] = dict(job.result(), path=str(path))
+            out["rhino"] = dict(job[0].result(), path=str(job[1]))
     return out
+
+
+def _rhino_job(stack: ExitStack, bundle: Path, rhino: str | os.PathLike,
+               options: dict[str, Any] | None, say: Callable[[str], None]) -> tuple[Any, Path]:
+    """The .3dm built in a second process into a temporary file that ``stack`` publishes:
+    ``(job, path)``."""
+    from gridshell.core.aside import Aside, can_fork
+    from gridshell.core.atomic import atomic_path
+    from gridshell.design.bundle import read_bundle
+    from gridshell.export.rhino import check_3dm_path, write_model
+
+    path = check_3dm_path(rhino)
+    options = dict(options or {})
+    if "progress" in options:
+        raise TypeError("write_outputs: rhino_options takes no progress (the model is "
+                        "built in another process, which prints nothing)")
+    read_bundle(bundle)             # read once, before the fork: both processes have it
+    tmp = stack.enter_context(atomic_path(path))
+    inside = path.resolve().parent == bundle.resolve()
+    say(f"exporting {path.name if inside else path}"
+        + (" (in a second process)" if can_fork() else ""))
+    return stack.enter_context(Aside(write_model, bundle, tmp, shown=path, **options)), path
+
+
+def _pdf_job(stack: ExitStack, bundle: Path, say: Callable[[str], None]) -> tuple[Any, Path]:
+    """report.pdf made in a second process into a temporary file that ``stack`` publishes:
+    ``(job, path)``."""
+    from gridshell.core.aside import Aside, can_fork
+    from gridshell.core.atomic import atomic_path
+    from gridshell.render.pdf import pdf_document
+
+    say("writing report.pdf" + (" (in a second process)" if can_fork() else ""))
+    path = bundle / "report.pdf"
+    tmp = stack.enter_context(atomic_path(path))
+    return stack.enter_context(Aside(pdf_document, bundle, tmp)), path

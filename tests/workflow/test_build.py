@@ -31,7 +31,8 @@ def test_the_pack_holds_every_stage_and_its_figures_hold(pack):
     out, res = pack
     assert list(res.stages) == list(STAGES) and not res.reused
     for f in ("design.json", "structure.json", "equilibrium/equilibrium.json",
-              "fabrication/manifest.json", "model.3dm", "report.html", "render.png",
+              "fabrication/manifest.json", "model.3dm", "report.html", "report.pdf",
+              "render.png",
               "analysis/analysis.json", BUILD_JSON):
         assert (out / f).is_file(), f
     assert list((out / "fabrication").glob("*.dxf")) and list((out / "fabrication").glob("*.svg"))
@@ -149,3 +150,38 @@ def test_a_new_design_with_the_analysis_reused_keeps_the_analysis_in_the_pack(tm
     assert "analyze" in again.reused and "design" not in again.reused
     assert (out / "analysis" / "analysis.json").is_file()
     assert verify_bundle(out)["ok"]
+
+
+def test_the_report_and_its_pdf_carry_the_assembly(pack):
+    """The build's report.html has the assembly section (every joint closed once, each step
+    naming the strips the design's joint joins) and report.pdf is the same on A4 pages: the
+    overview, the assembly, the tables, one page per cut sheet, structure and equilibrium."""
+    import re
+
+    from gridshell.design.assembly import assembly_plan
+    from gridshell.render.pdf import LINES
+    from gridshell.render.verdicts import bill_of_materials
+
+    out, _ = pack
+    design = json.loads((out / "design.json").read_text())
+    fab = json.loads((out / "fabrication" / "fabrication.json").read_text())
+    plan = assembly_plan(design, fab)
+    joins = {}
+    for r in design["lamellae"]:
+        for j in r["joints"]:
+            joins.setdefault(j, set()).add(r["id"])
+    crossings = sorted(j for j, on in joins.items() if len(on) == 2)
+    assert sorted(t["joint"] for t in plan["steps"]) == crossings
+    assert sorted(plan["single"]) == sorted(j for j, on in joins.items() if len(on) == 1)
+    assert all({t["strip"], t["across"]} == joins[t["joint"]] for t in plan["steps"])
+    page = (out / "report.html").read_text()
+    assert 'id="assembly"' in page and f"in the order they are closed ({len(crossings)})" in page
+    assert dict(bill_of_materials(out))["joints"].startswith(f"{len(crossings)}: one bolt")
+    assert page.index('id="fabrication"') < page.index('id="assembly"') < \
+        page.index('id="structure"')
+    pdf = (out / "report.pdf").read_bytes()
+    assert pdf.startswith(b"%PDF") and pdf.rstrip().endswith(b"%%EOF")
+    pages = len(re.findall(rb"/Type /Page\b", pdf))
+    n_tables = -(-len(plan["strips"]) // LINES) + -(-len(plan["steps"]) // LINES)
+    expected = 1 + 1 + n_tables + fab["n_sheets"] + 1 + 1
+    assert pages == expected, (pages, expected)
