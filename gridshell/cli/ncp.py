@@ -102,7 +102,7 @@ def run(args: Any) -> int:
     phlw = {"ctrl": tuple(args.phlw_ctrl), "samples": tuple(args.phlw_samples),
             "outer": args.phlw_outer, "max_iter": args.phlw_max_iter,
             "align": args.phlw_align}
-    curves = args.curves if args.curves is not None or args.spacing is not None else 10
+    curves = args.curves              # None with no --spacing either: 10 (a ring: its own)
     design = design_ncp(args.reference, mode=args.mode, curves=curves,
                         spacing=args.spacing, n=args.n, samples=tuple(args.samples),
                         levelset_ctrl=tuple(args.levelset_ctrl), omega_f=args.omega_f,
@@ -127,6 +127,7 @@ def run(args: Any) -> int:
     out = write(args.output, design, render=not args.no_render, progress=progress.callback)
     m = bundle.metrics
     from gridshell.measure.fidelity import fidelity_line
+    from gridshell.ncp.ring import region_line
     summary = {
         "bundle": str(out),
         "kind": bundle.kind,
@@ -140,6 +141,7 @@ def run(args: Any) -> int:
         "Delta_l [%]": m["delta_l"],
         "Delta_n [%]": m["delta_n"],
         "fidelity to the target": fidelity_line(m.get("fidelity")),
+        "region": region_line(m.get("region")),
         "deviation [% diag]": m["deviation"],
         "crossing kn difference [%]": {"mean": m["crossing_kn"]["mean"],
                                        "max": m["crossing_kn"]["max"]},

@@ -41,6 +41,10 @@ def load_surface(source: Any, *, mode: str, phlw_options: dict | None = None,
         n = float(source.n_rows[0]) if source.mode == "cnc" else None
         return source.surface, n, {"source": "phlw-result", "phlw_mode": source.mode,
                                    "units": METRES}
+    from gridshell.ncp.ring import RingSource
+
+    if isinstance(source, RingSource):        # the ring around an umbilic (gridshell.ncp.ring)
+        return _ring_surface(source, mode, dict(phlw_options or {}), progress)
     if isinstance(source, (str, Path)) and str(source).lower().endswith(".json"):
         if units is not None or obj is not None:
             raise InputError(f"{Path(source).name} is a B-spline in metres written by 'gridshell "
@@ -132,6 +136,26 @@ def _phlw_info(res: Any, init: Any, geo: Any) -> dict[str, Any]:
             "phlw_aligned_deg": float(init.rotated_deg),
             "units": geo.units, "input": geo.info(),
             "reference": (geo.V, geo.F)}   # taken out by the pipeline (fidelity), not stored
+
+
+def _ring_surface(src: Any, mode: str, opts: dict, progress: Callable[[str], None] | None
+                  ) -> tuple[BSplineSurface, float | None, dict]:
+    """The PHLW step on a ring patch towards the target's faces inside it; the info's
+    reference is the whole target (the net's fidelity and coverage are measured on it)."""
+    from gridshell.ncp.reference import InitialFit
+
+    for key in ("ctrl", "degree", "transpose", "align"):    # the ring fixes its own B-spline
+        opts.pop(key, None)
+    patch = src.patch
+    if progress is not None:
+        progress(f"PHLW step on the ring around the umbilic: radius {patch.inner:.3g} to "
+                 f"{patch.outer:.3g} m, {patch.share:.0f} % of the target (fit rms "
+                 f"{patch.fit_rms:.2g} m)")
+    res = _phlw_step(patch.surface, (patch.V, patch.F), mode, opts, progress)
+    info = _phlw_info(res, InitialFit(surface=patch.surface, rms=patch.fit_rms,
+                                      method="ring"), src.geo)
+    info["region"] = patch.record()
+    return res.surface, float(res.n_rows[0]) if mode == "cnc" else None, info
 
 
 def _phlw_units(path: Path) -> Any:

@@ -60,6 +60,9 @@ AXIS_TOL = 0.05
 #: AA pseudosphere's sequence turns them by up to 79 degrees where both ends turn them by 10
 FOLD_MARGIN_DEG = 10.0
 
+#: Newton iterations given to the strips of a folded state (approximate whatever they reach)
+FOLDED_ITER = 4
+
 #: a state whose joint-to-joint chords differ from the design's by more than this share is
 #: approximate: the strips, inextensible, are given the state's chord lengths between joints
 #: (the kinematic sequence keeps them only approximately, paper 4.2.4), as GG's carried states
@@ -212,11 +215,19 @@ def held_path(bundle: DesignBundle, frames: list[np.ndarray], axes: list[np.ndar
     r0 = rod.unit(np.asarray(axes[0], float))
     prev = r0
     states = []
+    # a state the blended simulation folds is approximate whatever its equilibrium: its strips
+    # get FOLDED_ITER Newton iterations, not a full solve (the fold is known from the joints)
+    lams = [lam for lam in bundle.net.lamellae if len(lam.joints) >= 2]
+    turns = np.array([max((max_turn(np.asarray(V, float)[lam.joints]) for lam in lams),
+                          default=0.0) for V in frames])
+    folds = (turns > FOLD_DEG) | (turns > max(turns[0], turns[-1]) + FOLD_MARGIN_DEG)
+    folds[[0, -1]] = False
     for f, (V, R) in enumerate(zip(frames, axes)):
         R = rod.unit(np.asarray(R, float))
         R = np.where((np.einsum("ij,ij->i", R, prev) < 0)[:, None], -R, R)
         prev = R
-        states.append(held_state(bundle, np.asarray(V, float), R, r0))
+        states.append(held_state(bundle, np.asarray(V, float), R, r0,
+                                 **({"max_iter": FOLDED_ITER} if folds[f] else {})))
         if progress is not None:
             st = states[-1]
             progress(f"strips of state {f}/{len(frames) - 1}: {st['iterations']} Newton "

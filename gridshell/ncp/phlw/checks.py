@@ -35,12 +35,18 @@ class RowFit(NamedTuple):
     clamped: np.ndarray
 
 
+#: a row whose H spreads less than this share of the curvature scale has no defined slope
+FLAT_ROW = 1e-2
+
+
 def fit_rows(K: np.ndarray, H: np.ndarray, mode: Mode = "phlw", rtol: float = 1e-4) -> RowFit:
     """Least-squares fit of ``K = 2 n H - (n^2 + t^2)`` per u-row (rows of ``K, H (rows, cols)``).
 
     ``phlw``: a line ``K = alpha H + beta`` per row, ``n = alpha / 2``, ``t^2 = -beta - n^2``;
-    a row whose ``H`` hardly varies (e.g. a parallel of a surface of revolution) has no
-    defined slope and gets ``n = mean H`` (the net angle pi/4, as E_beta prefers).
+    a row whose ``H`` hardly varies (its spread below :data:`FLAT_ROW` of the curvature
+    scale, e.g. a parallel of a surface of revolution, where a B-spline's wiggles alone would
+    set the slope) has no defined slope and gets ``n = mean H`` (the net angle pi/4, as
+    E_beta prefers).
     ``cnc``: one slope for all rows, one intercept per row. ``aa``: ``n = 0``,
     ``t^2 = -mean K``. Rows where the fitted line has ``t^2 < 0`` (``b^2 - 4ac > 0``: a
     secant of the parabola ``K = H^2``, no net) are listed in ``clamped``; in ``phlw`` mode
@@ -72,7 +78,7 @@ def fit_rows(K: np.ndarray, H: np.ndarray, mode: Mode = "phlw", rtol: float = 1e
         hm, km = H.mean(axis=1), K.mean(axis=1)
         Hc = H - hm[:, None]
         var = np.einsum("ij,ij->i", Hc, Hc)
-        flat = np.sqrt(var / m) <= rtol * scale          # np.std(h) <= rtol * scale
+        flat = np.sqrt(var / m) <= FLAT_ROW * scale      # np.std(h) <= FLAT_ROW * scale
         with np.errstate(divide="ignore", invalid="ignore"):
             alpha = np.einsum("ij,ij->i", Hc, K - km[:, None]) / var
         n = np.where(flat, hm, 0.5 * alpha)
