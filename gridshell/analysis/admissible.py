@@ -11,6 +11,7 @@ fits (GG); otherwise the optimizer's failure stands (exit 4).
 """
 from __future__ import annotations
 
+import os
 from typing import Any
 
 import numpy as np
@@ -25,6 +26,17 @@ OCULUS = 1.5
 #: net-direction samples and level-set control points on a ring (radius, angle)
 RING_SAMPLES = (48, 96)
 RING_LEVELSET = (8, 30)
+#: the share of the target (%) a ring's net must cover: the ring is the fallback where no
+#: regular patch exists, its design kept only where it covers most of the target
+RING_COVERAGE = 60.0
+#: curves across the ring's width (their spacing: the width over this)
+RING_CURVES = 12
+
+
+def _phlw_keywords(phlw_options: dict | None) -> dict:
+    """The optimizer's keywords of the user's PHLW options (the ring fixes its B-spline)."""
+    return {k: v for k, v in (phlw_options or {}).items()
+            if k not in ("ctrl", "degree", "transpose", "align")}
 
 
 def _analysis(source: Any, units: Any, obj: str | None) -> Any:
@@ -62,13 +74,18 @@ def no_patch_finding(source: Any, mode: str, *, units: Any = None, obj: str | No
 def design_ncp_explained(source: Any, *, mode: str = "phlw", units: Any = None,
                          obj: str | None = None, **options: Any) -> Any:
     """:func:`gridshell.ncp.pipeline.design_ncp` (same arguments), its PHLW step's failure
-    turned into :class:`NoNetError` (exit 3) where the analysis finds no admissible patch."""
+    turned into :class:`NoNetError` (exit 3) where the analysis finds no admissible patch -
+    after the ring around the umbilic (:func:`ring_design`) failed too; a design whose net
+    covers less than :data:`MIN_COVERAGE` % of a target file is replaced by the ring's, or
+    refused the same way."""
     from gridshell.ncp.pipeline import design_ncp
 
     try:
-        return design_ncp(source, mode=mode, units=units, obj=obj, **options)
+        design = design_ncp(source, mode=mode, units=units, obj=obj, **options)
     except ConvergenceError as exc:
-        if not getattr(exc, "phlw_failure", False):
+        # the PHLW step's failure, or a design that misses its figures on a target file: where
+        # the analysis finds no regular patch of the mode, the ring; else the failure stands
+        if not (getattr(exc, "phlw_failure", False) or isinstance(source, (str, os.PathLike))):
             raise
         a = _analysis(source, units, obj)
         finding = no_patch_finding(source, mode, units=units, obj=obj, analysis=a)
@@ -78,22 +95,40 @@ def design_ncp_explained(source: Any, *, mode: str = "phlw", units: Any = None,
         if design is not None:
             return design
         raise NoNetError(f"{finding}; {why}") from exc
+    cov = float((design.bundle.metrics.get("fidelity") or {}).get("coverage", 100.0))
+    if cov >= MIN_COVERAGE or not isinstance(source, (str, os.PathLike)):
+        return design
+    # the regular patch's net covers too little of the target: the ring, if it covers enough
+    ring, why = ring_design(source, _analysis(source, units, obj), mode=mode, units=units,
+                            obj=obj, **options)
+    if ring is not None:
+        return ring
+    raise NoNetError(f"the {mode} net of the regular patch covers {cov:.0f} % of the target "
+                     f"(< {MIN_COVERAGE:g} %: 'gridshell analyze' maps where the net can "
+                     f"exist); {why}")
 
 
-def _umbilic_frame(geo: Any, a: Any) -> tuple[np.ndarray, np.ndarray, float] | None:
+def _umbilic_frame(geo: Any, a: Any) -> tuple[np.ndarray, np.ndarray, float]:
     """``(centre, normal, oculus radius)`` of the target's largest near-umbilic region: its
     centre moved onto the target, the target's normal there, the radius of a disc 1.5 times
-    the region's area (m); None without one."""
+    the region's area (m; :func:`gridshell.ncp.ring.ring_patch` keeps it within its bounds);
+    without one the crest (the point farthest from the target's mean plane) and radius 0."""
     from gridshell.geometry.igl_adapter import closest_points, triangulate
 
-    umb = [r for r in a.regions if r.kind == "near umbilic"]
-    if not umb:
-        return None
     tV, T, _ = triangulate(np.asarray(geo.V, float), geo.F)
-    _, _, C = closest_points(np.asarray([umb[0].centre], float), tV, T)
     N = np.cross(tV[T[:, 1]] - tV[T[:, 0]], tV[T[:, 2]] - tV[T[:, 0]])   # 2 x area normals
     area = 0.5 * np.linalg.norm(N, axis=1).sum()
-    inner = float(np.sqrt(OCULUS * umb[0].share * area / np.pi))
+    umb = [r for r in a.regions if r.kind == "near umbilic"]
+    if umb:
+        centre, share = np.asarray([umb[0].centre], float), umb[0].share
+    else:             # a crest without a near-umbilic region (a bump): its highest point
+        n = N.sum(axis=0)
+        n = n / (np.linalg.norm(n) or 1.0)
+        h = (tV - tV.mean(axis=0)) @ n
+        centre, share = tV[[int(np.argmax(np.abs(h)) if abs(h.min()) > h.max()
+                                else np.argmax(h))]], 0.0
+    _, _, C = closest_points(centre, tV, T)
+    inner = float(np.sqrt(OCULUS * share * area / np.pi))
     # the normal: the area-weighted mean over the faces within the oculus (one face at the
     # apex of a fan is tilted)
     near = np.linalg.norm(tV[T].mean(axis=1) - C[0], axis=1) <= max(inner, 1e-9)
@@ -102,14 +137,17 @@ def _umbilic_frame(geo: Any, a: Any) -> tuple[np.ndarray, np.ndarray, float] | N
 
 
 def ring_design(source: Any, a: Any, *, mode: str, units: Any = None, obj: str | None = None,
-                min_coverage: float = MIN_COVERAGE, **options: Any) -> tuple[Any, str]:
+                min_coverage: float = RING_COVERAGE, **options: Any) -> tuple[Any, str]:
     """The NCP design on the ring around the target's umbilic (:mod:`gridshell.ncp.ring`):
     ``(design, "")``, or ``(None, why)`` where there is no ring, its PHLW step or design fails,
     or its net covers less than ``min_coverage`` % of the target. Samples and level-set
     control points follow the ring's long side; without ``curves`` or ``spacing`` the curves
-    are an eighth of the ring's width apart."""
+    are :data:`RING_CURVES` to the ring's width. The PHLW step runs on every fit of
+    :data:`gridshell.ncp.ring.FITS`; the design on the converged ones nearest to the target
+    (two at most)."""
     from gridshell.core.errors import GridshellError, InputError
     from gridshell.io.read import read_input
+    from gridshell.ncp.phlw import optimize_phlw
     from gridshell.ncp.pipeline import design_ncp
     from gridshell.ncp.ring import FITS, RingSource, ring_patch
 
@@ -118,18 +156,29 @@ def ring_design(source: Any, a: Any, *, mode: str, units: Any = None, obj: str |
     try:
         geo = read_input(source, units=units, obj=obj, what="the target")
         found = _umbilic_frame(geo, a)
-        if found is None:
-            return None, "no near-umbilic region to put a ring around"
         patches = [ring_patch(geo.V, geo.F, *found[:2], inner=found[2], fit=f) for f in FITS]
     except (InputError, ValueError) as exc:
         return None, f"no ring around the umbilic: {exc}"
-    why = ""
-    for patch in patches:            # the first fit whose PHLW step and design hold
+    steps, loose, why = [], [], ""
+    for patch in patches:            # the PHLW step on the fits in turn, until two converge
+        try:
+            res = optimize_phlw(patch.surface, (patch.V, patch.F), mode=mode,
+                                **_phlw_keywords(options.get("phlw_options")))
+        except GridshellError as exc:
+            why = str(exc)
+            continue
+        (steps if res.converged else loose).append((patch, res))
+        if len(steps) == 2:
+            break
+    if not steps:        # none converged: the nearest to the target, the design's gates judge
+        steps = sorted(loose, key=lambda pr: float(pr[1].deviation))[:2]
+        why = why or "the PHLW step converged on none of its fits"
+    for patch, res in steps:
         opts = dict(options, samples=RING_SAMPLES, levelset_ctrl=RING_LEVELSET)
         if opts.get("curves") is None and opts.get("spacing") is None:
-            opts["spacing"] = (patch.outer - patch.inner) / 8.0
+            opts["spacing"] = (patch.outer - patch.inner) / RING_CURVES
         try:
-            design = design_ncp(RingSource(geo, patch), mode=mode, **opts)
+            design = design_ncp(RingSource(geo, patch, result=res), mode=mode, **opts)
             break
         except GridshellError as exc:
             why = str(exc)

@@ -34,12 +34,15 @@ __all__ = ["FITS", "RingPatch", "RingSource", "region_line", "ring_patch"]
 
 #: the ring's share of the angle left open (the gap between the patch's two sides)
 GAP = 0.1
+#: the oculus's radius within these shares of the rim's
+OCULUS_MIN, OCULUS_MAX = 0.25, 0.45
 #: the outer rim this share of the largest (scaled) radius inside the footprint
 RIM = 0.97
 #: the ring B-splines tried in turn, (control points, samples it is fitted to), each (radius,
 #: angle): the PHLW step's principal-angle figure (1 degree) holds on some and not on others
-#: of these near-equal fits (measured on a paraboloid dome), so the first that holds is kept
-FITS = (((7, 20), (20, 60)), ((6, 18), (20, 60)), ((8, 24), (20, 60)), ((7, 14), (16, 40)))
+#: of these near-equal fits, so the first that holds is kept; in the order of the nets they
+#: gave on a paraboloid dome (coverage 79, 80, 59 % and a failing step)
+FITS = (((6, 18), (20, 60)), ((7, 14), (16, 40)), ((7, 20), (20, 60)), ((8, 24), (20, 60)))
 
 
 @dataclass
@@ -74,10 +77,12 @@ class RingPatch:
 class RingSource:
     """An NCP source (:func:`gridshell.ncp.source.load_surface`): the PHLW step runs on
     ``patch`` towards its faces; the net's fidelity is measured against the whole target
-    ``geo`` (:class:`gridshell.io.read.InputGeometry`)."""
+    ``geo`` (:class:`gridshell.io.read.InputGeometry`); ``result`` the step's outcome when
+    the caller has made it (chosen among several fits)."""
 
     geo: Any
     patch: RingPatch
+    result: Any = None          # the PHLW step's PHLWResult on ``patch``, if already made
     notes: list[str] = field(default_factory=list)
 
 
@@ -112,6 +117,7 @@ def ring_patch(V: np.ndarray, F: np.ndarray, centre: np.ndarray, normal: np.ndar
     :class:`InputError` where the target is not a height field over the umbilic's tangent
     plane or the ring would be empty."""
     from scipy.interpolate import LinearNDInterpolator
+    from scipy.spatial import ConvexHull
 
     from gridshell.geometry.igl_adapter import triangulate
 
@@ -120,9 +126,11 @@ def ring_patch(V: np.ndarray, F: np.ndarray, centre: np.ndarray, normal: np.ndar
     c = np.asarray(centre, float)
     A = _frame(tV, c, np.asarray(normal, float))
     L = (tV - c) @ A.T                                   # local coordinates
+    # a height field over the tangent plane: its faces' projections cover the footprint once
+    # (their areas add up to no more than the footprint's convex hull), whatever their
+    # orientation
     n_loc = np.cross(L[T[:, 1]] - L[T[:, 0]], L[T[:, 2]] - L[T[:, 0]])
-    up = n_loc[:, 2] * np.sign(np.sum(n_loc[:, 2]))
-    if np.mean(up > 0) < 0.99:
+    if 0.5 * np.abs(n_loc[:, 2]).sum() > 1.02 * ConvexHull(L[:, :2]).volume:
         raise InputError("the target folds over the tangent plane at its top (not a height "
                          "field there): no ring patch")
     b = _boundary(T)
@@ -130,9 +138,12 @@ def ring_patch(V: np.ndarray, F: np.ndarray, centre: np.ndarray, normal: np.ndar
     half = np.array([np.abs(xb).max(), np.abs(yb).max()])
     aspect = float(np.clip(half[1] / max(half[0], 1e-12), 0.3, 1.0))
     outer = RIM * float(np.min(np.hypot(xb, yb / aspect)))
-    if not outer > 1.5 * inner:
-        raise InputError(f"the ring around the umbilic is empty (oculus {inner:.3g} m, rim "
-                         f"{outer:.3g} m)")
+    if not outer > 0:
+        raise InputError("the ring around the umbilic is empty (the top on the rim)")
+    # the oculus at least OCULUS_MIN and at most OCULUS_MAX of the rim's radius: off the
+    # umbilic the net's directions exist (n = H lies strictly between the principal
+    # curvatures wherever they differ), the loops around it must be its curvature lines
+    inner = float(np.clip(inner, OCULUS_MIN * outer, OCULUS_MAX * outer))
     height = LinearNDInterpolator(L[:, :2], L[:, 2])
     (cu, cv), (su, sv) = fit
     rho = np.linspace(inner, outer, su)

@@ -151,7 +151,8 @@ def _ring_surface(src: Any, mode: str, opts: dict, progress: Callable[[str], Non
         progress(f"PHLW step on the ring around the umbilic: radius {patch.inner:.3g} to "
                  f"{patch.outer:.3g} m, {patch.share:.0f} % of the target (fit rms "
                  f"{patch.fit_rms:.2g} m)")
-    res = _phlw_step(patch.surface, (patch.V, patch.F), mode, opts, progress)
+    res = src.result if src.result is not None else \
+        _phlw_step(patch.surface, (patch.V, patch.F), mode, opts, progress)
     info = _phlw_info(res, InitialFit(surface=patch.surface, rms=patch.fit_rms,
                                       method="ring"), src.geo)
     info["region"] = patch.record()

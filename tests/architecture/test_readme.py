@@ -13,7 +13,8 @@ import pytest
 from gridshell.cli.main import SUBCOMMANDS, build_parser
 
 ROOT = Path(__file__).resolve().parents[2]
-DOCUMENTS = [ROOT / "README.md", ROOT / "docs" / "fabrication.md", ROOT / "samples" / "README.md"]
+DOCUMENTS = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md")),
+             ROOT / "samples" / "README.md"]
 FENCE = re.compile(r"^```(\w*)[ \t]*\n(.*?)^```", re.M | re.S)
 SYNOPSIS = re.compile(r"[\[\]|]|\.\.\.")   # [optional], a|b, N ...: a synopsis, not a command
 
