@@ -72,12 +72,14 @@ def no_patch_finding(source: Any, mode: str, *, units: Any = None, obj: str | No
 
 
 def design_ncp_explained(source: Any, *, mode: str = "phlw", units: Any = None,
-                         obj: str | None = None, **options: Any) -> Any:
+                         obj: str | None = None, min_coverage: float = MIN_COVERAGE,
+                         **options: Any) -> Any:
     """:func:`gridshell.ncp.pipeline.design_ncp` (same arguments), its PHLW step's failure
     turned into :class:`NoNetError` (exit 3) where the analysis finds no admissible patch -
     after the ring around the umbilic (:func:`ring_design`) failed too; a design whose net
-    covers less than :data:`MIN_COVERAGE` % of a target file is replaced by the ring's, or
-    refused the same way."""
+    covers less than ``min_coverage`` % of a target file (default :data:`MIN_COVERAGE`; 0 keeps
+    every design) is replaced by the ring's where that covers :data:`RING_COVERAGE` %, else
+    refused (:class:`NoNetError`)."""
     from gridshell.ncp.pipeline import design_ncp
 
     try:
@@ -91,21 +93,23 @@ def design_ncp_explained(source: Any, *, mode: str = "phlw", units: Any = None,
         finding = no_patch_finding(source, mode, units=units, obj=obj, analysis=a)
         if finding is None:
             raise
-        design, why = ring_design(source, a, mode=mode, units=units, obj=obj, **options)
+        design, why = ring_design(source, a, mode=mode, units=units, obj=obj,
+                                  min_coverage=max(min_coverage, RING_COVERAGE), **options)
         if design is not None:
             return design
         raise NoNetError(f"{finding}; {why}") from exc
     cov = float((design.bundle.metrics.get("fidelity") or {}).get("coverage", 100.0))
-    if cov >= MIN_COVERAGE or not isinstance(source, (str, os.PathLike)):
+    if cov >= min_coverage or not isinstance(source, (str, os.PathLike)):
         return design
-    # the regular patch's net covers too little of the target: the ring, if it covers enough
+    # the regular patch's net covers too little of the target: the ring's design where it
+    # covers enough, else refused naming both
     ring, why = ring_design(source, _analysis(source, units, obj), mode=mode, units=units,
-                            obj=obj, **options)
+                            obj=obj, min_coverage=max(min_coverage, RING_COVERAGE), **options)
     if ring is not None:
         return ring
     raise NoNetError(f"the {mode} net of the regular patch covers {cov:.0f} % of the target "
-                     f"(< {MIN_COVERAGE:g} %: 'gridshell analyze' maps where the net can "
-                     f"exist); {why}")
+                     f"(< {min_coverage:g} %, --min-coverage; 'gridshell analyze' maps where "
+                     f"the net can exist); {why}")
 
 
 def _umbilic_frame(geo: Any, a: Any) -> tuple[np.ndarray, np.ndarray, float]:
