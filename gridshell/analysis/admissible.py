@@ -77,9 +77,9 @@ def design_ncp_explained(source: Any, *, mode: str = "phlw", units: Any = None,
     """:func:`gridshell.ncp.pipeline.design_ncp` (same arguments), its PHLW step's failure
     turned into :class:`NoNetError` (exit 3) where the analysis finds no admissible patch -
     after the ring around the umbilic (:func:`ring_design`) failed too; a design whose net
-    covers less than ``min_coverage`` % of a target file (default :data:`MIN_COVERAGE`; 0 keeps
-    every design) is replaced by the ring's where that covers :data:`RING_COVERAGE` %, else
-    refused (:class:`NoNetError`)."""
+    covers less than ``min_coverage`` % of a target file (default :data:`MIN_COVERAGE`; 0: never)
+    is replaced by the ring's where that covers :data:`RING_COVERAGE` % and more than it, else
+    kept as it is."""
     from gridshell.ncp.pipeline import design_ncp
 
     try:
@@ -101,15 +101,11 @@ def design_ncp_explained(source: Any, *, mode: str = "phlw", units: Any = None,
     cov = float((design.bundle.metrics.get("fidelity") or {}).get("coverage", 100.0))
     if cov >= min_coverage or not isinstance(source, (str, os.PathLike)):
         return design
-    # the regular patch's net covers too little of the target: the ring's design where it
-    # covers enough, else refused naming both
-    ring, why = ring_design(source, _analysis(source, units, obj), mode=mode, units=units,
-                            obj=obj, min_coverage=max(min_coverage, RING_COVERAGE), **options)
-    if ring is not None:
-        return ring
-    raise NoNetError(f"the {mode} net of the regular patch covers {cov:.0f} % of the target "
-                     f"(< {min_coverage:g} %, --min-coverage; 'gridshell analyze' maps where "
-                     f"the net can exist); {why}")
+    # the regular patch's net covers little of the target: the ring's design where it covers
+    # more, else the regular one as it is (its coverage in the summary and design.json)
+    ring, _ = ring_design(source, _analysis(source, units, obj), mode=mode, units=units,
+                          obj=obj, min_coverage=max(cov, RING_COVERAGE), **options)
+    return ring if ring is not None else design
 
 
 def _umbilic_frame(geo: Any, a: Any) -> tuple[np.ndarray, np.ndarray, float]:

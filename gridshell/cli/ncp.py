@@ -68,12 +68,6 @@ def add_args(p: argparse.ArgumentParser) -> None:
                    help="mesh input: turn the reference's parametrization onto its mean principal "
                         "directions (as far as coverage allows) before the PHLW step (default: "
                         "keep it)")
-    p.add_argument("--min-coverage", type=number(0.0, maximum=100.0), default=50.0,
-                   metavar="PCT",
-                   help="share of the target the net must cover (within 2 %% of the diagonal), "
-                        "%%; a regular patch's net covering less is replaced by the ring around "
-                        "the umbilic's where that covers 60 %%, else refused, exit 3 (default "
-                        "50; 0 keeps every design)")
     p.add_argument("--max-deviation", type=nonnegative, metavar="PCT",
                    help="refuse (exit 4, nothing written) a net whose joints lie farther from "
                         "the target than this on average, %% of its diagonal (default: no gate)")
@@ -116,7 +110,6 @@ def run(args: Any) -> int:
                         postopt_rounds=args.rounds, frames=args.frames,
                         phlw_options=phlw, strict=args.strict,
                         allow_unconverged=args.allow_unconverged,
-                        min_coverage=args.min_coverage,
                         **input_options(args), progress=progress.callback)
     bundle, report = design
     failed = _unconverged(bundle, report)

@@ -72,7 +72,11 @@ def test_cli_bad_reference_exits_with_input_error(tmp_path, capsys):
 def test_cli_unconverged_surface_exits_4_unless_allowed(tmp_path, capsys):
     """A PHLW step stopped after 4 iterations has not converged: exit 4, nothing written,
     the failing figure named; --strict is still accepted (deprecated, same behaviour)."""
-    ref = _torus_obj(tmp_path / "torus.obj")
+    ref = tmp_path / "torus.obj"        # a torus zone bent off revolution: the step has work
+    th, ph = np.meshgrid(np.linspace(-0.8, 0.8, 12), np.linspace(0, 1.2, 12), indexing="ij")
+    rho = 2.0 + np.cos(th) + 0.15 * np.sin(3 * ph) * np.cos(2 * th)
+    write_mesh(ref, np.stack([rho * np.cos(ph), rho * np.sin(ph), np.sin(th)], -1)
+               .reshape(-1, 3), grid_quads(12, 12))
     for extra in ([], ["--strict"]):
         out = tmp_path / "design"
         assert main(["phlw", str(ref), "-o", str(out), "--mode", "phlw", *SMALL, *extra]) == 4
