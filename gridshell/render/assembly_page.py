@@ -5,20 +5,13 @@ Lengths in mm of the model, as cut."""
 from __future__ import annotations
 
 import html
-import json
 from pathlib import Path
 from typing import Any
 
 from gridshell.design.assembly import assembly_plan, deploy_steps
+from gridshell.render.verdicts import _json
 
 __all__ = ["assembly_of", "assembly_section"]
-
-
-def _json(path: Path) -> dict[str, Any] | None:
-    try:
-        return json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return None
 
 
 def assembly_of(d: Path) -> tuple[dict[str, Any], list[str]] | None:
