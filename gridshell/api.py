@@ -87,13 +87,15 @@ def design_ncp(source: Any, *, mode: str = "phlw", curves: int | tuple[int, int]
                frames: int = 12, sim_weights: dict[str, float] | None = None,
                surface_samples: tuple[int, int] = (100, 100), phlw_options: dict | None = None,
                allow_unconverged: bool = False, strict: bool = False, units: Any = None,
-               clean: bool = True, obj: str | None = None, progress: Progress = None) -> Design:
+               clean: bool = True, obj: str | None = None, min_coverage: float | None = None,
+               progress: Progress = None) -> Design:
     """Design an NCP gridshell (PHLW, CNC or AA) on a reference surface: ``(bundle,
     report)``; parameters and results of :func:`gridshell.ncp.pipeline.design_ncp`. Where
     the PHLW step fails on a reference with no regular patch of the mode (the analysis's
     finding), the design is made on the ring around the umbilic, or
     :class:`~gridshell.core.errors.NoNetError` (exit 3) says why
-    (:func:`gridshell.analysis.admissible.design_ncp_explained`)."""
+    (:func:`gridshell.analysis.admissible.design_ncp_explained`, which also gates the net's
+    coverage of a target file: ``min_coverage`` %, None its default, 0 no gate)."""
     from gridshell.analysis.admissible import design_ncp_explained
 
     return design_ncp_explained(
@@ -103,7 +105,7 @@ def design_ncp(source: Any, *, mode: str = "phlw", curves: int | tuple[int, int]
         postopt_weights=postopt_weights, postopt_rounds=postopt_rounds, frames=frames,
         sim_weights=sim_weights, surface_samples=surface_samples, phlw_options=phlw_options,
         allow_unconverged=allow_unconverged, strict=strict, units=units, clean=clean, obj=obj,
-        progress=progress)
+        min_coverage=min_coverage, progress=progress)
 
 
 def optimize_phlw(surf: Any, reference: Any, *, mode: str = "phlw",

@@ -72,14 +72,18 @@ def no_patch_finding(source: Any, mode: str, *, units: Any = None, obj: str | No
 
 
 def design_ncp_explained(source: Any, *, mode: str = "phlw", units: Any = None,
-                         obj: str | None = None, min_coverage: float = MIN_COVERAGE,
+                         obj: str | None = None, min_coverage: float | None = None,
                          **options: Any) -> Any:
     """:func:`gridshell.ncp.pipeline.design_ncp` (same arguments), its PHLW step's failure
     turned into :class:`NoNetError` (exit 3) where the analysis finds no admissible patch -
-    after the ring around the umbilic (:func:`ring_design`) failed too; a design whose net
-    covers less than ``min_coverage`` % of a target file (default :data:`MIN_COVERAGE`; 0: never)
-    is replaced by the ring's where that covers :data:`RING_COVERAGE` % and more than it, else
-    kept as it is."""
+    after the ring around the umbilic (:func:`ring_design`) failed too.
+
+    The coverage gate on a target file (% of its area within 2 % of the net): a design below
+    ``min_coverage`` is replaced by the ring's where that covers more and at least the gate,
+    else refused (:class:`NoNetError`). ``None`` (the default): :data:`RING_COVERAGE` where
+    the analysis finds no regular patch of the mode over :data:`MIN_COVERAGE` % (a dome, a
+    hill), else a regular design under :data:`MIN_COVERAGE` % is kept unless the ring covers
+    more (its coverage in the summary and design.json); ``0``: no gate."""
     from gridshell.ncp.pipeline import design_ncp
 
     try:
@@ -94,18 +98,40 @@ def design_ncp_explained(source: Any, *, mode: str = "phlw", units: Any = None,
         if finding is None:
             raise
         design, why = ring_design(source, a, mode=mode, units=units, obj=obj,
-                                  min_coverage=max(min_coverage, RING_COVERAGE), **options)
+                                  min_coverage=max(min_coverage or 0.0, RING_COVERAGE),
+                                  **options)
         if design is not None:
             return design
         raise NoNetError(f"{finding}; {why}") from exc
+    return _coverage_gate(design, source, mode, units, obj, min_coverage, options)
+
+
+def _coverage_gate(design: Any, source: Any, mode: str, units: Any, obj: str | None,
+                   min_coverage: float | None, options: dict) -> Any:
+    """``design`` when its net covers enough of the target (:func:`design_ncp_explained`),
+    else the ring's design, else ``design`` kept (default gate, a regular patch exists) or
+    :class:`NoNetError` naming the coverage and the analysis's finding."""
     cov = float((design.bundle.metrics.get("fidelity") or {}).get("coverage", 100.0))
-    if cov >= min_coverage or not isinstance(source, (str, os.PathLike)):
+    if not isinstance(source, (str, os.PathLike)) or min_coverage == 0 or \
+            cov >= (RING_COVERAGE if min_coverage is None else min_coverage):
         return design
-    # the regular patch's net covers little of the target: the ring's design where it covers
-    # more, else the regular one as it is (its coverage in the summary and design.json)
-    ring, _ = ring_design(source, _analysis(source, units, obj), mode=mode, units=units,
-                          obj=obj, min_coverage=max(cov, RING_COVERAGE), **options)
-    return ring if ring is not None else design
+    a = _analysis(source, units, obj)
+    finding = no_patch_finding(source, mode, units=units, obj=obj, analysis=a)
+    gate = min_coverage if min_coverage is not None else \
+        (RING_COVERAGE if finding is not None else MIN_COVERAGE)
+    if cov >= gate:
+        return design
+    ring, why = ring_design(source, a, mode=mode, units=units, obj=obj,
+                            min_coverage=max(cov + 1e-9, gate), **options)
+    if ring is not None:
+        return ring
+    if min_coverage is None and finding is None:
+        return design           # a regular patch exists: its net as it is, coverage said
+    raise NoNetError(
+        f"the {mode} net covers {cov:.0f} % of the target, less than "
+        f"{'--min-coverage ' if min_coverage is not None else ''}{gate:g} %"
+        f"{'; ' + finding if finding else ''}; {why}; nothing was written "
+        "(--min-coverage 0 keeps the design as it is)")
 
 
 def _umbilic_frame(geo: Any, a: Any) -> tuple[np.ndarray, np.ndarray, float]:

@@ -71,6 +71,12 @@ def add_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--max-deviation", type=nonnegative, metavar="PCT",
                    help="refuse (exit 4, nothing written) a net whose joints lie farther from "
                         "the target than this on average, %% of its diagonal (default: no gate)")
+    p.add_argument("--min-coverage", type=number(0.0, maximum=100.0), metavar="PCT",
+                   help="refuse (exit 3, nothing written) a net covering less of a target "
+                        "file than this (%% of its area within 2 %% of the diagonal from the "
+                        "net), after trying the ring around its umbilic; 0: no gate (default: "
+                        "60 where the analysis finds no regular patch of the mode - a dome, a "
+                        "hill - else none)")
     p.add_argument("--allow-unconverged", action="store_true",
                    help="write a design whose figures (Delta_a mean / max after the "
                         "post-optimization, Delta_l max, Delta_n max, the collapse error) miss "
@@ -110,7 +116,8 @@ def run(args: Any) -> int:
                         postopt_rounds=args.rounds, frames=args.frames,
                         phlw_options=phlw, strict=args.strict,
                         allow_unconverged=args.allow_unconverged,
-                        **input_options(args), progress=progress.callback)
+                        min_coverage=args.min_coverage, **input_options(args),
+                        progress=progress.callback)
     bundle, report = design
     failed = _unconverged(bundle, report)
     for name in failed:
@@ -127,7 +134,7 @@ def run(args: Any) -> int:
     out = write(args.output, design, render=not args.no_render, progress=progress.callback)
     m = bundle.metrics
     from gridshell.measure.fidelity import fidelity_line
-    from gridshell.ncp.ring import region_line
+    from gridshell.measure.fidelity import region_line
     summary = {
         "bundle": str(out),
         "kind": bundle.kind,

@@ -114,6 +114,20 @@ def _mismatch(out: dict[str, Any], stored: dict[str, Any], table: dict[str, str]
     return bad
 
 
+def _fidelity_mismatch(f: dict | None, stored: dict | None) -> list[str]:
+    """``["fidelity"]`` when the recomputed fidelity ``f`` does not reproduce the stored one
+    (mean deviation relative 1e-3, coverage 0.5 points: the joints are read back from text and
+    a target sample may sit on the 2 % limit), else ``[]`` (nothing to compare)."""
+    if not f or "skipped" in f or not isinstance(stored, dict) or "coverage" not in stored:
+        return []
+    try:
+        same = (np.isclose(f["deviation_mean"], float(stored["deviation_mean"]), rtol=1e-3,
+                           atol=1e-6) and abs(f["coverage"] - float(stored["coverage"])) <= 0.5)
+    except (TypeError, ValueError, KeyError):
+        same = False
+    return [] if same else ["fidelity"]
+
+
 def _count_mismatch(d: dict, n_joints: int, n_loops: int, families: dict[str, int]) -> list[str]:
     """The stored counts of design.json ``d`` (top level and ``metrics``) that differ from the
     files: ``n_joints`` / ``n_loops`` (net.obj), ``n_lamellae`` (lamella records per family)."""
@@ -216,34 +230,57 @@ def _net_figures(d: dict, net: Any, surf_V: np.ndarray, surf_F: np.ndarray) -> d
     return out
 
 
+def _read_target(d: dict) -> Any:
+    """The user's target of design.json ``d`` (``params.target`` of GG, ``params.source`` of
+    NCP) read as the design read it: the recorded unit, object and cleaning; None without a
+    target file (a B-spline surface.json or arrays given to the API);
+    :class:`~gridshell.core.errors.InputError` when it cannot be read."""
+    from gridshell.core.units import Units
+    from gridshell.io.read import read_input
+
+    params = d.get("params") or {}
+    target = params.get("target") or params.get("source")
+    if not isinstance(target, str) or not target or target.startswith("(") \
+            or target.lower().endswith(".json"):
+        return None
+    given = params.get("input") or {}
+    return read_input(target, units=Units.from_json(d.get("units") or params.get("units")),
+                      obj=given.get("object_query"),
+                      clean=given.get("clean", True) is not None, require_disk=False)
+
+
 def _deviation_figures(d: dict, net: Any, surf_V: np.ndarray,
                        surf_F: np.ndarray) -> dict[str, Any]:
     """``deviation`` (% of the diagonal): NCP kinds, of the joints from surface.obj; GG, of
     surface.obj (and ``deviation_joints``) from the target of ``params.target``, read as the
-    design read it (``{"skipped": reason}`` when unreadable; nothing without a target)."""
+    design read it (``{"skipped": reason}`` when unreadable; nothing without a target).
+    Both: ``fidelity``, the net's deviation from the user's target and its coverage
+    (:func:`gridshell.measure.fidelity.net_fidelity`, issue 29 item 4), from the target file
+    (NCP from a B-spline surface.json: from surface.obj)."""
     from gridshell.core.errors import InputError
+    from gridshell.measure.fidelity import net_fidelity
     from gridshell.measure.metrics import deviation, deviations
 
     out: dict[str, Any] = {}
-    target = (d.get("params") or {}).get("target")
     if d["kind"] != "GG":  # the joints from the designed (PHLW) surface, as the pipeline measures them
         dv = deviation(net.joints, surf_V, surf_F, reuse=True)
         out["deviation"] = {"mean": dv["mean"], "max": dv["max"]}
-    elif target:
-        try:  # read as the design read it: the recorded unit, object and cleaning
-            from gridshell.io.read import read_input
-            from gridshell.core.units import Units
-
-            given = (d.get("params") or {}).get("input") or {}
-            t = read_input(target, units=Units.from_json(d.get("units")),
-                           obj=given.get("object_query"),
-                           clean=given.get("clean", True) is not None, require_disk=False)
-        except InputError as exc:
-            out["deviation"] = {"skipped": f"target {target} unreadable: {exc}"}
-        else:
-            dv, dj = deviations([surf_V, net.joints], t.V, t.F)
-            out["deviation"] = {"mean": dv["mean"], "max": dv["max"]}
-            out["deviation_joints"] = {"mean": dj["mean"], "max": dj["max"]}
+    try:
+        t = _read_target(d)
+    except InputError as exc:
+        out["fidelity"] = {"skipped": f"the target is unreadable: {exc}"}
+        if d["kind"] == "GG":
+            out["deviation"] = {"skipped": f"the target is unreadable: {exc}"}
+        return out
+    if t is None and d["kind"] == "GG":
+        return out
+    tV, tF = (t.V, t.F) if t is not None else (surf_V, surf_F)
+    out["fidelity"] = {**net_fidelity(net.joints, net.loops, tV, tF),
+                       "target": t.path if t is not None else "surface.obj"}
+    if d["kind"] == "GG":
+        dv, dj = deviations([surf_V, net.joints], t.V, t.F)
+        out["deviation"] = {"mean": dv["mean"], "max": dv["max"]}
+        out["deviation_joints"] = {"mean": dj["mean"], "max": dj["max"]}
     return out
 
 
@@ -292,6 +329,7 @@ def _verdict(out: dict[str, Any], d: dict, net: Any, problems: list[str]) -> Non
     out["mismatch"] = (_count_mismatch(d, len(net.joints), len(net.loops), families)
                        + _mismatch(out, out["stored"],
                                    NCP_STORED if d["kind"] != "GG" else GG_STORED))
+    out["mismatch"] += _fidelity_mismatch(out.get("fidelity"), out["stored"].get("fidelity"))
     if out["mismatch"]:
         problems.append("design.json disagrees with the files on " + ", ".join(out["mismatch"])
                         + " (the bundle was changed after the design)")
@@ -300,6 +338,12 @@ def _verdict(out: dict[str, Any], d: dict, net: Any, problems: list[str]) -> Non
     out["required"] = {"figures": [g.name for g in gates], "files": list(FIGURE_FILES[d["kind"]])}
     out["gates"] = [g.as_dict() for g in gates]
     out["checks"] = [g.line() for g in gates]
+    f = out.get("fidelity")
+    if f:
+        from gridshell.measure.fidelity import fidelity_line
+
+        out["checks"].append("fidelity (not a gate): " + (f"skipped, {f['skipped']}" if
+                                                          "skipped" in f else fidelity_line(f)))
     out["problems"] = problems
     out["ok"] = not bad and not problems
 

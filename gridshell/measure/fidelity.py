@@ -12,9 +12,12 @@ Units: metres in, percent out.
 """
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
-__all__ = ["COVER_TOL", "fidelity_line", "loop_triangles", "net_fidelity", "require_fidelity"]
+__all__ = ["COVER_TOL", "fidelity_line", "fidelity_rows", "loop_triangles", "net_fidelity",
+           "region_line", "require_fidelity"]
 
 #: a target point is covered when it lies within this share of the diagonal of the net (%)
 COVER_TOL = 2.0
@@ -78,6 +81,24 @@ def fidelity_line(f: dict | None) -> str:
     return (f"joints from {f.get('target', 'the target')}: mean {f['deviation_mean']:.3g} %, "
             f"p95 {f['deviation_p95']:.3g} %, max {f['deviation_max']:.3g} % of the diagonal; "
             f"covers {f['coverage']:.0f} % of it (within {COVER_TOL:g} %)")
+
+
+def region_line(rec: dict[str, Any] | None) -> str:
+    """One line on the region a design was made on (design.json ``metrics["region"]``)."""
+    if not rec:
+        return "the whole surface"
+    return (f"{rec['kind']}: radius {rec['inner_m']:.3g} to {rec['outer_m']:.3g} m "
+            f"(loops {rec['aspect']:.2g} as wide across), the top inside and a "
+            f"{rec['gap_deg']:.0f} deg gap left out; {rec['share_percent']:.0f} % of the target")
+
+
+def fidelity_rows(metrics: dict) -> list[tuple[str, str]]:
+    """The report's rows on a design's fidelity to its target and the region designed on
+    (design.json ``metrics``; none where the design stored no fidelity)."""
+    if not metrics.get("fidelity"):
+        return []
+    return [("fidelity to the target", fidelity_line(metrics["fidelity"])),
+            ("designed region", region_line(metrics.get("region")))]
 
 
 def require_fidelity(metrics: dict, max_deviation: float | None) -> None:

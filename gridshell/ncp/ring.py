@@ -30,7 +30,7 @@ import numpy as np
 from gridshell.core.errors import InputError
 from gridshell.geometry.bspline import BSplineSurface, fit_grid
 
-__all__ = ["FITS", "RingPatch", "RingSource", "region_line", "ring_patch"]
+__all__ = ["FITS", "RingPatch", "RingSource", "ring_patch"]
 
 #: the ring's share of the angle left open (the gap between the patch's two sides)
 GAP = 0.1
@@ -167,12 +167,3 @@ def ring_patch(V: np.ndarray, F: np.ndarray, centre: np.ndarray, normal: np.ndar
     return RingPatch(surface=surf, V=tV[used], F=Tr.reshape(-1, 3), origin=c, axes=A,
                      inner=float(inner), outer=outer, aspect=aspect, gap=float(gap),
                      share=share, fit_rms=float(rms))
-
-
-def region_line(rec: dict[str, Any] | None) -> str:
-    """One line on the region a design was made on (design.json ``metrics["region"]``)."""
-    if not rec:
-        return "the whole surface"
-    return (f"{rec['kind']}: radius {rec['inner_m']:.3g} to {rec['outer_m']:.3g} m "
-            f"(loops {rec['aspect']:.2g} as wide across), the top inside and a "
-            f"{rec['gap_deg']:.0f} deg gap left out; {rec['share_percent']:.0f} % of the target")

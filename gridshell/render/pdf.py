@@ -58,6 +58,11 @@ def _overview(d: Path) -> list[str]:
 
     lines = [f"{topic}: {status} - {_TAG.sub('', text)}"
              for topic, status, text in verdicts(d, *figures_line(d))]
+    from gridshell.design.bundle import read_design_json
+    from gridshell.measure.fidelity import fidelity_rows
+
+    lines += [f"{k}: {v}" for k, v in
+              fidelity_rows(read_design_json(d).get("metrics") or {})]
     bom = bill_of_materials(d)
     if bom:
         lines += ["", "Bill of materials"] + [f"  {k}: {v}" for k, v in bom]

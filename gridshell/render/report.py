@@ -377,6 +377,9 @@ def report_html(bundle_dir: str | os.PathLike) -> str:
                 ("joints", design.get("n_joints")), ("net-loops", design.get("n_loops")),
                 ("lamellae", f"{len(lams)} (C1: {fam[1]}, C3: {fam[3]})"),
                 ("total lamella length [m]", f"{total:.4g}")]
+    from gridshell.measure.fidelity import fidelity_rows
+
+    overview += fidelity_rows(metrics)   # how faithfully the net follows the user's target
     if "collapse" in design:
         c = design["collapse"]
         overview.append(("collapse curve", f"{c.get('shape')}" + (

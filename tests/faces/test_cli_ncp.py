@@ -64,6 +64,16 @@ def test_cli_from_a_mesh_runs_the_phlw_step(tmp_path, capsys):
     # the aligned joints on the design's circle of radius 1/n
     assert v["aligned_radius_error"] < 1 and v["aligned_radius_error_n"] < 1
     assert v["aligned_circle_deviation"]["max"] < 1
+    # the net's fidelity to the user's torus.obj, recomputed from it: what design.json says
+    f, stored = v["fidelity"], d["metrics"]["fidelity"]
+    assert f["target"] == str(ref) and f["coverage"] == pytest.approx(stored["coverage"], abs=0.5)
+    assert f["deviation_mean"] == pytest.approx(stored["deviation_mean"], rel=1e-3)
+    assert any(ln.startswith("fidelity (not a gate): joints from") for ln in v["checks"])
+    # without the target file the fidelity is skipped, the design's figures still checked
+    ref.rename(tmp_path / "gone.obj")
+    assert main(["verify", str(out)]) == 0
+    v = json.loads(capsys.readouterr().out)
+    assert "skipped" in v["fidelity"] and v["mismatch"] == []
 
 
 def test_cli_phlw_mode_then_verify(tmp_path, capsys):

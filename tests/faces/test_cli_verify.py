@@ -67,3 +67,26 @@ def test_gg_bundle_passes_its_own_tools(tmp_path, capsys, name):
     assert not res["ok"] and "alignability" in res["mismatch"]
     assert main(["fabricate", str(b), "-o", str(tmp_path / "fab"), "-q", "--no-plan"]) == 2
     assert not (tmp_path / "fab").exists()
+
+
+def test_verify_recomputes_the_nets_fidelity_from_the_target_file(tmp_path, capsys):
+    """The dome's net sits on the dome: verify measures it again from dome.obj as design.json
+    has it; the dome raised by 1 % of its diagonal moves every joint ~1 % away (the dome is
+    shallow: its normal is nearly z) and verify says the files disagree."""
+    target, b = tmp_path / "dome.obj", tmp_path / "design"
+    V, F = SURFACES["dome"]()
+    write_mesh(target, V, F)
+    assert main(["gg", str(target), "-o", str(b), *GG]) == 0
+    capsys.readouterr()
+    stored = json.loads((b / "design.json").read_text())["metrics"]["fidelity"]
+    assert main(["verify", str(b)]) == 0
+    f = json.loads(capsys.readouterr().out)["fidelity"]
+    assert f["deviation_mean"] == pytest.approx(stored["deviation_mean"], rel=1e-3)
+    assert f["coverage"] == pytest.approx(stored["coverage"], abs=0.5) and f["coverage"] > 60
+    diag = float(np.linalg.norm(np.ptp(V, axis=0)))
+    write_mesh(target, V + [0.0, 0.0, 0.01 * diag], F)
+    assert main(["verify", str(b)]) in (2, 4)
+    res = json.loads(capsys.readouterr().out)
+    assert "fidelity" in res["mismatch"]
+    assert res["fidelity"]["deviation_mean"] == pytest.approx(1.0, abs=0.1)
+

@@ -132,6 +132,10 @@ def test_the_report_states_every_verdict_and_the_bill_of_materials(pack, tmp_pat
     kg = length * p["width"] * 1e-3 * p["thickness"] * 1e-3 * get_material(
         json.loads((out / "structure.json").read_text())["material"]["name"]).density
     assert rows["mass of the strips"].startswith(f"{kg:.3g} kg")
+    # the net's fidelity to the user's target, as design.json stores it
+    f = json.loads((out / "design.json").read_text())["metrics"]["fidelity"]
+    assert f"covers {f['coverage']:.0f} % of it" in page and "fidelity to the target" in page
+    assert f"mean {f['deviation_mean']:.3g} %" in page
     # an overstressed check is said first, as a failure, above the figures that pass
     bad = tmp_path / "bad"
     shutil.copytree(out, bad)
