@@ -16,19 +16,17 @@ from typing import Any
 
 import numpy as np
 
-from gridshell.analysis.recommend import MIN_COVERAGE
+from gridshell.analysis.recommend import MIN_COVERAGE, RING_COVERAGE
 from gridshell.core.errors import ConvergenceError, NoNetError
 
 __all__ = ["design_ncp_explained", "no_patch_finding", "ring_design"]
 
-#: the oculus left open on a ring: a disc of this many times the near-umbilic region's area
-OCULUS = 1.5
+#: near-umbilic share of a target (%) from which a regular patch's net must cover
+#: :data:`RING_COVERAGE` % by default: the patch ends at umbilics (an elliptic dome's)
+UMBILIC_SHARE = 1.0
 #: net-direction samples and level-set control points on a ring (radius, angle)
 RING_SAMPLES = (48, 96)
 RING_LEVELSET = (8, 30)
-#: the share of the target (%) a ring's net must cover: the ring is the fallback where no
-#: regular patch exists, its design kept only where it covers most of the target
-RING_COVERAGE = 60.0
 #: curves across the ring's width (their spacing: the width over this)
 RING_CURVES = 12
 
@@ -37,6 +35,13 @@ def _phlw_keywords(phlw_options: dict | None) -> dict:
     """The optimizer's keywords of the user's PHLW options (the ring fixes its B-spline)."""
     return {k: v for k, v in (phlw_options or {}).items()
             if k not in ("ctrl", "degree", "transpose", "align")}
+
+
+def _umbilic_of(a: Any) -> tuple[np.ndarray | None, float]:
+    """``(centre (3,) m, share of the target)`` of the analysis's largest near-umbilic
+    region, ``(None, 0)`` without one."""
+    umb = [r for r in a.regions if r.kind == "near umbilic"]
+    return (np.asarray(umb[0].centre, float), float(umb[0].share)) if umb else (None, 0.0)
 
 
 def _analysis(source: Any, units: Any, obj: str | None) -> Any:
@@ -50,6 +55,15 @@ def _analysis(source: Any, units: Any, obj: str | None) -> Any:
         return None
 
 
+def _where(a: Any) -> str:
+    """Where the analysis ``a`` finds near-umbilic regions (or the signs of K without)."""
+    umb = [r for r in a.regions if r.kind == "near umbilic"]
+    return (f"near-umbilic regions cover {a.classes['near umbilic']:.0f} % of the target "
+            f"(the largest {100 * umb[0].share:.0f} % around "
+            f"({', '.join(f'{c:.3g}' for c in umb[0].centre)}) m)" if umb else
+            f"K > 0 on {a.classes['K>0']:.0f} %, K < 0 on {a.classes['K<0']:.0f} % of it")
+
+
 def no_patch_finding(source: Any, mode: str, *, units: Any = None, obj: str | None = None,
                      min_coverage: float = MIN_COVERAGE, analysis: Any = None) -> str | None:
     """The analysis's finding when ``mode`` has no regular patch over ``min_coverage`` % of
@@ -60,13 +74,8 @@ def no_patch_finding(source: Any, mode: str, *, units: Any = None, obj: str | No
     cov = a.coverage.get(mode, 0.0)
     if cov >= min_coverage:
         return None
-    umb = [r for r in a.regions if r.kind == "near umbilic"]
-    where = (f"near-umbilic regions cover {a.classes['near umbilic']:.0f} % of the target "
-             f"(the largest {100 * umb[0].share:.0f} % around "
-             f"({', '.join(f'{c:.3g}' for c in umb[0].centre)}) m)" if umb else
-             f"K > 0 on {a.classes['K>0']:.0f} %, K < 0 on {a.classes['K<0']:.0f} % of it")
     return (f"no regular patch of the {mode} net covers {min_coverage:g} % of this target: "
-            f"{where}; the largest admissible patch covers {cov:.0f} % "
+            f"{_where(a)}; the largest admissible patch covers {cov:.0f} % "
             f"('gridshell analyze' maps it); a GG gridshell fits such shapes "
             f"('gridshell gg' or 'gridshell build')")
 
@@ -117,6 +126,8 @@ def _coverage_gate(design: Any, source: Any, mode: str, units: Any, obj: str | N
         return design
     a = _analysis(source, units, obj)
     finding = no_patch_finding(source, mode, units=units, obj=obj, analysis=a)
+    if finding is None and a is not None and a.classes["near umbilic"] >= UMBILIC_SHARE:
+        finding = f"the regular patch ends at umbilics: {_where(a)}"
     gate = min_coverage if min_coverage is not None else \
         (RING_COVERAGE if finding is not None else MIN_COVERAGE)
     if cov >= gate:
@@ -134,34 +145,6 @@ def _coverage_gate(design: Any, source: Any, mode: str, units: Any, obj: str | N
         "(--min-coverage 0 keeps the design as it is)")
 
 
-def _umbilic_frame(geo: Any, a: Any) -> tuple[np.ndarray, np.ndarray, float]:
-    """``(centre, normal, oculus radius)`` of the target's largest near-umbilic region: its
-    centre moved onto the target, the target's normal there, the radius of a disc 1.5 times
-    the region's area (m; :func:`gridshell.ncp.ring.ring_patch` keeps it within its bounds);
-    without one the crest (the point farthest from the target's mean plane) and radius 0."""
-    from gridshell.geometry.igl_adapter import closest_points, triangulate
-
-    tV, T, _ = triangulate(np.asarray(geo.V, float), geo.F)
-    N = np.cross(tV[T[:, 1]] - tV[T[:, 0]], tV[T[:, 2]] - tV[T[:, 0]])   # 2 x area normals
-    area = 0.5 * np.linalg.norm(N, axis=1).sum()
-    umb = [r for r in a.regions if r.kind == "near umbilic"]
-    if umb:
-        centre, share = np.asarray([umb[0].centre], float), umb[0].share
-    else:             # a crest without a near-umbilic region (a bump): its highest point
-        n = N.sum(axis=0)
-        n = n / (np.linalg.norm(n) or 1.0)
-        h = (tV - tV.mean(axis=0)) @ n
-        centre, share = tV[[int(np.argmax(np.abs(h)) if abs(h.min()) > h.max()
-                                else np.argmax(h))]], 0.0
-    _, _, C = closest_points(centre, tV, T)
-    inner = float(np.sqrt(OCULUS * share * area / np.pi))
-    # the normal: the area-weighted mean over the faces within the oculus (one face at the
-    # apex of a fan is tilted)
-    near = np.linalg.norm(tV[T].mean(axis=1) - C[0], axis=1) <= max(inner, 1e-9)
-    normal = N[near].sum(axis=0) if near.any() else N.sum(axis=0)
-    return np.asarray(C[0], float), normal, inner
-
-
 def ring_design(source: Any, a: Any, *, mode: str, units: Any = None, obj: str | None = None,
                 min_coverage: float = RING_COVERAGE, **options: Any) -> tuple[Any, str]:
     """The NCP design on the ring around the target's umbilic (:mod:`gridshell.ncp.ring`):
@@ -175,16 +158,27 @@ def ring_design(source: Any, a: Any, *, mode: str, units: Any = None, obj: str |
     from gridshell.io.read import read_input
     from gridshell.ncp.phlw import optimize_phlw
     from gridshell.ncp.pipeline import design_ncp
-    from gridshell.ncp.ring import FITS, RingSource, ring_patch
+    from gridshell.ncp.ring import FITS, RingSource, ring_patch, umbilic_frame
 
     if mode not in ("phlw", "cnc") or a is None:
         return None, f"no ring patch for mode {mode}"
     try:
         geo = read_input(source, units=units, obj=obj, what="the target")
-        found = _umbilic_frame(geo, a)
-        patches = [ring_patch(geo.V, geo.F, *found[:2], inner=found[2], fit=f) for f in FITS]
     except (InputError, ValueError) as exc:
         return None, f"no ring around the umbilic: {exc}"
+    patches, why = [], ""
+    umbilic = _umbilic_of(a)
+    for about in [umbilic] + ([(None, 0.0)] if umbilic[0] is not None else []):
+        # about the umbilic, else about the crest (an umbilic on the rim: an elliptic dome's)
+        try:
+            found = umbilic_frame(geo.V, geo.F, *about)
+            patches = [ring_patch(geo.V, geo.F, *found[:2], inner=found[2], fit=f)
+                       for f in FITS]
+            break
+        except (InputError, ValueError) as exc:
+            why = why or str(exc)
+    if not patches:
+        return None, f"no ring around the umbilic: {why}"
     steps, loose, why = [], [], ""
     for patch in patches:            # the PHLW step on the fits in turn, until two converge
         try:

@@ -45,6 +45,7 @@ class Analysis:
     gg: GGTrial | None
     recommendation: Recommendation
     seconds: float
+    ring: dict[str, Any] | None = None
 
     @property
     def coverage(self) -> dict[str, float]:
@@ -63,6 +64,7 @@ class Analysis:
                         "largest_patch": None if r is None else r.as_dict(),
                         "coverage_percent": round(self.coverage[m], 2)}
                     for m, r in self.patches.items()},
+            "ring": self.ring,
             "gg": None if self.gg is None else self.gg.as_dict(),
             "recommendation": self.recommendation.as_dict(),
             "seconds": round(self.seconds, 2),
@@ -95,14 +97,38 @@ def analyze_target(target: Any, *, units: Any = None, clean: bool = True, obj: s
     regular = _larger(largest_rectangle(m, ~umb & (sign > 0)),
                       largest_rectangle(m, ~umb & (sign < 0)))
     patches = {"phlw": regular, "cnc": regular, "aa": largest_rectangle(m, sign < 0)}
-    gg = gg_trial(g) if trial else None
     cov = {k: 0.0 if r is None else 100.0 * r.share for k, r in patches.items()}
-    rec = _for_target(recommend(cov, gg, min_coverage), g.path, units, obj)
+    # no regular patch of curvature lines (a dome, a hill): the ring around its umbilic
+    ring = _ring(V, F, found) if cov["phlw"] < min_coverage else None
+    gg = gg_trial(g) if trial else None
+    rec = _for_target(recommend(cov, gg, min_coverage, ring=ring), g.path, units, obj)
     info = {"name": g.name, "path": g.path, "units": g.units.name, "vertices": int(len(g.V)),
             "faces": int(len(g.F)), "diagonal_m": round(m.diagonal, 6),
             "surface": "the .3dm NURBS surface" if g.surface is not None else
             f"least-squares B-spline (rms {rms:.3g} m)", "working_copy": working}
-    return Analysis(info, m, classes, found, patches, gg, rec, time.perf_counter() - t0)
+    return Analysis(info, m, classes, found, patches, gg, rec, time.perf_counter() - t0, ring)
+
+
+def _ring(V: np.ndarray, F: np.ndarray, found: list[Region]) -> dict[str, Any]:
+    """The ring around the target's largest near-umbilic region (or its crest) on which
+    ``gridshell ncp`` designs a PHLW or CNC net where no regular patch exists
+    (:func:`gridshell.ncp.ring.ring_patch`): its radii, centre and share of the target, or
+    ``{"none": why}``. Its loops are curvature lines on a surface of revolution; elsewhere
+    the PHLW step moves them there."""
+    from gridshell.core.errors import InputError
+    from gridshell.ncp.ring import ring_patch, umbilic_frame
+
+    umb = [r for r in found if r.kind == "near umbilic"]
+    try:
+        frame = umbilic_frame(V, F, *((np.asarray(umb[0].centre), umb[0].share) if umb
+                                      else (None, 0.0)))
+        p = ring_patch(V, F, *frame[:2], inner=frame[2])
+    except (InputError, ValueError) as exc:
+        return {"none": str(exc)}
+    return {"kind": "ring around the umbilic" if umb else "ring around the crest",
+            "modes": ["phlw", "cnc"], "centre_m": [round(float(c), 6) for c in p.origin],
+            "inner_m": round(p.inner, 6), "outer_m": round(p.outer, 6),
+            "share_percent": round(p.share, 2)}
 
 
 def _for_target(rec: Recommendation, path: Any, units: Any, obj: str | None) -> Recommendation:
@@ -172,6 +198,11 @@ def summary_of(a: Analysis) -> dict[str, Any]:
     d["regions"] = "; ".join(f"{r.kind} {100 * r.share:.0f} % at ({r.centre[0]:.2f}, "
                              f"{r.centre[1]:.2f}, {r.centre[2]:.2f}) m" for r in big) or "-"
     d["NCP largest regular patch [%]"] = {m: round(c, 1) for m, c in a.coverage.items()}
+    if a.ring is not None:
+        d["NCP ring"] = (f"no ring: {a.ring['none']}" if "none" in a.ring else
+                         f"{a.ring['kind']}, radius {a.ring['inner_m']:.3g} to "
+                         f"{a.ring['outer_m']:.3g} m: {a.ring['share_percent']:.0f} % of the "
+                         "target (phlw, cnc: 'gridshell ncp' designs there)")
     if a.gg is None:
         d["GG trial"] = "not run (--no-trial)"
     elif a.gg.error:

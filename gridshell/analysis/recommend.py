@@ -13,12 +13,15 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-__all__ = ["GG_GOOD", "MIN_COVERAGE", "Recommendation", "recommend"]
+__all__ = ["GG_GOOD", "MIN_COVERAGE", "RING_COVERAGE", "Recommendation", "recommend"]
 
 #: mean deviation (% of the diagonal) under which a GG design follows the shape
 GG_GOOD = 2.0
 #: share of the target (%) an NCP mode's largest admissible patch must cover
 MIN_COVERAGE = 50.0
+#: the share of the target (%) a ring's net must cover: the ring is the fallback where no
+#: regular patch exists, its design kept only where it covers most of the target
+RING_COVERAGE = 60.0
 #: the order NCP modes are preferred in at equal coverage (PHLW is the general one)
 _NCP_ORDER = ("phlw", "cnc", "aa")
 
@@ -39,10 +42,12 @@ class Recommendation:
         return dict(self.__dict__)
 
 
-def recommend(coverage: dict[str, float], gg: Any, min_coverage: float = MIN_COVERAGE
-              ) -> Recommendation:
+def recommend(coverage: dict[str, float], gg: Any, min_coverage: float = MIN_COVERAGE,
+              ring: dict[str, Any] | None = None) -> Recommendation:
     """``coverage``: NCP mode -> % of the target its largest admissible patch covers;
-    ``gg``: the :class:`~gridshell.analysis.trial.GGTrial`."""
+    ``gg``: the :class:`~gridshell.analysis.trial.GGTrial`; ``ring``: the ring around the
+    umbilic where no regular patch exists (its ``share_percent``; an NCP PHLW net on it is
+    recommended where it covers :data:`RING_COVERAGE` % and GG does not follow the shape)."""
     gg_dev = gg.deviation_mean if gg is not None else None
     if gg_dev is not None and gg_dev <= GG_GOOD:
         return Recommendation("gg", None, "gridshell gg TARGET -o DIR",
@@ -55,9 +60,20 @@ def recommend(coverage: dict[str, float], gg: Any, min_coverage: float = MIN_COV
                + ("" if gg_dev is None else f"; the nearest GG surface lies {gg_dev:.2f} % away"))
         return Recommendation("ncp", best, f"gridshell ncp TARGET -o DIR --mode {best}", why,
                               None, coverage[best])
+    share = (ring or {}).get("share_percent", 0.0)
+    if share >= RING_COVERAGE and gg is not None:     # the GG trial ran and misses the shape
+        why = (f"no regular patch of curvature lines covers {min_coverage:g} % of the target; "
+               f"the {ring['kind']} covers {share:.0f} % of it"
+               + ("" if gg_dev is None else f"; the nearest GG surface lies {gg_dev:.2f} % away"))
+        return Recommendation("ncp", "phlw", "gridshell ncp TARGET -o DIR --mode phlw", why,
+                              None, share)
     best_ncp = max(_NCP_ORDER, key=lambda m: coverage.get(m, 0.0))
     why = (f"no NCP mode has a regular patch over {min_coverage:g} % of the target (best: "
            f"{best_ncp} {coverage.get(best_ncp, 0.0):.0f} %)")
+    if share:
+        why += (f"; the {ring['kind']} covers {share:.0f} % of it " +
+                ("('gridshell ncp' designs there)" if share >= RING_COVERAGE else
+                 f"(an NCP design there needs {RING_COVERAGE:g} %)"))
     if gg_dev is None:
         return Recommendation("gg", None, "gridshell gg TARGET -o DIR",
                               why + f"; the GG trial failed: {gg.error if gg else 'not run'}",

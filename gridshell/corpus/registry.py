@@ -22,14 +22,15 @@ from gridshell.corpus.surfaces import FAMILIES, Shape
 __all__ = ["COUNTS", "FAST", "MODES", "REFERENCES", "Reference", "build_reference", "get",
            "names", "select"]
 
-#: references per family (100 in all); the last four families (the domes and hills architects
+#: references per family (110 in all); the last five families (the domes and hills architects
 #: draw) are written in the users' units and formats (:data:`_FILES`)
 COUNTS: dict[str, int] = {"revolution": 10, "associate": 8, "hill": 8, "dome": 7, "ridge": 5,
                           "saddle": 8, "monkey": 5, "sphere-cap": 4, "near-sphere": 5,
                           "pseudosphere": 4, "near-pseudosphere": 5, "dini": 3,
-                          "bump": 7, "round-dome": 7, "asym-hill": 7, "pavilion": 7}
+                          "bump": 7, "round-dome": 7, "asym-hill": 7, "pavilion": 7,
+                          "round-plan": 10}
 #: families whose target files come in a user's units and formats, not metres in OBJ
-_USER_FILES = ("bump", "round-dome", "asym-hill", "pavilion")
+_USER_FILES = ("bump", "round-dome", "asym-hill", "pavilion", "round-plan")
 #: (format, units) of those files, cycled: Rhino models in millimetres first
 _FILES = [("3dm", "mm"), ("obj", "mm"), ("ply", "m"), ("3dm", "cm"), ("off", "mm"),
           ("obj", "m"), ("3dm", "m"), ("ply", "mm"), ("3dm", "mm")]

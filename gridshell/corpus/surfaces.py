@@ -453,6 +453,63 @@ def make_pavilion(rng: np.random.Generator) -> Shape:
     return _turned_shape("pavilion", {"bumps": len(terms)}, terms, 1.0, Y, _u(rng, 0.0, np.pi))
 
 
+def _plan_xy(a: np.ndarray, b: np.ndarray, X: float, Y: float) -> tuple[np.ndarray, np.ndarray]:
+    """The unit square onto the (nearly) elliptic plan of semi-axes ``X, Y``: ``u = 2 b - 1``,
+    ``w = 2 a - 1``, ``x = X u sqrt(1 - 0.4 w^2)``, ``y = Y w sqrt(1 - 0.4 u^2)``: the
+    square's sides onto a rim through ``(+-X, 0)`` and ``(0, +-Y)`` whose corners bulge 10 %
+    out (``0.5`` instead of ``0.4`` is the ellipse, but its map folds the square's corners
+    flat: a grid cell of angle 180 degrees)."""
+    a, b = np.broadcast_arrays(np.asarray(a, float), np.asarray(b, float))
+    u, w = 2 * b - 1, 2 * a - 1
+    return X * u * np.sqrt(1 - 0.4 * w * w), Y * w * np.sqrt(1 - 0.4 * u * u)
+
+
+#: the shapes of the round-plan family, drawn in turn
+ROUND_PLAN_KINDS = ("paraboloid", "sphere", "elliptic", "bump", "asymmetric", "oblate")
+
+
+def make_round_plan(rng: np.random.Generator) -> Shape:
+    """Domes and hills on round and elliptic plans, as architects draw them (issue 29): a
+    paraboloid, sphere cap or oblate dome of revolution about the plan's centre (an umbilic at
+    the crown; the sphere umbilic everywhere), an elliptic paraboloid (two umbilics on its long
+    axis), a Gaussian bump on a flat skirt (K of both signs) or an asymmetric hill (an off-centre
+    bump and a cubic skew). The plan is the unit square mapped onto the ellipse of semi-axes 1
+    and ``Y`` (:func:`_plan_xy`): the grid's outer rows and columns run along the rim. K in
+    closed form from the height (K does not depend on the parametrization)."""
+    kind = str(rng.choice(ROUND_PLAN_KINDS))
+    Y = 1.0 if kind in ("paraboloid", "sphere", "oblate", "bump") else _u(rng, 0.6, 0.85)
+    if kind == "paraboloid":
+        h, R2 = _u(rng, 0.25, 0.5), _u(rng, 1.0, 1.3)
+        terms: list[tuple] = [("poly", h, 0, 0), ("poly", -h / R2, 2, 0),
+                              ("poly", -h / R2, 0, 2)]
+    elif kind in ("sphere", "oblate"):
+        R = _u(rng, 1.3, 2.2)
+        c = R if kind == "sphere" else R * _u(rng, 0.35, 0.6)
+        terms = [("ellipsoid", R, R, c), ("poly", -c * np.sqrt(1 - 1 / (R * R)), 0, 0)]
+    elif kind == "elliptic":
+        h = _u(rng, 0.3, 0.5)
+        terms = [("poly", h, 0, 0), ("poly", -h / 1.1, 2, 0), ("poly", -h / (1.1 * Y * Y), 0, 2)]
+    elif kind == "bump":
+        sx = _u(rng, 0.4, 0.55)
+        terms = [("gauss", _u(rng, 0.3, 0.45), 0.0, 0.0, sx, sx * _u(rng, 0.85, 1.15))]
+    else:
+        terms = [("gauss", _u(rng, 0.35, 0.5), _u(rng, -0.2, 0.2), _u(rng, -0.1, 0.1) * Y,
+                  _u(rng, 0.45, 0.6), _u(rng, 0.4, 0.55) * Y),
+                 ("poly", _u(rng, -0.05, 0.05), 3, 0), ("poly", _u(rng, -0.05, 0.05), 1, 2)]
+    h = height_terms(terms)
+
+    def f(a, b):
+        x, y = _plan_xy(a, b, 1.0, Y)
+        return np.stack([x, y, h(x, y)[0]], axis=-1)
+
+    def K(a, b):
+        _, hx, hy, hxx, hxy, hyy = h(*_plan_xy(a, b, 1.0, Y))
+        return (hxx * hyy - hxy**2) / (1 + hx**2 + hy**2) ** 2
+    p = {"kind": kind, "X": 1.0, "Y": Y, "terms": [list(t) for t in terms]}
+    return Shape("round-plan", p, f, kind in ("paraboloid", "sphere", "oblate"),
+                 {"K": K, "height": h})
+
+
 #: family -> generator, in registry order
 FAMILIES: dict[str, Callable[[np.random.Generator], Shape]] = {
     "revolution": make_revolution,
@@ -471,4 +528,5 @@ FAMILIES: dict[str, Callable[[np.random.Generator], Shape]] = {
     "round-dome": make_round_dome,
     "asym-hill": make_asym_hill,
     "pavilion": make_pavilion,
+    "round-plan": make_round_plan,
 }

@@ -30,8 +30,10 @@ import numpy as np
 from gridshell.core.errors import InputError
 from gridshell.geometry.bspline import BSplineSurface, fit_grid
 
-__all__ = ["FITS", "RingPatch", "RingSource", "ring_patch"]
+__all__ = ["FITS", "RingPatch", "RingSource", "ring_patch", "umbilic_frame"]
 
+#: the oculus left open on a ring: a disc of this many times the near-umbilic region's area
+OCULUS = 1.5
 #: the ring's share of the angle left open (the gap between the patch's two sides)
 GAP = 0.1
 #: the oculus's radius within these shares of the rim's
@@ -167,3 +169,30 @@ def ring_patch(V: np.ndarray, F: np.ndarray, centre: np.ndarray, normal: np.ndar
     return RingPatch(surface=surf, V=tV[used], F=Tr.reshape(-1, 3), origin=c, axes=A,
                      inner=float(inner), outer=outer, aspect=aspect, gap=float(gap),
                      share=share, fit_rms=float(rms))
+
+
+def umbilic_frame(V: np.ndarray, F: np.ndarray, centre: np.ndarray | None, share: float
+                  ) -> tuple[np.ndarray, np.ndarray, float]:
+    """``(centre, normal, oculus radius)`` of the ring about a target's near-umbilic region
+    (``centre`` (3,) m, ``share`` of the target's area): the centre moved onto the target
+    ``V, F``, the target's normal there, the radius of a disc :data:`OCULUS` times the
+    region's area (m; :func:`ring_patch` keeps it within its bounds); ``centre`` None: the
+    crest (the point farthest from the target's mean plane) and radius 0."""
+    from gridshell.geometry.igl_adapter import closest_points, triangulate
+
+    tV, T, _ = triangulate(np.asarray(V, float), F)
+    N = np.cross(tV[T[:, 1]] - tV[T[:, 0]], tV[T[:, 2]] - tV[T[:, 0]])   # 2 x area normals
+    area = 0.5 * np.linalg.norm(N, axis=1).sum()
+    if centre is None:     # a crest without a near-umbilic region (a bump): its highest point
+        n = N.sum(axis=0)
+        n = n / (np.linalg.norm(n) or 1.0)
+        h = (tV - tV.mean(axis=0)) @ n
+        centre, share = tV[int(np.argmax(np.abs(h)) if abs(h.min()) > h.max()
+                               else np.argmax(h))], 0.0
+    _, _, C = closest_points(np.asarray([centre], float), tV, T)
+    inner = float(np.sqrt(OCULUS * share * area / np.pi))
+    # the normal: the area-weighted mean over the faces within the oculus (one face at the
+    # apex of a fan is tilted)
+    near = np.linalg.norm(tV[T].mean(axis=1) - C[0], axis=1) <= max(inner, 1e-9)
+    normal = N[near].sum(axis=0) if near.any() else N.sum(axis=0)
+    return np.asarray(C[0], float), normal, inner

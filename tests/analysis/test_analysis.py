@@ -117,3 +117,26 @@ def test_largest_rectangle_matches_brute_force(seed):
     (i0, i1), (j0, j1) = r.rows, r.cols
     assert ok[i0:i1 + 1, j0:j1 + 1].all()
     assert np.isclose(r.share, best / area[on].sum())
+
+
+def test_a_dome_without_a_regular_patch_gets_the_ring_around_its_umbilic():
+    """The ring (inner to outer radius about the crown, a 10 % gap) on z = -a r^2: its share
+    of the target is the closed-form area of the annulus sector, int sqrt(1 + 4 a^2 r^2) r dr
+    dtheta, over the mesh's area; the recommendation without a GG trial stays GG and names
+    the ring."""
+    a_, (V, F) = 0.3, paraboloid()
+    a = analyze_target((V, F), units="m", samples=48, trial=False)
+    assert a.coverage["phlw"] < 50 and a.ring["kind"] == "ring around the umbilic"
+    assert np.hypot(*a.ring["centre_m"][:2]) < 0.05
+    i, o = a.ring["inner_m"], a.ring["outer_m"]
+    assert 0.25 * o - 1e-9 <= i <= 0.45 * o + 1e-9 and 0.9 < o <= 1.0
+
+    def prim(r):
+        return (1 + 4 * a_ * a_ * r * r) ** 1.5 / (12 * a_ * a_)
+    ring_area = 0.9 * 2 * np.pi * (prim(o) - prim(i))
+    T = V[F]
+    area = 0.5 * np.linalg.norm(np.cross(T[:, 1] - T[:, 0], T[:, 2] - T[:, 0]), axis=1).sum()
+    assert a.ring["share_percent"] == pytest.approx(100 * ring_area / area, rel=0.05)
+    rec = a.recommendation
+    assert rec.pipeline == "gg" and "ring around the umbilic" in rec.why
+    assert a.as_dict()["ring"] == a.ring

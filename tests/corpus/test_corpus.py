@@ -190,7 +190,7 @@ def test_select_and_the_fast_subset():
 
 # ---- the shapes architects draw, in the files users bring ---------------------------------
 
-USER_FAMILIES = ("bump", "round-dome", "asym-hill", "pavilion")
+USER_FAMILIES = ("bump", "round-dome", "asym-hill", "pavilion", "round-plan")
 
 
 def test_user_families_come_in_every_format_and_unit():
@@ -244,3 +244,28 @@ def test_pavilion_footprint_is_three_by_two():
         base = (V - np.asarray(r.offset)) @ R        # back to the canonical frame (R^T R = I)
         dx, dy = np.ptp(base[:, 0]), np.ptp(base[:, 1])
         assert 1.35 < max(dx, dy) / min(dx, dy) < 1.7
+
+
+def test_round_plans_have_the_closed_form_crown_and_a_round_rim():
+    """The round-plan family: at the plan's centre a dome of revolution is umbilic with the
+    closed-form curvature (paraboloid h (1 - r^2 / R2): 2 h / R2; sphere of radius R: 1 / R;
+    oblate spheroid of semi-axes R, R, c at its pole: c / R^2); the grid's outer ring of
+    vertices lies on the rim, 1 to 1.1 times the semi-axes from the centre (canonical plan)."""
+    refs = select("round-plan")
+    assert len(refs) == 10 and len({r.params["kind"] for r in refs}) >= 5
+    assert {r.mesh for r in refs} == {"quad", "tri"} and {"3dm", "obj"} <= {r.file_format
+                                                                        for r in refs}
+    for r in refs:
+        p, t = r.params, r.params["terms"]
+        if p["kind"] in ("paraboloid", "sphere", "oblate"):
+            k = {"paraboloid": lambda: -2 * t[1][1],
+                 "sphere": lambda: 1 / t[0][1],
+                 "oblate": lambda: t[0][3] / t[0][1] ** 2}[p["kind"]]() / r.scale
+            k1, k2 = r.principal_curvatures(np.array([0.5]), np.array([0.5]))
+            assert abs(abs(k1[0]) - k) < 0.01 * k and abs(abs(k2[0]) - k) < 0.01 * k, r.name
+            assert r.revolution and r.curvature == "K>0" and r.no_net == ("ncp-aa",)
+        P = r.grid()
+        rim = np.concatenate([P[0], P[-1], P[:, 0], P[:, -1]])
+        base = (rim - np.asarray(r.offset)) @ np.asarray(r.rotation) / r.scale  # canonical
+        rho = np.hypot(base[:, 0] - base[:, 0].mean(), (base[:, 1] - base[:, 1].mean()) / p["Y"])
+        assert rho.min() > 0.99 * rho.max() / 1.1 and rho.max() / rho.min() < 1.11, r.name
