@@ -50,3 +50,57 @@ def test_other_failures_pass_through(monkeypatch):
     V, F = sphere_cap()
     with pytest.raises(ConvergenceError, match="post-optimization"):
         admissible.design_ncp_explained((V, F), mode="cnc", units="m")
+
+
+class _Design:
+    """A design whose net covers ``coverage`` % of the target (only what the gate reads)."""
+
+    def __init__(self, coverage):
+        self.bundle = type("B", (), {"metrics": {"fidelity": {"coverage": coverage}}})()
+
+
+@pytest.fixture
+def covering(monkeypatch, tmp_path):
+    """``run(target, coverage, **kw)``: design_ncp_explained on the mesh ``target`` (written to
+    an OBJ) where the regular design's net covers ``coverage`` % and the ring's design fails
+    (covers 50 %) unless ``ring`` is given; the ring's calls are counted."""
+    from gridshell.geometry.meshfile import write_mesh
+    from gridshell.ncp import pipeline
+
+    calls = []
+
+    def run(mesh, coverage, ring=None, **kw):
+        monkeypatch.setattr(pipeline, "design_ncp", lambda source, **k: _Design(coverage))
+        monkeypatch.setattr(admissible, "ring_design", lambda *a, **k: calls.append(k) or (
+            (ring, "") if ring is not None else (None, "the ring's net covers 50 %")))
+        path = tmp_path / "target.obj"
+        write_mesh(path, *mesh)
+        return admissible.design_ncp_explained(str(path), mode="phlw", units="m", **kw)
+    run.calls = calls
+    return run
+
+
+def test_a_dome_net_under_60_percent_is_exit_3_naming_coverage_and_umbilic(covering):
+    from tests.analysis.test_analysis import paraboloid
+
+    with pytest.raises(NoNetError) as e:
+        covering(paraboloid(), 55.0)
+    msg = str(e.value)
+    assert "covers 55 % of the target, less than 60 %" in msg and "near-umbilic" in msg
+    assert "the ring's net covers 50 %" in msg and "--min-coverage 0" in msg
+    assert covering.calls[-1]["min_coverage"] == pytest.approx(60.0)
+    kept = covering(paraboloid(), 55.0, min_coverage=0)       # no gate: as it is
+    assert kept.bundle.metrics["fidelity"]["coverage"] == 55.0
+    ring = _Design(75.0)
+    assert covering(paraboloid(), 55.0, ring=ring) is ring      # the ring covers more
+
+
+def test_a_regular_patch_keeps_its_net_unless_the_user_gates_it(covering):
+    from tests.analysis.test_analysis import saddle
+
+    n = len(covering.calls)
+    assert covering(saddle(), 44.0).bundle.metrics["fidelity"]["coverage"] == 44.0
+    assert len(covering.calls) == n + 1                # the ring was tried (it covers less)
+    assert covering(saddle(), 70.0).bundle.metrics["fidelity"]["coverage"] == 70.0
+    with pytest.raises(NoNetError, match="less than --min-coverage 80 %"):
+        covering(saddle(), 70.0, min_coverage=80.0)
