@@ -24,6 +24,9 @@ __all__ = ["design_ncp_explained", "no_patch_finding", "ring_design"]
 #: near-umbilic share of a target (%) from which a regular patch's net must cover
 #: :data:`RING_COVERAGE` % by default: the patch ends at umbilics (an elliptic dome's)
 UMBILIC_SHARE = 1.0
+#: curves per family of the second design a net covering too little of the target gets
+#: (default 10: its outer loops end a spacing short of the rim)
+DENSE_CURVES = 16
 #: net-direction samples and level-set control points on a ring (radius, angle)
 RING_SAMPLES = (48, 96)
 RING_LEVELSET = (8, 30)
@@ -88,8 +91,9 @@ def design_ncp_explained(source: Any, *, mode: str = "phlw", units: Any = None,
     after the ring around the umbilic (:func:`ring_design`) failed too.
 
     The coverage gate on a target file (% of its area within 2 % of the net): a design below
-    ``min_coverage`` is replaced by the ring's where that covers more and at least the gate,
-    else refused (:class:`NoNetError`). ``None`` (the default): :data:`RING_COVERAGE` where
+    ``min_coverage`` is replaced by a denser net's (:data:`DENSE_CURVES`, unless the user
+    set ``curves`` or ``spacing``) or the ring's where that covers more and at least the
+    gate, else refused (:class:`NoNetError`). ``None`` (the default): :data:`RING_COVERAGE` where
     the analysis finds no regular patch of the mode over :data:`MIN_COVERAGE` % (a dome, a
     hill), else a regular design under :data:`MIN_COVERAGE` % is kept unless the ring covers
     more (its coverage in the summary and design.json); ``0``: no gate."""
@@ -115,15 +119,35 @@ def design_ncp_explained(source: Any, *, mode: str = "phlw", units: Any = None,
     return _coverage_gate(design, source, mode, units, obj, min_coverage, options)
 
 
+def _coverage(design: Any) -> float:
+    """The share (%) of the target its net covers (design.json ``metrics.fidelity``)."""
+    return float((design.bundle.metrics.get("fidelity") or {}).get("coverage", 100.0))
+
+
 def _coverage_gate(design: Any, source: Any, mode: str, units: Any, obj: str | None,
                    min_coverage: float | None, options: dict) -> Any:
     """``design`` when its net covers enough of the target (:func:`design_ncp_explained`),
-    else the ring's design, else ``design`` kept (default gate, a regular patch exists) or
+    else (without ``curves`` or ``spacing``) the denser net of :data:`DENSE_CURVES` curves
+    where that covers enough, else the ring's design, else ``design`` kept (default gate, a regular patch exists) or
     :class:`NoNetError` naming the coverage and the analysis's finding."""
-    cov = float((design.bundle.metrics.get("fidelity") or {}).get("coverage", 100.0))
+    cov = _coverage(design)
     if not isinstance(source, (str, os.PathLike)) or min_coverage == 0 or \
             cov >= (RING_COVERAGE if min_coverage is None else min_coverage):
         return design
+    if options.get("curves") is None and options.get("spacing") is None:
+        # the net's outer loops fall a spacing short of the rim: a denser net reaches further
+        from gridshell.core.errors import GridshellError
+        from gridshell.ncp.pipeline import design_ncp
+
+        try:
+            denser = design_ncp(source, mode=mode, units=units, obj=obj,
+                                **dict(options, curves=DENSE_CURVES))
+        except GridshellError:
+            denser = None
+        if denser is not None and _coverage(denser) > cov:
+            design, cov = denser, _coverage(denser)
+        if cov >= (RING_COVERAGE if min_coverage is None else min_coverage):
+            return design
     a = _analysis(source, units, obj)
     finding = no_patch_finding(source, mode, units=units, obj=obj, analysis=a)
     if finding is None and a is not None and a.classes["near umbilic"] >= UMBILIC_SHARE:

@@ -62,15 +62,18 @@ class _Design:
 @pytest.fixture
 def covering(monkeypatch, tmp_path):
     """``run(target, coverage, **kw)``: design_ncp_explained on the mesh ``target`` (written to
-    an OBJ) where the regular design's net covers ``coverage`` % and the ring's design fails
-    (covers 50 %) unless ``ring`` is given; the ring's calls are counted."""
+    an OBJ) where the regular design's net covers ``coverage`` % (with DENSE_CURVES curves
+    ``dense`` %, if given) and the ring's design fails (covers 50 %) unless ``ring`` is given;
+    the ring's calls are counted."""
     from gridshell.geometry.meshfile import write_mesh
     from gridshell.ncp import pipeline
 
     calls = []
 
-    def run(mesh, coverage, ring=None, **kw):
-        monkeypatch.setattr(pipeline, "design_ncp", lambda source, **k: _Design(coverage))
+    def run(mesh, coverage, ring=None, dense=None, **kw):
+        monkeypatch.setattr(pipeline, "design_ncp", lambda source, **k: _Design(
+            dense if dense is not None and k.get("curves") == admissible.DENSE_CURVES
+            else coverage))
         monkeypatch.setattr(admissible, "ring_design", lambda *a, **k: calls.append(k) or (
             (ring, "") if ring is not None else (None, "the ring's net covers 50 %")))
         path = tmp_path / "target.obj"
@@ -104,3 +107,16 @@ def test_a_regular_patch_keeps_its_net_unless_the_user_gates_it(covering):
     assert covering(saddle(), 70.0).bundle.metrics["fidelity"]["coverage"] == 70.0
     with pytest.raises(NoNetError, match="less than --min-coverage 80 %"):
         covering(saddle(), 70.0, min_coverage=80.0)
+
+
+def test_a_denser_net_is_tried_first_where_the_default_covers_too_little(covering):
+    from tests.analysis.test_analysis import paraboloid
+
+    n = len(covering.calls)
+    got = covering(paraboloid(), 55.0, dense=64.0)
+    assert got.bundle.metrics["fidelity"]["coverage"] == 64.0 and len(covering.calls) == n
+    with pytest.raises(NoNetError, match="covers 57 % of the target"):   # the better of two
+        covering(paraboloid(), 55.0, dense=57.0)
+    with pytest.raises(NoNetError, match="covers 55 %"):       # the user's own curves: kept
+        covering(paraboloid(), 55.0, dense=64.0, curves=8)
+
