@@ -165,25 +165,36 @@ def _figures(mode: str, metrics: dict[str, Any]) -> dict[str, Any]:
             "deviation": get("deviation")}
 
 
-def run_one(ref: Reference, mode: str, work: Path, timeout: float,
-            fab_args: list[str] = ()) -> dict[str, Any]:
-    """One run of ``mode`` on ``ref`` in ``work``, with its checks; a JSON-able record."""
+def _target(ref: Reference, work: Path) -> tuple[Path, Path, list[str]]:
+    """``(folder, target file, --units words)`` of ``ref`` in ``work`` (the file written once;
+    ``--units`` as a user passes it: not for a .3dm, which carries its own)."""
     d = work / ref.name
     d.mkdir(parents=True, exist_ok=True)
     target = d / target_name(ref)
     if not target.exists():
         ref.write_target(d)
-    units = [] if ref.file_format == "3dm" else ["--units", ref.units]  # as a user passes it
+    return d, target, [] if ref.file_format == "3dm" else ["--units", ref.units]
+
+
+def _record(ref: Reference, mode: str, res: dict[str, Any]) -> dict[str, Any]:
+    """The record of ``mode`` on ``ref`` after its command's result ``res``, checks empty."""
+    return {"reference": ref.name, "family": ref.family, "mode": mode,
+            "mesh": f"{ref.mesh[0]}{ref.rows}x{ref.cols}", "size": ref.size,
+            "curvature": ref.curvature, "expect_no_net": mode in ref.no_net,
+            "tried": mode in ref.tried, "file": f"{ref.file_format} {ref.units}",
+            "code": res["code"], "time": res["time"], "message": "", "gates": [],
+            "verify_ok": None, "verify_gates_ok": None, "fabricate": None, "energy_up": [],
+            "converged": None}
+
+
+def run_one(ref: Reference, mode: str, work: Path, timeout: float,
+            fab_args: list[str] = ()) -> dict[str, Any]:
+    """One run of ``mode`` on ``ref`` in ``work``, with its checks; a JSON-able record."""
+    d, target, units = _target(ref, work)
     out = d / mode
     words = {**MODES, **PHLW_MODES}[mode]
-    rec: dict[str, Any] = {"reference": ref.name, "family": ref.family, "mode": mode,
-                           "mesh": f"{ref.mesh[0]}{ref.rows}x{ref.cols}", "size": ref.size,
-                           "curvature": ref.curvature, "expect_no_net": mode in ref.no_net,
-                           "tried": mode in ref.tried,
-                           "file": f"{ref.file_format} {ref.units}"}
     res = _call([words[0], str(target), "-o", str(out), "--json", *units, *words[1:]], timeout)
-    rec.update(code=res["code"], time=res["time"], message="", gates=[], verify_ok=None,
-               verify_gates_ok=None, fabricate=None, energy_up=[], converged=None)
+    rec = _record(ref, mode, res)
     if res["code"] is None:
         rec["message"] = f"timeout after {timeout:g} s"
         return rec
@@ -233,23 +244,13 @@ def run_recommended(ref: Reference, mode: str, work: Path, timeout: float,
                     fab_args: list[str] = ()) -> dict[str, Any]:
     """``gridshell analyze`` on ``ref`` (its GG trial included), then the run it recommends
     (:func:`run_one`), its record marked ``recommended`` with the analysis's time and why."""
-    d = work / ref.name
-    d.mkdir(parents=True, exist_ok=True)
-    target = d / target_name(ref)
-    if not target.exists():
-        ref.write_target(d)
-    units = [] if ref.file_format == "3dm" else ["--units", ref.units]
+    _, target, units = _target(ref, work)
     a = _call(["analyze", str(target), "--json", "--no-files", "-q", *units], timeout)
     words = ((_json(a["stdout"]) or {}).get("recommended") or "").split()
     pick = ("gg" if words[1:2] == ["gg"] else
             f"ncp-{words[words.index('--mode') + 1]}" if "--mode" in words else None)
     if a["code"] != 0 or pick not in MODES:
-        rec = {"reference": ref.name, "family": ref.family, "mode": "analyze",
-               "mesh": f"{ref.mesh[0]}{ref.rows}x{ref.cols}", "size": ref.size,
-               "curvature": ref.curvature, "expect_no_net": False, "tried": False,
-               "file": f"{ref.file_format} {ref.units}", "code": a["code"], "time": a["time"],
-               "message": _message(a) or "no recommendation", "gates": [], "verify_ok": None,
-               "verify_gates_ok": None, "fabricate": None, "energy_up": [], "converged": None}
+        rec = dict(_record(ref, "analyze", a), message=_message(a) or "no recommendation")
     else:
         rec = run_one(ref, pick, work, timeout, fab_args)
     rec.update(recommended=True, analyze_time=a["time"],
