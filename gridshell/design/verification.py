@@ -249,14 +249,14 @@ def _read_target(d: dict) -> Any:
                       clean=given.get("clean", True) is not None, require_disk=False)
 
 
-def _deviation_figures(d: dict, net: Any, surf_V: np.ndarray,
-                       surf_F: np.ndarray) -> dict[str, Any]:
+def _deviation_figures(d: dict, net: Any, surf_V: np.ndarray, surf_F: np.ndarray,
+                       fidelity: bool = True) -> dict[str, Any]:
     """``deviation`` (% of the diagonal): NCP kinds, of the joints from surface.obj; GG, of
     surface.obj (and ``deviation_joints``) from the target of ``params.target``, read as the
     design read it (``{"skipped": reason}`` when unreadable; nothing without a target).
     Both: ``fidelity``, the net's deviation from the user's target and its coverage
     (:func:`gridshell.measure.fidelity.net_fidelity`, issue 29 item 4), from the target file
-    (NCP from a B-spline surface.json: from surface.obj)."""
+    (NCP from a B-spline surface.json: from surface.obj); not with ``fidelity`` False."""
     from gridshell.core.errors import InputError
     from gridshell.measure.fidelity import net_fidelity
     from gridshell.measure.metrics import deviation, deviations
@@ -265,6 +265,8 @@ def _deviation_figures(d: dict, net: Any, surf_V: np.ndarray,
     if d["kind"] != "GG":  # the joints from the designed (PHLW) surface, as the pipeline measures them
         dv = deviation(net.joints, surf_V, surf_F, reuse=True)
         out["deviation"] = {"mean": dv["mean"], "max": dv["max"]}
+    if not fidelity and d["kind"] != "GG":
+        return out
     try:
         t = _read_target(d)
     except InputError as exc:
@@ -275,8 +277,9 @@ def _deviation_figures(d: dict, net: Any, surf_V: np.ndarray,
     if t is None and d["kind"] == "GG":
         return out
     tV, tF = (t.V, t.F) if t is not None else (surf_V, surf_F)
-    out["fidelity"] = {**net_fidelity(net.joints, net.loops, tV, tF),
-                       "target": t.path if t is not None else "surface.obj"}
+    if fidelity:
+        out["fidelity"] = {**net_fidelity(net.joints, net.loops, tV, tF),
+                           "target": t.path if t is not None else "surface.obj"}
     if d["kind"] == "GG":
         dv, dj = deviations([surf_V, net.joints], t.V, t.F)
         out["deviation"] = {"mean": dv["mean"], "max": dv["max"]}
@@ -348,7 +351,7 @@ def _verdict(out: dict[str, Any], d: dict, net: Any, problems: list[str]) -> Non
     out["ok"] = not bad and not problems
 
 
-def verify_bundle(path: str | Path) -> dict[str, Any]:
+def verify_bundle(path: str | Path, *, fidelity: bool = True) -> dict[str, Any]:
     """Metrics of the bundle at ``path`` recomputed from design.json, net.obj, axes.obj,
     surface.obj (and aligned.obj, axes_r.npy, aligned_r.npy when present).
 
@@ -363,13 +366,14 @@ def verify_bundle(path: str | Path) -> dict[str, Any]:
     The verdict: ``required`` (the figures and files this kind needs), ``gates`` (:func:`gridshell.measure.quality.design_gates` of the recomputed figures,
     as dicts), ``checks`` (their pass / FAIL lines), ``problems`` (a file of
     :data:`FIGURE_FILES` missing, a figure not computed, a mismatch) and ``ok``: every gate
-    holds and there is no problem. A bundle whose net.obj, axes.obj, surface.obj or
-    design.json cannot be read raises :class:`~gridshell.core.errors.InputError`.
+    holds and there is no problem. ``fidelity`` (default True): also the net's ``fidelity``
+    to the user's target (no gate; the pre-cut verdict leaves it out). A bundle whose net.obj,
+    axes.obj, surface.obj or design.json cannot be read raises :class:`~gridshell.core.errors.InputError`.
     """
     path = Path(path)
     d, done, net, surf_V, surf_F = _read_files(path)
     out = _net_figures(d, net, surf_V, surf_F)
-    out.update(_deviation_figures(d, net, surf_V, surf_F))
+    out.update(_deviation_figures(d, net, surf_V, surf_F, fidelity))
     problems = [f"{name} is missing: the figures that need it were not computed"
                 for name in FIGURE_FILES[d["kind"]] if not (path / name).is_file()]
     Va = _read_aligned(path, done, net)
@@ -404,7 +408,7 @@ def design_verdict(bundle: Any) -> Verdict:
     (:func:`verify_bundle`); an in-memory :class:`~gridshell.design.bundle.DesignBundle` on its
     metrics (:func:`gridshell.measure.quality.design_gates`)."""
     if isinstance(bundle, (str, Path)):
-        res = verify_bundle(bundle)
+        res = verify_bundle(bundle, fidelity=False)   # no gate on it: not measured here
         return Verdict(tuple(Gate.from_dict(g) for g in res["gates"]), tuple(res["problems"]), res)
     from gridshell.measure.quality import design_gates
 
