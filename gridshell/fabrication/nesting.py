@@ -337,6 +337,9 @@ COLUMNS = 8        # most columns of turned straight strips tried per sheet (row
 #: raster passes for curved parts (:mod:`gridshell.fabrication.raster`), cheapest first: pixel size
 #: (mm), rotation step (degrees; free rotation), the height that ranks places
 RASTER = [(1.5, 15.0, "centre"), (1.0, 10.0, "top"), (1.0, 10.0, "centre")]
+#: most correlations (one per rotation and sheet tried) a raster pass may compute (about a
+#: minute at 1 mm pixels on a 600 x 400 mm sheet); a bigger layout keeps the drop nesting's
+RASTER_WORK = 20000
 
 
 def _key(key: str, x: np.ndarray, y: np.ndarray, h: float) -> np.ndarray:
@@ -474,15 +477,16 @@ def _raster_best(parts: list[Part], shapes: list[list[_Shape]], Lx: float, Ly: f
                  g: float, rotation: str, best: tuple | None, floor: int, passes: list
                  ) -> tuple | None:
     """``best`` or a better layout of the raster ``passes`` (of :data:`RASTER`), parts largest
-    first; stops at ``floor`` sheets. Under ``rotation="grain"`` parts turn by 0 or 180 degrees only
-    (from their nesting orientation, chord along the long side)."""
+    first; stops at ``floor`` sheets; a pass over :data:`RASTER_WORK` correlations is dropped.
+    Under ``rotation="grain"`` parts turn by 0 or 180 degrees only (from their nesting
+    orientation, chord along the long side)."""
     polys = [s[0].poly for s in shapes]
     order = sorted(range(len(parts)), key=lambda i: (-polys[i].area, i))
     for res, step, key in passes:
         if best is not None and best[0][0] <= floor:
             break
         got = raster_nest(polys, Lx, Ly, g, order, step=step, turns=rotation, res=res,
-                          key=key)
+                          key=key, budget=RASTER_WORK)
         if got is None:
             continue
         sheet_of, motion, n = got

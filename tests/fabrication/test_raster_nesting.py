@@ -141,3 +141,22 @@ def test_depth_pruning_keeps_the_layout_and_skips_products(monkeypatch):
     assert with_rule[0] == without[0] and with_rule[2] == without[2] >= 3
     assert with_rule[1] == without[1]
     assert n_with <= calls["n"] - 8            # each bar skips at least the first sheet
+
+
+def test_pose_cache_and_work_budget(monkeypatch):
+    """Keeping the poses of one outline at a time (POSES = 1) gives the layout of a cache of
+    every outline; a pass whose correlations exceed ``budget`` gives None (the drop layout is
+    kept), one within the budget the same layout as without a budget."""
+    import gridshell.fabrication.raster as raster
+
+    rng = np.random.default_rng(5)
+    base = _parts(rng, 4)
+    polys = base + base + _parts(rng, 8)            # congruent parts share their poses
+    order = sorted(range(len(polys)), key=lambda i: -polys[i].area)
+    free = raster_nest(polys, 300.0, 200.0, 2.0, order, step=30.0)
+    monkeypatch.setattr(raster, "POSES", 1)
+    one = raster_nest(polys, 300.0, 200.0, 2.0, order, step=30.0)
+    assert one[0] == free[0] and one[1] == free[1] and one[2] == free[2] >= 2
+    assert raster_nest(polys, 300.0, 200.0, 2.0, order, step=30.0, budget=5) is None
+    big = raster_nest(polys, 300.0, 200.0, 2.0, order, step=30.0, budget=10 ** 6)
+    assert big[0] == free[0] and big[1] == free[1]
