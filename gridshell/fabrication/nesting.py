@@ -338,7 +338,7 @@ COLUMNS = 8        # most columns of turned straight strips tried per sheet (row
 #: (mm), rotation step (degrees; free rotation), the height that ranks places
 RASTER = [(1.5, 15.0, "centre"), (1.0, 10.0, "top"), (1.0, 10.0, "centre")]
 #: most correlations (one per rotation and sheet tried) a raster pass may compute (about a
-#: minute at 1 mm pixels on a 600 x 400 mm sheet); a bigger layout keeps the drop nesting's
+#: minute at 1 mm pixels on a 600 x 400 mm sheet); a bigger layout keeps the drop layout
 RASTER_WORK = 20000
 
 
