@@ -129,8 +129,9 @@ def _lift(p: _Pose, key: str) -> float:
 
 
 class _Sheet:
-    """A raster sheet: occupancy image, its FFT, the exact placed polygons and the
-    :func:`depth` of its free pixels within ``extent`` (pixel rows and columns of the sheet)."""
+    """A raster sheet: occupancy image, its FFT, the exact placed polygons, the
+    :func:`depth` of its free pixels within ``extent`` (pixel rows and columns of the sheet)
+    and the number of correlations (one per rotation) computed on it."""
 
     def __init__(self, shape: tuple[int, int], extent: tuple[int, int]):
         self.occ = np.zeros(shape, np.float32)
@@ -138,17 +139,16 @@ class _Sheet:
         self.polys: list[Polygon] = []
         self.extent = extent
         self.depth = self._free_depth()
+        self.correlations = 0
 
     def _free_depth(self) -> float:
         a, b = self.extent
         return depth(self.occ[:a, :b] < FREE)
 
     def place(self, poses: tuple[list[_Pose], np.ndarray | None], gap: float, res: float,
-              shape: tuple[int, int], key: str = "bottom", work: list[int] | None = None
-              ) -> tuple[_Pose, float, float] | None:
+              shape: tuple[int, int], key: str = "bottom") -> tuple[_Pose, float, float] | None:
         """The free place over the poses (and their masks' FFTs stacked) whose ranking height
-        (``key``) is lowest, then leftmost, checked exactly; None if there is none. ``work[0]``
-        counts the correlations (one per rotation) computed."""
+        (``key``) is lowest, then leftmost, checked exactly; None if there is none."""
         poses, stack = poses
         fits = [k for k, p in enumerate(poses) if p.depth <= self.depth]
         if len(fits) < len(poses):          # rotations too deep for the free pixels
@@ -156,8 +156,7 @@ class _Sheet:
         if not poses:
             return None
         if self.polys:
-            if work is not None:
-                work[0] += len(poses)
+            self.correlations += len(poses)
             F = stack * self.fft[None]
             corr = scipy.fft.irfft2(F, s=shape, axes=(1, 2))
         lifts = [_lift(p, key) / res for p in poses]
@@ -227,12 +226,14 @@ def raster_nest(polys: list[Polygon], Lx: float, Ly: float, gap: float,
         angles = np.radians(np.arange(0.0, 360.0, step))
     cache: OrderedDict = OrderedDict()      # the poses of the last POSES outlines
 
-    def poses_of(P: Polygon) -> tuple[list[_Pose], np.ndarray | None]:
+    def poses_of(P: Polygon) -> tuple[Motion, tuple[list[_Pose], np.ndarray | None]]:
+        """The move of ``P`` to the origin and its poses (with their FFTs stacked)."""
         x0, y0, _, _ = P.bounds                   # parts of one outline share their poses
+        pre = Motion(0.0, -x0, -y0)
         same = np.round(np.asarray(P.exterior.coords) - (x0, y0), 3).tobytes()
         if same in cache:
             cache.move_to_end(same)
-            return cache[same]
+            return pre, cache[same]
         ps = _poses(shapely.affinity.translate(P, -x0, -y0), Lx, Ly, gap, angles, shape, res)
         stack = np.stack([p.fft for p in ps]) if ps else None
         for k, p in enumerate(ps):
@@ -240,20 +241,18 @@ def raster_nest(polys: list[Polygon], Lx: float, Ly: float, gap: float,
         cache[same] = (ps, stack)
         if len(cache) > POSES:
             cache.popitem(last=False)
-        return cache[same]
+        return pre, cache[same]
 
     sheets: list[_Sheet] = []
-    work = [0]
     sheet_of = [0] * len(polys)
     motion = [Motion()] * len(polys)
     for i in order:
-        P = polys[i]
-        pre, ps = Motion(0.0, -P.bounds[0], -P.bounds[1]), poses_of(P)
+        pre, ps = poses_of(polys[i])
         for k in range(len(sheets) + 1):
             if k == len(sheets):
                 sheets.append(_Sheet(shape, extent))
-            got = sheets[k].place(ps, gap, res, shape, key, work)
-            if budget is not None and work[0] > budget:
+            got = sheets[k].place(ps, gap, res, shape, key)
+            if budget is not None and sum(s.correlations for s in sheets) > budget:
                 return None
             if got is not None:
                 break
