@@ -5,11 +5,12 @@ analysed on its working copy, :func:`gridshell.io.working.working_mesh`), takes 
 (a .3dm NURBS surface as it is, else the least-squares fit of the NCP pipeline, paper 4.2.1),
 samples the curvature map (:mod:`~gridshell.analysis.maps`), finds the regions and the
 largest patch each NCP mode admits (:mod:`~gridshell.analysis.regions`), runs the coarse GG
-trial (:mod:`~gridshell.analysis.trial`) and recommends (:mod:`~gridshell.analysis.recommend`).
+and NCP trials (:mod:`~gridshell.analysis.trial`) and recommends (:mod:`~gridshell.analysis.recommend`).
 :func:`write_analysis` writes analysis.json and analysis.png.
 """
 from __future__ import annotations
 
+import dataclasses
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -20,12 +21,14 @@ import numpy as np
 from gridshell.analysis.maps import K_ZERO, UMBILIC_GAP, CurvatureMap, curvature_map
 from gridshell.analysis.recommend import MIN_COVERAGE, Recommendation, recommend
 from gridshell.analysis.regions import Rectangle, Region, largest_rectangle, regions
-from gridshell.analysis.trial import GGTrial, gg_trial
+from gridshell.analysis.trial import GGTrial, NCPTrial, gg_trial, ncp_trial
 
 __all__ = ["ANALYSIS_FACES", "Analysis", "analyze_target", "summary_of", "write_analysis"]
 
 #: faces of the working copy the analysis runs on (a 200k-triangle target is decimated)
 ANALYSIS_FACES = 20000
+#: faces of the copy the NCP trials fit against
+TRIAL_FACES = 2000
 #: what each NCP mode needs of the surface (paper 3-4), as said in analysis.json
 CONDITIONS = {"phlw": "a regular patch of curvature lines: no near-umbilic sample, K of one "
                       "sign (no parabolic line)",
@@ -46,6 +49,7 @@ class Analysis:
     recommendation: Recommendation
     seconds: float
     ring: dict[str, Any] | None = None
+    ncp_trials: dict[str, NCPTrial] = field(default_factory=dict)
 
     @property
     def coverage(self) -> dict[str, float]:
@@ -66,6 +70,7 @@ class Analysis:
                     for m, r in self.patches.items()},
             "ring": self.ring,
             "gg": None if self.gg is None else self.gg.as_dict(),
+            "ncp_trials": {m: t.as_dict() for m, t in self.ncp_trials.items()},
             "recommendation": self.recommendation.as_dict(),
             "seconds": round(self.seconds, 2),
             "method": ("the target's B-spline (9 x 9, bi-degree 4 least squares, or the .3dm "
@@ -80,8 +85,9 @@ def analyze_target(target: Any, *, units: Any = None, clean: bool = True, obj: s
                    min_coverage: float = MIN_COVERAGE) -> Analysis:
     """Analyse ``target`` (a path, an InputGeometry or ``(V, F)``; ``units``, ``clean``,
     ``obj`` as for :func:`~gridshell.io.read.read_input`). ``samples`` per parameter
-    direction; ``trial``: run the coarse GG design; ``min_coverage`` (%) for a mode to be
-    recommended."""
+    direction; ``trial``: run the coarse GG design and the coarse PHLW step of each NCP mode
+    (the distance of the nearest GG / PHLW / CNC / PK surface); ``min_coverage`` (%) for a
+    mode to be recommended."""
     from gridshell.io.read import read_input
 
     t0 = time.perf_counter()
@@ -100,13 +106,29 @@ def analyze_target(target: Any, *, units: Any = None, clean: bool = True, obj: s
     cov = {k: 0.0 if r is None else 100.0 * r.share for k, r in patches.items()}
     # no regular patch of curvature lines (a dome, a hill): the ring around its umbilic
     ring = _ring(V, F, found) if cov["phlw"] < min_coverage else None
-    gg = gg_trial(g) if trial else None
-    rec = _for_target(recommend(cov, gg, min_coverage, ring=ring), g.path, units, obj)
+    # the trials on the working copy the map was taken on (not a second decimation)
+    # the trials on the map's working copy (not a second decimation)
+    gg = gg_trial(dataclasses.replace(g, V=V, F=F) if working else g) if trial else None
+    trials = _ncp_trials(surface, V, F, m, found) if trial else {}
+    rec = _for_target(recommend(cov, gg, min_coverage, ring=ring, trials=trials), g.path,
+                      units, obj)
     info = {"name": g.name, "path": g.path, "units": g.units.name, "vertices": int(len(g.V)),
             "faces": int(len(g.F)), "diagonal_m": round(m.diagonal, 6),
             "surface": "the .3dm NURBS surface" if g.surface is not None else
             f"least-squares B-spline (rms {rms:.3g} m)", "working_copy": working}
-    return Analysis(info, m, classes, found, patches, gg, rec, time.perf_counter() - t0, ring)
+    return Analysis(info, m, classes, found, patches, gg, rec, time.perf_counter() - t0, ring,
+                    trials)
+
+
+def _ncp_trials(surface: Any, V: np.ndarray, F: np.ndarray, m: CurvatureMap,
+                found: list[Region]) -> dict[str, NCPTrial]:
+    """The coarse PHLW step of each NCP mode against a copy of the target of at most
+    :data:`TRIAL_FACES` faces (the step's closest points are most of its time; its 8 x 8
+    samples need no more), its distances measured on the map's samples."""
+    from gridshell.io.working import working_mesh
+
+    Vt, Ft, _ = working_mesh(V, F, TRIAL_FACES)
+    return {k: ncp_trial(surface, Vt, Ft, k, m, found) for k in ("phlw", "cnc", "aa")}
 
 
 def _ring(V: np.ndarray, F: np.ndarray, found: list[Region]) -> dict[str, Any]:
@@ -134,7 +156,6 @@ def _ring(V: np.ndarray, F: np.ndarray, found: list[Region]) -> dict[str, Any]:
 def _for_target(rec: Recommendation, path: Any, units: Any, obj: str | None) -> Recommendation:
     """The recommendation with its command spelt for this target: its path, and the
     ``--units`` / ``--object`` the analysis was given."""
-    import dataclasses
     import shlex
 
     cmd = rec.command.replace("TARGET", shlex.quote(str(path)) if path else "TARGET")
@@ -211,7 +232,28 @@ def summary_of(a: Analysis) -> dict[str, Any]:
         d["GG trial"] = (f"deviation mean {a.gg.deviation_mean:.2f} %, max "
                          f"{a.gg.deviation_max:.2f} % of the diagonal; net covers "
                          f"{a.gg.coverage:.0f} % ({a.gg.seconds:.1f} s, coarse)")
+    for mode, t in a.ncp_trials.items():
+        d[f"NCP trial {mode}"] = _trial_line(t)
     d["recommended"] = rec.command
     d["why"] = rec.why
     d["time [s]"] = round(a.seconds, 2)
     return d
+
+
+def _trial_line(t: NCPTrial) -> str:
+    """One line of the summary for an NCP trial: how far its surface lies, and where most."""
+    if t.error is not None:
+        return f"none: {t.error}"
+    kind = t.as_dict()["surface"]
+    d = t.deviation
+    line = (f"nearest {kind} surface {d['mean']:.2f} % mean, {d['max']:.2f} % max of the diagonal "
+            "from the target")
+    worst = max((r for r in t.regions if r["share_percent"] >= 5), default=None,
+                key=lambda r: r["mean"])
+    if worst is not None and len(t.regions) > 1:
+        line += f" (most over the {worst['kind']} region: {worst['mean']:.2f} % mean)"
+    if not t.of_kind:
+        line += (f"; not yet of its kind (relation {t.relation:.2g}, angle {t.angle_deg:.1f} deg, "
+                 f"no real net at {t.no_net_percent:.0f} % of the samples): no {kind} surface "
+                 "this close over the whole target")
+    return line + f" ({t.seconds:.1f} s)"

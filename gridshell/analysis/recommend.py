@@ -43,11 +43,14 @@ class Recommendation:
 
 
 def recommend(coverage: dict[str, float], gg: Any, min_coverage: float = MIN_COVERAGE,
-              ring: dict[str, Any] | None = None) -> Recommendation:
+              ring: dict[str, Any] | None = None, trials: dict[str, Any] | None = None
+              ) -> Recommendation:
     """``coverage``: NCP mode -> % of the target its largest admissible patch covers;
     ``gg``: the :class:`~gridshell.analysis.trial.GGTrial`; ``ring``: the ring around the
     umbilic where no regular patch exists (its ``share_percent``; an NCP PHLW net on it is
-    recommended where it covers :data:`RING_COVERAGE` % and GG does not follow the shape)."""
+    recommended where it covers :data:`RING_COVERAGE` % and GG does not follow the shape);
+    ``trials``: NCP mode -> :class:`~gridshell.analysis.trial.NCPTrial` (an NCP mode's
+    expected deviation is its trial's mean where the trial surface is of its kind)."""
     gg_dev = gg.deviation_mean if gg is not None else None
     if gg_dev is not None and gg_dev <= GG_GOOD:
         return Recommendation("gg", None, "gridshell gg TARGET -o DIR",
@@ -58,8 +61,12 @@ def recommend(coverage: dict[str, float], gg: Any, min_coverage: float = MIN_COV
         best = max(ok, key=lambda m: (coverage[m], -_NCP_ORDER.index(m)))
         why = (f"its largest admissible patch covers {coverage[best]:.0f} % of the target"
                + ("" if gg_dev is None else f"; the nearest GG surface lies {gg_dev:.2f} % away"))
+        t = (trials or {}).get(best)
+        dev = t.deviation["mean"] if t is not None and t.of_kind and t.deviation else None
+        if dev is not None:
+            why += f"; a {t.as_dict()['surface']} surface lies {dev:.2f} % away (coarse trial)"
         return Recommendation("ncp", best, f"gridshell ncp TARGET -o DIR --mode {best}", why,
-                              None, coverage[best])
+                              dev, coverage[best])
     share = (ring or {}).get("share_percent", 0.0)
     if share >= RING_COVERAGE and gg is not None:     # the GG trial ran and misses the shape
         why = (f"no regular patch of curvature lines covers {min_coverage:g} % of the target; "

@@ -11,7 +11,7 @@ exact boundary.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -23,12 +23,14 @@ __all__ = ["Rectangle", "Region", "largest_rectangle", "regions"]
 @dataclass(frozen=True)
 class Region:
     """A connected region of one class: ``kind``, its share of the target's area (0..1),
-    its centre (the area-weighted mean of its samples, metres) and its sample count."""
+    its centre (the area-weighted mean of its samples, metres), its sample count and its
+    samples (``mask``, the map's shape)."""
 
     kind: str
     share: float
     centre: tuple[float, float, float]
     samples: int
+    mask: np.ndarray | None = field(default=None, repr=False, compare=False)
 
     def as_dict(self) -> dict:
         return {"kind": self.kind, "share_percent": round(100 * self.share, 2),
@@ -67,7 +69,7 @@ def regions(m: CurvatureMap, mask: np.ndarray, kind: str, min_share: float = 0.0
             continue
         w = m.area[sel]
         c = (m.S[sel] * w[:, None]).sum(0) / max(w.sum(), 1e-300)
-        out.append(Region(kind, share, tuple(float(x) for x in c), int(sel.sum())))
+        out.append(Region(kind, share, tuple(float(x) for x in c), int(sel.sum()), sel))
     return sorted(out, key=lambda r: -r.share)
 
 
