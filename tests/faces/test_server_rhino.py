@@ -67,7 +67,10 @@ def test_a_mm_3dm_mesh_keeps_its_double_precision_vertices(tmp_path):
     assert g.V.shape == Vmm.shape and g.V.dtype == np.float64
     # metres to the last bits (float32 would be ~1e-6 m off at 12 km from the origin)
     assert np.abs(np.sort(g.V, axis=0) - np.sort(Vmm, axis=0) / 1000.0).max() <= 4e-15 * 20
-    assert np.array_equal(np.sort(g.V * 1000.0, axis=0), np.sort(Vmm, axis=0))
+    # back in mm within one unit in the last place (x / 1000 * 1000 need not be x exactly:
+    # numpy 2.4's exp gives this hill one such vertex)
+    back, want = np.sort(g.V * 1000.0, axis=0), np.sort(Vmm, axis=0)
+    assert np.all(np.abs(back - want) <= np.spacing(np.abs(want)))
 
 
 def test_a_mesh_gives_the_same_arrays_through_the_server_and_the_cli(tmp_path):
