@@ -106,7 +106,6 @@ def analyze_target(target: Any, *, units: Any = None, clean: bool = True, obj: s
     cov = {k: 0.0 if r is None else 100.0 * r.share for k, r in patches.items()}
     # no regular patch of curvature lines (a dome, a hill): the ring around its umbilic
     ring = _ring(V, F, found) if cov["phlw"] < min_coverage else None
-    # the trials on the working copy the map was taken on (not a second decimation)
     # the trials on the map's working copy (not a second decimation)
     gg = gg_trial(dataclasses.replace(g, V=V, F=F) if working else g) if trial else None
     trials = _ncp_trials(surface, V, F, m, found) if trial else {}
@@ -244,7 +243,7 @@ def _trial_line(t: NCPTrial) -> str:
     """One line of the summary for an NCP trial: how far its surface lies, and where most."""
     if t.error is not None:
         return f"none: {t.error}"
-    kind = t.as_dict()["surface"]
+    kind = t.surface
     d = t.deviation
     line = (f"nearest {kind} surface {d['mean']:.2f} % mean, {d['max']:.2f} % max of the diagonal "
             "from the target")

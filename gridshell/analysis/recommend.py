@@ -64,7 +64,7 @@ def recommend(coverage: dict[str, float], gg: Any, min_coverage: float = MIN_COV
         t = (trials or {}).get(best)
         dev = t.deviation["mean"] if t is not None and t.of_kind and t.deviation else None
         if dev is not None:
-            why += f"; a {t.as_dict()['surface']} surface lies {dev:.2f} % away (coarse trial)"
+            why += f"; a {t.surface} surface lies {dev:.2f} % away (coarse trial)"
         return Recommendation("ncp", best, f"gridshell ncp TARGET -o DIR --mode {best}", why,
                               dev, coverage[best])
     share = (ring or {}).get("share_percent", 0.0)

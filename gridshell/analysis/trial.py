@@ -88,8 +88,13 @@ class NCPTrial:
     seconds: float = 0.0
     error: str | None = None
 
+    @property
+    def surface(self) -> str:
+        """The kind of surface the mode's net lives on: PHLW, CNC or PK."""
+        return {"phlw": "PHLW", "cnc": "CNC", "aa": "PK"}[self.mode]
+
     def as_dict(self) -> dict[str, Any]:
-        return {"mode": self.mode, "surface": {"phlw": "PHLW", "cnc": "CNC", "aa": "PK"}[self.mode],
+        return {"mode": self.mode, "surface": self.surface,
                 "deviation_percent": None if self.deviation is None else
                 {k: _r(v, 4) for k, v in self.deviation.items()},
                 "regions": self.regions, "relation_max_rel": _r(self.relation, 5),
